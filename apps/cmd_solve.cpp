@@ -1,0 +1,233 @@
+// trivcon solve MESH [options]   and   trivcon check MESH FIELD [options]
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+
+#include "commands.h"
+#include "summary.h"
+#include "trivcon/design.h"
+#include "trivcon/error.h"
+#include "trivcon/field_io.h"
+
+namespace trivcon::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Options that describe a prescription, shared by solve and check.
+struct PrescriptionOptions {
+  int N = 1;
+  std::vector<std::string> sing_files, sings, generators, loops;
+  void add_to(CLI::App* cmd, bool with_cycles) {
+    cmd->add_option("-N,--symmetry", N, "Symmetry: 1 vectors, 2 lines, 4 crosses, any N >= 1")->check(CLI::Range(1, 1000));
+    cmd->add_option("-s,--singularities", sing_files,
+                    "Singularity file: 'VERTEX INDEX' per line (INDEX integer or p/q), or Directional's .sings");
+    cmd->add_option("--sing", sings, "A singular vertex, V:INDEX (e.g. 12:1/4); repeatable");
+    if (with_cycles) {
+      cmd->add_option("--generator", generators, "Index of generator G (see info --cycles), G:INDEX; repeatable");
+      cmd->add_option("--boundary", loops, "Index of boundary loop L (see info --cycles), L:INDEX; repeatable");
+    }
+  }
+  IndexPrescription build() const {
+    IndexPrescription p;
+    p.N = N;
+    for (const auto& f : sing_files) read_singularities(f, p);
+    for (const auto& s : sings) add_vertex_index(s, p);
+    for (const auto& s : generators) add_generator_index(s, p);
+    for (const auto& s : loops) add_loop_index(s, p);
+    return p;
+  }
+};
+
+struct SolveOptions {
+  std::string mesh;
+  PrescriptionOptions prescription;
+  std::string weights = "cotan", solver = "cholesky";
+  std::vector<int> root_faces;
+  std::vector<double> root_angles;
+  std::string field_out, connection_out, lines_out, report;
+  bool quiet = false;
+};
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << std::setprecision(3) << v;
+  return s.str();
+}
+
+void run_solve(const SolveOptions& o) {
+  nlohmann::ordered_json report;
+  auto t0 = Clock::now();
+  const MeshData mesh = load_mesh(o.mesh);
+  const double read_seconds = seconds_since(t0);
+  const IndexPrescription prescription = o.prescription.build();
+  if (o.root_angles.size() > o.root_faces.size()) throw Error("--root-angle given without a matching --root-face");
+  std::vector<std::pair<int, double>> roots;
+  for (size_t i = 0; i < o.root_faces.size(); ++i) roots.emplace_back(o.root_faces[i], i < o.root_angles.size() ? o.root_angles[i] : 0.0);
+
+  SolverOptions options;
+  options.weights = o.weights == "unit" ? WeightKind::Unit : WeightKind::Cotan;
+  options.solver = o.solver == "qr" ? SolverKind::QR : SolverKind::Cholesky;
+  const FieldDesigner designer(mesh.V, mesh.F, options);
+  const Design d = designer.design(prescription, roots);
+  const Topology& t = designer.topology();
+  const Connection& c = d.connection;
+
+  // Verification: constraint residuals relative to the right-hand sides, transport, indices.
+  const double tolerance = 1e-9 * std::max(1.0, c.rhs_scale);
+  const double residual = std::max(c.max_vertex_residual, c.max_cycle_residual);
+  std::vector<int> unexplained;  // index mismatches not explained by a turn of ≥ π/N across an edge of the vertex
+  for (int v : d.index_mismatch_vertices) {
+    bool large = false;
+    for (int a = t.vertex_edge_offsets[v]; a < t.vertex_edge_offsets[v + 1]; ++a)
+      large |= std::abs(c.x(t.vertex_edges[a])) >= 3.14159265358979323846 / prescription.N;
+    if (!large) unexplained.push_back(v);
+  }
+
+  auto t1 = Clock::now();
+  if (!o.field_out.empty()) write_field(o.field_out, mesh.V, mesh.F, designer.geometry(), d.field);
+  if (!o.connection_out.empty()) write_connection(o.connection_out, t, c.x, prescription.N);
+  if (!o.lines_out.empty()) write_field_lines(o.lines_out, mesh.V, mesh.F, designer.geometry(), d.field);
+  const double write_seconds = seconds_since(t1);
+
+  report["mesh"] = mesh_summary(o.mesh, mesh, t, designer.geometry());
+  report["N"] = prescription.N;
+  report["weights"] = o.weights;
+  report["solver"] = o.solver;
+  nlohmann::ordered_json sing = nlohmann::ordered_json::array();
+  for (auto [v, n] : prescription.vertex) sing.push_back({{"vertex", v}, {"index", format_index(n, prescription.N)}});
+  report["singularities"] = sing;
+  nlohmann::ordered_json gens = nlohmann::ordered_json::array();
+  for (size_t g = 0; g < c.generator_index.size(); ++g)
+    gens.push_back({{"id", g},
+                    {"component", designer.cycles().generators[g].component},
+                    {"index", format_index(c.generator_index[g], prescription.N)},
+                    {"chosen", static_cast<bool>(c.generator_chosen[g])}});
+  report["generators"] = gens;
+  nlohmann::ordered_json loops = nlohmann::ordered_json::array();
+  for (size_t l = 0; l < c.loop_index.size(); ++l)
+    loops.push_back({{"id", l}, {"index", format_index(c.loop_index[l], prescription.N)}, {"chosen", static_cast<bool>(c.loop_chosen[l])}});
+  report["boundary_loops"] = loops;
+  report["energy"] = c.energy;
+  report["residuals"] = {{"max_vertex", c.max_vertex_residual},
+                         {"max_cycle", c.max_cycle_residual},
+                         {"rhs_scale", c.rhs_scale},
+                         {"transport_mismatch", d.transport_mismatch}};
+  nlohmann::ordered_json mism = nlohmann::ordered_json::array();
+  for (int v : d.index_mismatch_vertices) mism.push_back({{"vertex", v}, {"field_index", format_index(d.indices.vertex[v], prescription.N)}});
+  report["indices"] = {{"singular_vertices", prescription.vertex.size()},
+                       {"field_mismatches", mism},
+                       {"unexplained_mismatches", unexplained.size()},
+                       {"large_turn_edges", d.large_turn_edges}};
+  const PrepareTimings& pt = designer.timings();
+  const SetupTimings& st = designer.solver().timings();
+  report["seconds"] = {{"read", read_seconds},     {"topology", pt.topology},     {"geometry", pt.geometry},
+                       {"cycles", pt.cycles},      {"setup", pt.setup},           {"setup_assemble", st.assemble},
+                       {"setup_factor", st.factor}, {"setup_schur", st.schur},    {"solve", d.solve_seconds},
+                       {"field", d.field_seconds}, {"verify", d.verify_seconds}, {"write", write_seconds}};
+  if (!o.report.empty())
+    write_file_atomically(o.report, [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+
+  if (!o.quiet) {
+    std::cout << "mesh " << o.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
+              << " component(s), chi " << t.euler_characteristic() << ", " << designer.cycles().generators.size() << " generator(s), "
+              << t.boundary_loops.size() << " boundary loop(s)\n"
+              << "N " << prescription.N << ", " << prescription.vertex.size() << " singular vertices, weights " << o.weights << ", solver "
+              << o.solver << "\n"
+              << "energy " << std::setprecision(10) << c.energy << "\n"
+              << "max residual " << fmt(residual) << " rad (vertex " << fmt(c.max_vertex_residual) << ", cycles " << fmt(c.max_cycle_residual)
+              << "), transport mismatch " << fmt(d.transport_mismatch) << " rad\n"
+              << "indices read back from the field: " << d.index_mismatch_vertices.size() << " differ from the prescription";
+    if (!d.index_mismatch_vertices.empty())
+      std::cout << " (" << d.index_mismatch_vertices.size() - unexplained.size()
+                << " at vertices where the connection turns by pi/N or more across an edge, which a per-face field cannot show)";
+    std::cout << "\ntime: read " << fmt(read_seconds) << " s, topology " << fmt(pt.topology) << " s, geometry " << fmt(pt.geometry)
+              << " s, cycles " << fmt(pt.cycles) << " s, setup " << fmt(pt.setup) << " s, solve " << fmt(d.solve_seconds) << " s, field "
+              << fmt(d.field_seconds) << " s\n";
+  }
+  if (residual > tolerance || d.transport_mismatch > tolerance || !unexplained.empty()) {
+    std::cerr << "trivcon: verification failed: residual " << residual << ", transport mismatch " << d.transport_mismatch << ", "
+              << unexplained.size() << " unexplained index mismatches\n";
+    exit_code = 3;
+  }
+}
+
+struct CheckOptions {
+  std::string mesh, field;
+  PrescriptionOptions prescription;
+  bool json = false;
+};
+
+void run_check(CheckOptions& o) {
+  const MeshData mesh = load_mesh(o.mesh);
+  check_finite(mesh.V);
+  const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
+  const Geometry g = compute_geometry(mesh.V, t);
+  const Cycles cycles = compute_cycles(t);
+  int file_N = 0;
+  const MatrixX3d directions = read_field(o.field, t.num_faces, &file_N);
+  if (o.prescription.N == 1 && file_N > 1) o.prescription.N = file_N;  // -N not given: take the file's
+  const IndexPrescription p = o.prescription.build();
+  validate_prescription(t, static_cast<int>(cycles.generators.size()), p);
+  const Field field = field_from_directions(g, directions, p.N);
+  const FieldIndices idx = field_indices(t, g, cycles, field);
+  nlohmann::ordered_json found = nlohmann::ordered_json::array(), differ = nlohmann::ordered_json::array();
+  for (int v = 0; v < t.num_vertices; ++v) {
+    const int want = p.vertex.count(v) ? p.vertex.at(v) : 0;
+    if (idx.vertex[v] != 0) found.push_back({{"vertex", v}, {"index", format_index(idx.vertex[v], p.N)}});
+    if (idx.vertex[v] != want)
+      differ.push_back({{"vertex", v}, {"found", format_index(idx.vertex[v], p.N)}, {"prescribed", format_index(want, p.N)}});
+  }
+  nlohmann::ordered_json j;
+  j["N"] = p.N;
+  j["singularities"] = found;
+  j["differences"] = differ;
+  nlohmann::ordered_json loops = nlohmann::ordered_json::array(), gens = nlohmann::ordered_json::array();
+  for (size_t l = 0; l < idx.loop.size(); ++l) loops.push_back({{"id", l}, {"index", format_index(idx.loop[l], p.N)}});
+  for (size_t i = 0; i < idx.generator.size(); ++i) gens.push_back({{"id", i}, {"index", format_index(idx.generator[i], p.N)}});
+  j["boundary_loops"] = loops;
+  j["generators"] = gens;
+  if (o.json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "N " << p.N << ": " << found.size() << " singular vertices in the field\n";
+    for (const auto& s : found) std::cout << "  vertex " << s["vertex"] << " index " << s["index"].get<std::string>() << "\n";
+    for (size_t l = 0; l < idx.loop.size(); ++l) std::cout << "  boundary loop " << l << " index " << format_index(idx.loop[l], p.N) << "\n";
+    std::cout << (differ.empty() ? "matches the prescription\n" : std::to_string(differ.size()) + " vertices differ from the prescription\n");
+    for (const auto& s : differ)
+      std::cout << "  vertex " << s["vertex"] << ": found " << s["found"].get<std::string>() << ", prescribed " << s["prescribed"].get<std::string>() << "\n";
+  }
+  if (!differ.empty()) exit_code = 4;
+}
+
+}  // namespace
+
+void register_solve(CLI::App& app) {
+  static SolveOptions o;
+  auto* cmd = app.add_subcommand("solve", "Compute the smoothest field with exactly the prescribed singularities");
+  cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply, optionally .gz")->required();
+  o.prescription.add_to(cmd, true);
+  cmd->add_option("--weights", o.weights, "cotan (default: clamped cotangent weights) or unit")->check(CLI::IsMember({"cotan", "unit"}));
+  cmd->add_option("--solver", o.solver, "cholesky (default) or qr (the paper's SuiteSparseQR route)")->check(CLI::IsMember({"cholesky", "qr"}));
+  cmd->add_option("--root-face", o.root_faces, "Face where propagation starts (one per component at most; repeatable)");
+  cmd->add_option("--root-angle", o.root_angles, "Angle (radians, in the root face's frame) of the field at the matching --root-face");
+  cmd->add_option("--field-out", o.field_out, "Field file: .txt (x y z per face), .rawfield (Directional) or .ply");
+  cmd->add_option("--connection-out", o.connection_out, "Connection file: 'i j x' per interior edge");
+  cmd->add_option("--lines-out", o.lines_out, "OBJ with a short segment per face and direction");
+  cmd->add_option("--report", o.report, "JSON report: sizes, topology, indices used, energy, residuals, timings");
+  cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");
+  cmd->callback([] { run_solve(o); });
+
+  static CheckOptions c;
+  auto* check = app.add_subcommand("check", "Compute the indices of a per-face field (any tool's) and compare with a prescription");
+  check->add_option("mesh", c.mesh, "Mesh file")->required();
+  check->add_option("field", c.field, "Field: trivcon's .txt or .ply, or Directional's .rawfield")->required();
+  c.prescription.add_to(check, false);
+  check->add_flag("--json", c.json, "Print JSON");
+  check->callback([] { run_check(c); });
+}
+
+}  // namespace trivcon::cli

@@ -1,0 +1,66 @@
+#include "summary.h"
+
+namespace trivcon::cli {
+
+nlohmann::ordered_json mesh_summary(const std::string& path, const MeshData& mesh, const Topology& t, const Geometry& g) {
+  nlohmann::ordered_json j;
+  j["file"] = path;
+  j["format"] = mesh.format;
+  j["vertices"] = t.num_vertices;
+  j["faces"] = t.num_faces;
+  j["edges"] = t.num_edges;
+  j["polygons"] = mesh.polygon_count;
+  j["euler_characteristic"] = t.euler_characteristic();
+  j["boundary_loops"] = t.boundary_loops.size();
+  j["components"] = nlohmann::ordered_json::array();
+  for (size_t c = 0; c < t.components.size(); ++c) {
+    const ComponentInfo& info = t.components[c];
+    nlohmann::ordered_json cj;
+    cj["id"] = c;
+    cj["faces"] = info.faces;
+    cj["vertices"] = info.vertices;
+    cj["edges"] = info.edges;
+    cj["euler_characteristic"] = info.euler_characteristic;
+    cj["genus"] = info.genus;
+    cj["boundary_loops"] = info.boundary_loops;
+    cj["first_face"] = info.first_face;
+    j["components"].push_back(cj);
+  }
+  j["unreferenced_vertices"] = t.unreferenced_vertices.size();
+  j["zero_area_faces"] = g.zero_area_faces;
+  j["degenerate_faces"] = g.degenerate_faces;
+  j["reoriented_faces"] = t.flipped_faces.size();
+  j["negative_cotan_edges"] = g.negative_cotan_edges;
+  return j;
+}
+
+nlohmann::ordered_json cycles_summary(const Topology& t, const Geometry& g, const Cycles& cycles) {
+  nlohmann::ordered_json j;
+  j["generators"] = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < cycles.generators.size(); ++i) {
+    const DualCycle& c = cycles.generators[i];
+    nlohmann::ordered_json cj;
+    cj["id"] = i;
+    cj["component"] = c.component;
+    cj["length"] = c.edges.size();
+    cj["levi_civita_holonomy"] = levi_civita_holonomy(c, g);
+    // The faces visited, starting with L of the first edge.
+    nlohmann::ordered_json faces = nlohmann::ordered_json::array();
+    for (size_t k = 0; k < c.edges.size(); ++k) faces.push_back(t.edge_faces(c.edges[k], c.signs[k] > 0 ? 0 : 1));
+    cj["faces"] = faces;
+    j["generators"].push_back(cj);
+  }
+  j["loops"] = nlohmann::ordered_json::array();
+  for (size_t l = 0; l < t.boundary_loops.size(); ++l) {
+    nlohmann::ordered_json lj;
+    lj["id"] = l;
+    lj["component"] = t.vertex_component[t.boundary_loops[l][0]];
+    lj["length"] = t.boundary_loops[l].size();
+    lj["curvature"] = loop_curvature(t, g, static_cast<int>(l));
+    lj["vertices"] = t.boundary_loops[l];
+    j["loops"].push_back(lj);
+  }
+  return j;
+}
+
+}  // namespace trivcon::cli

@@ -1,0 +1,35 @@
+// trivcon: command-line front end. Subcommands live in apps/cmd_*.cpp; all the work is in the library.
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "commands.h"
+#include "trivcon/error.h"
+
+namespace trivcon::cli {
+int exit_code = 0;
+MeshData load_mesh(const std::string& path) { return read_mesh(path); }
+}  // namespace trivcon::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"trivcon: direction fields with exactly the singularities you ask for (trivial connections, Crane et al. 2010)"};
+  app.set_version_flag("--version", std::string("trivcon ") + TRIVCON_VERSION);
+  app.require_subcommand(1);
+  trivcon::cli::register_info(app);
+  trivcon::cli::register_solve(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const trivcon::Error& e) {
+    std::cerr << "trivcon: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "trivcon: error: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "trivcon: internal error: " << e.what() << "\n";
+    return 70;
+  }
+  return trivcon::cli::exit_code;
+}

@@ -1,0 +1,61 @@
+// trivcon/design.h: the whole pipeline on plain (V, F) — validate, prepare once, then design fields.
+//
+//   trivcon::FieldDesigner designer(V, F);          // topology, geometry, cycles, factorization
+//   trivcon::IndexPrescription p;  p.N = 4;  p.vertex[12] = 1;  ...
+//   trivcon::Design d = designer.design(p);          // a re-solve: milliseconds
+//   d.field.angle, d.connection.x, d.indices ...
+//
+// Every design is verified: the largest holonomy residual over all vertex, loop and generator cycles,
+// the field's mismatch with the connection across every dual edge, and the indices read back from the
+// field itself are compared with the prescription (see trivcon/field.h for when they can differ).
+#pragma once
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "trivcon/cycles.h"
+#include "trivcon/field.h"
+#include "trivcon/geometry.h"
+#include "trivcon/solver.h"
+#include "trivcon/topology.h"
+
+namespace trivcon {
+
+struct Design {
+  Connection connection;
+  Field field;
+  FieldIndices indices;                  // read back from the field
+  double transport_mismatch = 0;         // max over dual edges, radians (mod 2π/N)
+  std::vector<int> index_mismatch_vertices;  // interior vertices whose field index differs from the prescription
+  int large_turn_edges = 0;              // edges with |x_e| ≥ π/N (where a field cannot show the index)
+  double solve_seconds = 0, field_seconds = 0, verify_seconds = 0;
+};
+
+struct PrepareTimings {
+  double topology = 0, geometry = 0, cycles = 0, setup = 0;
+};
+
+class FieldDesigner {
+ public:
+  // Validates (finite coordinates, manifold, orientable) and prepares; throws trivcon::Error.
+  FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptions options = {});
+
+  Design design(const IndexPrescription& prescription, const std::vector<std::pair<int, double>>& roots = {}) const;
+
+  const MatrixX3d& V() const { return V_; }
+  const Topology& topology() const { return topology_; }
+  const Geometry& geometry() const { return geometry_; }
+  const Cycles& cycles() const { return cycles_; }
+  const ConnectionSolver& solver() const { return *solver_; }
+  const PrepareTimings& timings() const { return timings_; }
+
+ private:
+  MatrixX3d V_;
+  Topology topology_;
+  Geometry geometry_;
+  Cycles cycles_;
+  std::unique_ptr<ConnectionSolver> solver_;
+  PrepareTimings timings_;
+};
+
+}  // namespace trivcon

@@ -1,0 +1,40 @@
+// trivcon/field_io.h: the files `trivcon solve` writes, and the readers that take them back.
+//
+// Formats (all ids 0-based and the input file's own; faces in file order after fan triangulation):
+// - Field text (.txt or any other extension): lines starting with '#' are comments; trivcon writes
+//   "# trivcon field", "# N <N>", "# faces <F>" first. Then one line "x y z" per face: the first of the
+//   face's N unit directions, in world coordinates, in the face's plane. The others are that vector
+//   rotated by 2πk/N about the face normal (right-hand rule, normal of the face as oriented).
+// - .rawfield (Directional's raw field): first line "N F", then one line per face with 3N numbers,
+//   the N vectors x y z one after the other, counter-clockwise.
+// - .ply: binary little-endian PLY of the mesh (vertex: double x y z; face: list uchar int
+//   vertex_indices, then double fx fy fz = the first direction).
+// - Connection: "# trivcon connection", "# N <N>", then one line "i j x" per interior edge, i < j,
+//   sorted by (i, j); x is the adjustment angle in radians with the sign of trivcon/solver.h.
+// - Lines (.obj): for each face and each of its N directions, a segment from the face centroid of length
+//   0.4 × the face's mean edge length: "v" lines, then "l a b" lines (1-based, OBJ).
+// Readers accept what the writers write (and .rawfield from Directional) and report the file and line of
+// any problem. All writers are atomic (trivcon/io.h).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "trivcon/field.h"
+#include "trivcon/geometry.h"
+#include "trivcon/io.h"
+
+namespace trivcon {
+
+// Writes by extension: .rawfield, .ply, anything else the text format.
+void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& geometry, const Field& field);
+// Reads a field written by write_field or a Directional .rawfield: world directions (F × 3, the first
+// direction per face) and N (0 when the file does not say). `num_faces` must match.
+MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file = nullptr);
+
+void write_connection(const std::string& path, const Topology& topology, const Eigen::VectorXd& x, int N);
+// Reads (i, j) → x back; returns per-edge x (0 on boundary edges); every interior edge must be listed once.
+Eigen::VectorXd read_connection(const std::string& path, const Topology& topology);
+
+void write_field_lines(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& geometry, const Field& field);
+
+}  // namespace trivcon

@@ -1,0 +1,56 @@
+// trivcon/geometry.h: the intrinsic and extrinsic geometry the trivial-connection solver needs.
+//
+// Conventions (all angles in radians)
+// - Faces are those of Topology::F (consistently oriented). Face f's frame: the x axis runs along its
+//   first half-edge, corner 0 → corner 1; angles increase counter-clockwise seen with the face's
+//   normal n = (p1 − p0) × (p2 − p0) pointing at the viewer. A direction at angle β in face f is the
+//   world vector cos β · frame_x(f) + sin β · frame_y(f), with frame_y = n̂ × frame_x.
+// - Corner angles are intrinsic (from the three edge vectors via atan2(|a × b|, a · b)) and sum to π in
+//   every face. Degenerate faces get a fixed convention so that this still holds: three collinear
+//   distinct points give (0, 0, π); a zero-length edge gives 0 opposite it and π/2 at its endpoints;
+//   a face whose corners coincide gives π/3 each.
+// - half_edge_angle(f, k): the angle, in f's frame, of the half-edge from corner k to corner k+1:
+//   0, π − α1, π + α0 for k = 0, 1, 2 (αk is the corner angle at corner k).
+// - rho(e), for an interior edge e = (i, j), i < j, L = edge_faces(e, 0) and R = edge_faces(e, 1):
+//   the Levi-Civita rotation from L to R, i.e. the angle of p_j − p_i in R's frame minus its angle in
+//   L's frame, taken in (−π, π]. A direction at angle β_L in L is parallel-transported to β_L + ρ in R.
+//   Boundary edges have ρ = 0 (unused).
+// - angle_defect(v): 2π − Σ corner angles at an interior vertex (Gaussian curvature); π − Σ corner
+//   angles at a boundary vertex (geodesic curvature of the boundary); 0 at an unreferenced vertex.
+//   Gauss–Bonnet holds exactly per component: Σ angle_defect = 2π χ (up to round-off).
+// - cotan_weight(e) = ½ (max(cot α, 0) + max(cot β, 0)) over the angles opposite interior edge e
+//   (the paper's Sections 2.5 and 4.2: negative cotangents are clamped). A degenerate face (area ≤
+//   1e-14 × its longest edge², or a zero-length edge) contributes 0, so no weight is ever NaN or
+//   infinite; an edge whose weight is 0 carries no adjustment angle (x_e = 0). Boundary edges: 0.
+#pragma once
+#include <Eigen/Core>
+
+#include "trivcon/topology.h"
+
+namespace trivcon {
+
+struct Geometry {
+  MatrixX3d corner_angles;     // F × 3
+  MatrixX3d half_edge_angle;   // F × 3
+  Eigen::VectorXd face_area;   // extrinsic area, 0 for degenerate faces
+  std::vector<char> degenerate_face;
+  MatrixX3d frame_x, frame_y, normal;  // unit vectors; for a degenerate face the normal is borrowed from its neighbours
+  Eigen::VectorXd angle_defect;        // per vertex
+  Eigen::VectorXd rho;                 // per edge
+  Eigen::VectorXd cotan_weight;        // per edge
+  int negative_cotan_edges = 0;        // interior edges with ½(cot α + cot β) < 0 before clamping
+  int degenerate_faces = 0;           // faces treated as degenerate (see above)
+  int zero_area_faces = 0;            // faces whose extrinsic area is exactly 0
+
+  // Angle of the world vector `d` in face f's frame (its projection onto the face's plane).
+  double angle_in_face(int f, const Eigen::Vector3d& d) const;
+  // World unit vector at angle `beta` in face f's frame.
+  Eigen::Vector3d direction_in_face(int f, double beta) const;
+};
+
+Geometry compute_geometry(const MatrixX3d& V, const Topology& topology);
+
+// Wraps an angle into (−π, π].
+double wrap_angle(double a);
+
+}  // namespace trivcon

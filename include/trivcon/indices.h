@@ -1,0 +1,52 @@
+// trivcon/indices.h: what the user prescribes — singular vertices, and the turning of the field around
+// generators and boundary loops — and how it is read and checked.
+//
+// Indices are exact multiples of 1/N and are stored as integers n meaning n/N (N = 1 vectors, 2 lines,
+// 4 crosses, any N ≥ 1). The index of a vertex is the number of turns the field makes, relative to
+// parallel transport, along the vertex's counter-clockwise dual cycle (paper Section 2.3): +1 a source
+// or a sink on a sphere, −1 a saddle; a cross field on a cube has +1/4 at the 8 corners.
+// Generator and boundary-loop indices are measured the same way along their dual cycles (trivcon/cycles.h):
+// the connection's holonomy there is 2π · index; a generator's index counts the field's turns relative to
+// Levi-Civita transport with each edge's rotation ρ_e taken in (−π, π] (so it depends on the cycle,
+// which `trivcon info --cycles` lists). A boundary loop's index is that of the virtual vertex capping
+// the hole: a flat disk with a constant field has loop index +1; a flat annulus with a constant field has +1 on
+// its outer loop and −1 on its inner loop.
+// Gauss–Bonnet: on every component the vertex indices plus the loop indices sum to χ.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "trivcon/topology.h"
+
+namespace trivcon {
+
+struct IndexPrescription {
+  int N = 1;
+  std::map<int, int> vertex;     // vertex id → n (index n/N); absent: 0
+  std::map<int, int> generator;  // generator id → n; absent: chosen to make the field smoothest
+  std::map<int, int> loop;       // boundary loop id → n; absent: chosen to make the field smoothest
+};
+
+// Parses an index "3", "-1", "1/4", "-3/2" into units of 1/N; throws naming `where` when it is not
+// a multiple of 1/N or not a number.
+int parse_index(const std::string& text, int N, const std::string& where);
+
+// Adds the singularities of a file: one "VERTEX INDEX" per line, '#' comments, blank lines; or, for a
+// file ending in .sings, Directional's format (first line "N count", then "vertex n" lines meaning n/N;
+// its N must divide into ours: an index n/N_file must be a multiple of 1/N). A vertex listed twice is an error.
+void read_singularities(const std::string& path, IndexPrescription& prescription);
+// Adds "V:INDEX" (from --sing), "G:INDEX" (--generator) or "L:INDEX" (--boundary).
+void add_vertex_index(const std::string& spec, IndexPrescription& prescription);
+void add_generator_index(const std::string& spec, IndexPrescription& prescription);
+void add_loop_index(const std::string& spec, IndexPrescription& prescription);
+
+// Writes singularities (vertex, n) in the plain format above, indices as reduced fractions.
+std::string format_index(int n, int N);
+
+// Checks the prescription against the mesh: vertex out of range, unreferenced or on the boundary;
+// generator or loop id out of range; on each closed component, vertex indices summing to χ; on a
+// component whose loops all have prescribed indices, vertex and loop indices summing to χ.
+void validate_prescription(const Topology& topology, int num_generators, const IndexPrescription& prescription);
+
+}  // namespace trivcon

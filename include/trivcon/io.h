@@ -1,0 +1,56 @@
+// trivcon/io.h: reading and writing triangle meshes (OBJ, OFF, PLY, and the same gzipped).
+//
+// Conventions
+// - Vertex ids are the file's own, 0-based, in file order; no vertex is dropped, merged or renumbered
+//   (unreferenced vertices are kept).
+// - Faces are in file order; a polygon with k > 3 corners (a, b, c, d, ...) is fan-triangulated in
+//   order into (a,b,c), (a,c,d), ...; `polygon_of_triangle` maps each triangle back to the file's
+//   polygon. Polygons are counted 0-based in file order.
+// - Readers only parse: they check syntax, counts, index ranges (an index outside [0, V) is an
+//   error), repeated corners within a polygon, and that every coordinate is finite. Topology
+//   (manifoldness, orientation) is checked by trivcon/topology.h.
+// - Errors are trivcon::Error with the file name and the 1-based line (text formats) or byte
+//   offset (binary PLY), e.g. "mesh.obj:12: face index 40 out of range (file has 39 vertices)".
+// - Writers write to a temporary file beside the target and rename it into place, so a failed write
+//   never leaves a half-written file. Everything written can be read back identically (binary PLY
+//   stores doubles; OBJ stores coordinates with 17 significant digits).
+#pragma once
+#include <Eigen/Core>
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace trivcon {
+
+using MatrixX3d = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+using MatrixX3i = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+struct MeshData {
+  MatrixX3d V;                          // vertex positions, file order
+  MatrixX3i F;                          // triangles, file order after fan triangulation
+  std::vector<int> polygon_of_triangle; // file polygon of each triangle
+  int polygon_count = 0;                // polygons in the file
+  std::string format;                   // "obj", "off", "ply-ascii", "ply-binary-le", "ply-binary-be"
+};
+
+// Reads by extension: .obj .off .ply, each optionally followed by .gz (case-insensitive).
+MeshData read_mesh(const std::string& path);
+
+// Format-specific readers on an in-memory buffer (already decompressed); `name` is used in messages.
+MeshData read_obj(const std::string& buffer, const std::string& name);
+MeshData read_off(const std::string& buffer, const std::string& name);
+MeshData read_ply(const std::string& buffer, const std::string& name);
+
+// Whole file into memory, gunzipping when the path ends in .gz. Errors name the file.
+std::string read_file_bytes(const std::string& path);
+
+void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F);
+void write_ply(const std::string& path, const MatrixX3d& V, const MatrixX3i& F);  // binary little-endian, double x y z, int list
+
+// Writes via `fill` into a temporary file beside `path`, then renames it into place. If `fill`
+// throws or the stream fails, the temporary is removed and `path` is untouched. All of trivcon's
+// outputs go through this.
+void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& fill);
+
+}  // namespace trivcon

@@ -1,0 +1,109 @@
+// trivcon/solver.h: the trivial connection closest to Levi-Civita (paper Sections 2.3–2.6, 3).
+//
+// Unknowns: one adjustment angle x_e per interior edge (a dual 1-form), with the sign convention of
+// trivcon/geometry.h: a direction at angle β_L in L = edge_faces(e, 0) is carried to
+// β_R = β_L + ρ_e − x_e in R = edge_faces(e, 1) (paper Eq. 3). Constraints, with indices k = n/N:
+//   interior vertex v:      Σ_e s_ve x_e = K_v − 2π k_v      (s_ve = +1 if v is e's larger id, else −1)
+//   boundary loop ℓ:        Σ_e c_e x_e  = K_ℓ − 2π k_ℓ      (c: the loop cycle, K_ℓ its loop_curvature)
+//   generator γ:            Σ_e c_e x_e  = z_γ − 2π k_γ      (z_γ = levi_civita_holonomy)
+// Objective: minimise Σ x_e² / w_e (w = cotan or unit weights); an edge with w_e = 0 gets x_e = 0.
+//
+// Default route (SolverKind::Cholesky): x = W (Dᵀ λ + Cᵀ μ), where D holds the interior-vertex rows
+// and C the loop and generator rows. D W Dᵀ is the cotan Laplacian on interior vertices; on a closed
+// component one vertex row is dropped (Gauss–Bonnet makes it redundant), and on a component with
+// boundary one loop row is (its index follows from the others). It is factored once with CHOLMOD
+// (supernodal, OpenBLAS); C is eliminated through the small dense Schur complement S = CWCᵀ − CWDᵀ
+// (DWDᵀ)⁻¹DWCᵀ. A new prescription only changes the right-hand side: one or two sparse triangular
+// solves per edit.
+// Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
+// system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
+//
+// Free cycle indices (generators and loops not prescribed) are chosen so that the field is smoothest:
+// the energy is a quadratic function of them, E = E₀ + (2π/N)² (u − n)ᵀ P (u − n) with P = S⁻¹; the
+// real minimiser (given the prescribed ones) is rounded to the nearest integers n, then improved by
+// single ±1 steps while the energy decreases.
+#pragma once
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "trivcon/cycles.h"
+#include "trivcon/geometry.h"
+#include "trivcon/indices.h"
+#include "trivcon/topology.h"
+
+namespace trivcon {
+
+enum class WeightKind { Cotan, Unit };
+enum class SolverKind { Cholesky, QR };
+
+struct SolverOptions {
+  WeightKind weights = WeightKind::Cotan;
+  SolverKind solver = SolverKind::Cholesky;
+};
+
+struct Connection {
+  int N = 1;
+  Eigen::VectorXd x;                   // per edge; 0 on boundary edges and on edges of zero weight
+  std::vector<int> generator_index;    // n per generator (index n/N), as used
+  std::vector<int> loop_index;         // n per boundary loop, as used
+  std::vector<char> generator_chosen;  // 1 where the solver chose the index
+  std::vector<char> loop_chosen;
+  double energy = 0;                   // Σ x_e² / w_e
+  // Verification: largest |Σ coefficient · x − right-hand side| over all interior vertices (including
+  // the dropped ones), all loops and all generators, and the scale of the right-hand sides.
+  double max_vertex_residual = 0, max_cycle_residual = 0, rhs_scale = 0;
+};
+
+struct SetupTimings {
+  double assemble = 0, factor = 0, schur = 0;
+};
+
+class ConnectionSolver {
+ public:
+  // Builds and factors everything that does not depend on the prescription. Throws trivcon::Error if
+  // the weights leave part of the surface unable to carry curvature (a vertex or a region joined to the
+  // rest only by zero-weight edges) or if a factorization fails.
+  ConnectionSolver(const Topology& topology, const Geometry& geometry, const Cycles& cycles, SolverOptions options = {});
+  ~ConnectionSolver();
+  ConnectionSolver(const ConnectionSolver&) = delete;
+  ConnectionSolver& operator=(const ConnectionSolver&) = delete;
+
+  // Validates the prescription and returns the connection. Only right-hand sides change per call.
+  Connection solve(const IndexPrescription& prescription) const;
+
+  const Eigen::VectorXd& weights() const { return weights_; }  // per edge, 0 on boundary edges
+  const SetupTimings& timings() const { return timings_; }
+  int num_generators() const { return static_cast<int>(cycles_.generators.size()); }
+  // Levi-Civita holonomy the constraints use: K_ℓ per loop, z_γ per generator.
+  const std::vector<double>& loop_curvatures() const { return loop_curvature_; }
+  const std::vector<double>& generator_holonomies() const { return generator_holonomy_; }
+
+  struct Engine;  // the factorization (Cholesky + Schur, or QR)
+
+ private:
+  const Topology& topology_;
+  const Geometry& geometry_;
+  const Cycles& cycles_;
+  SolverOptions options_;
+  Eigen::VectorXd weights_;
+  std::vector<double> loop_curvature_, generator_holonomy_;
+  SetupTimings timings_;
+  std::unique_ptr<Engine> engine_;
+
+  // Rows of the reduced system: interior vertices (minus one per closed component), then the cycle
+  // rows C: boundary loops (minus one per component with boundary), then generators.
+  std::vector<int> active_edges_, edge_column_;  // interior edges with w_e > 0, and their column
+  std::vector<int> vertex_row_;                  // row of each vertex, −1 if none
+  int num_vertex_rows_ = 0;
+  std::vector<int> dropped_vertex_, dropped_loop_;  // per component, −1 if none
+  std::vector<int> loop_rows_;                   // loop id of each loop row
+  const DualCycle& cycle_of_row(int r) const;
+  void check_weight_connectivity() const;
+};
+
+// Residuals of `x` against every constraint for the given indices (n/N): fills the verification fields.
+void verify_connection(const Topology& topology, const Geometry& geometry, const Cycles& cycles, const IndexPrescription& prescription,
+                       Connection& connection);
+
+}  // namespace trivcon

@@ -1,0 +1,133 @@
+#include "trivcon/field.h"
+
+#include <cmath>
+
+#include "trivcon/error.h"
+
+namespace trivcon {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+double wrap_positive(double a) {
+  a = std::fmod(a, 2 * kPi);
+  return a < 0 ? a + 2 * kPi : a;
+}
+}  // namespace
+
+double reduce_angle(double a, int N) {
+  const double period = 2 * kPi / N;
+  a -= period * std::round(a / period);
+  if (a <= -period / 2) a += period;
+  if (a > period / 2) a -= period;
+  return a;
+}
+
+Field propagate_field(const Topology& t, const Geometry& g, const Eigen::VectorXd& x, int N,
+                      const std::vector<std::pair<int, double>>& roots) {
+  Field field;
+  field.N = N;
+  field.angle.setZero(t.num_faces);
+  std::vector<char> seen(t.num_faces, 0);
+  std::vector<std::pair<int, double>> starts;
+  for (auto [f, angle] : roots) {
+    if (f < 0 || f >= t.num_faces)
+      throw Error("root face " + std::to_string(f) + " out of range (mesh has " + std::to_string(t.num_faces) + " faces)");
+    if (!std::isfinite(angle)) throw Error("root angle of face " + std::to_string(f) + " is not finite");
+    starts.emplace_back(f, angle);
+  }
+  std::vector<char> component_rooted(t.components.size(), 0);
+  for (auto [f, angle] : starts) {
+    if (component_rooted[t.face_component[f]])
+      throw Error("two root faces given for component " + std::to_string(t.face_component[f]));
+    component_rooted[t.face_component[f]] = 1;
+  }
+  for (size_t c = 0; c < t.components.size(); ++c)
+    if (!component_rooted[c]) starts.emplace_back(t.components[c].first_face, 0.0);
+  std::vector<int> queue;
+  queue.reserve(t.num_faces);
+  for (auto [root, angle] : starts) {
+    field.angle(root) = wrap_positive(angle);
+    seen[root] = 1;
+    queue.assign(1, root);
+    for (size_t q = 0; q < queue.size(); ++q) {
+      const int f = queue[q];
+      for (int k = 0; k < 3; ++k) {
+        const int e = t.face_edges(f, k);
+        if (t.is_boundary_edge(e)) continue;
+        const bool from_left = t.edge_faces(e, 0) == f;
+        const int h = from_left ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
+        if (seen[h]) continue;
+        seen[h] = 1;
+        const double turn = g.rho(e) - x(e);
+        field.angle(h) = wrap_positive(field.angle(f) + (from_left ? turn : -turn));
+        queue.push_back(h);
+      }
+    }
+  }
+  return field;
+}
+
+MatrixX3d field_directions(const Geometry& g, const Field& field) {
+  MatrixX3d d(field.angle.size(), 3);
+  for (int f = 0; f < field.angle.size(); ++f) d.row(f) = g.direction_in_face(f, field.angle(f));
+  return d;
+}
+
+Field field_from_directions(const Geometry& g, const MatrixX3d& directions, int N) {
+  Field field;
+  field.N = N;
+  field.angle.resize(directions.rows());
+  for (int f = 0; f < directions.rows(); ++f) {
+    const Eigen::Vector3d d = directions.row(f);
+    if (!d.allFinite()) throw Error("the direction of face " + std::to_string(f) + " is not finite");
+    const double along = std::hypot(d.dot(g.frame_x.row(f)), d.dot(g.frame_y.row(f)));
+    if (!(along > 1e-12 * d.norm())) throw Error("the direction of face " + std::to_string(f) + " has no component in the face's plane");
+    field.angle(f) = wrap_positive(g.angle_in_face(f, d));
+  }
+  return field;
+}
+
+FieldIndices field_indices(const Topology& t, const Geometry& g, const Cycles& cycles, const Field& field) {
+  const int N = field.N;
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(t.num_edges);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    d(e) = reduce_angle(field.angle(t.edge_faces(e, 1)) - field.angle(t.edge_faces(e, 0)) - g.rho(e), N);
+  }
+  FieldIndices out;
+  auto to_n = [&](double raw_turns) {
+    const double scaled = raw_turns * N;
+    const double rounded = std::round(scaled);
+    out.max_rounding = std::max(out.max_rounding, std::abs(scaled - rounded));
+    return static_cast<int>(rounded);
+  };
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(t.num_vertices);
+  for (int e = 0; e < t.num_edges; ++e) {
+    sum(t.edge_vertices(e, 1)) += d(e);
+    sum(t.edge_vertices(e, 0)) -= d(e);
+  }
+  out.vertex.assign(t.num_vertices, 0);
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (t.is_interior_vertex(v)) out.vertex[v] = to_n((g.angle_defect(v) + sum(v)) / (2 * kPi));
+  auto cycle_sum = [&](const DualCycle& c) {
+    double s = 0;
+    for (size_t k = 0; k < c.edges.size(); ++k) s += c.signs[k] * d(c.edges[k]);
+    return s;
+  };
+  for (size_t l = 0; l < cycles.loops.size(); ++l)
+    out.loop.push_back(to_n((loop_curvature(t, g, static_cast<int>(l)) + cycle_sum(cycles.loops[l])) / (2 * kPi)));
+  for (const DualCycle& c : cycles.generators) out.generator.push_back(to_n((levi_civita_holonomy(c, g) + cycle_sum(c)) / (2 * kPi)));
+  return out;
+}
+
+double max_transport_mismatch(const Topology& t, const Geometry& g, const Eigen::VectorXd& x, const Field& field) {
+  double worst = 0;
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const double jump = field.angle(t.edge_faces(e, 1)) - field.angle(t.edge_faces(e, 0)) - (g.rho(e) - x(e));
+    worst = std::max(worst, std::abs(reduce_angle(jump, field.N)));
+  }
+  return worst;
+}
+
+}  // namespace trivcon

@@ -1,0 +1,240 @@
+#include "trivcon/field_io.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <iomanip>
+#include <sstream>
+
+#include "trivcon/error.h"
+
+namespace trivcon {
+
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// The N unit directions of face f, counter-clockwise.
+Eigen::Vector3d direction_k(const Geometry& g, const Field& field, int f, int k) {
+  return g.direction_in_face(f, field.angle(f) + 2 * 3.14159265358979323846 * k / field.N);
+}
+
+void put_double(std::ostream& out, double v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); }
+
+// Lines of a text file with their 1-based numbers, comments and blank lines skipped.
+struct TextLines {
+  std::istringstream in;
+  std::string path, line;
+  int number = 0;
+  explicit TextLines(const std::string& p) : in(read_file_bytes(p)), path(p) {}
+  bool next() {
+    while (std::getline(in, line)) {
+      ++number;
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      const size_t a = line.find_first_not_of(" \t");
+      if (a == std::string::npos || line[a] == '#') continue;
+      return true;
+    }
+    return false;
+  }
+  std::string where() const { return path + ":" + std::to_string(number); }
+};
+
+std::vector<double> parse_numbers(const TextLines& lines, size_t expected) {
+  std::istringstream fields(lines.line);
+  std::vector<double> values;
+  std::string token;
+  while (fields >> token) {
+    char* end = nullptr;
+    const double v = std::strtod(token.c_str(), &end);
+    if (end != token.c_str() + token.size() || !std::isfinite(v)) throw Error(lines.where() + ": malformed number '" + token + "'");
+    values.push_back(v);
+  }
+  if (values.size() != expected)
+    throw Error(lines.where() + ": expected " + std::to_string(expected) + " numbers, got " + std::to_string(values.size()));
+  return values;
+}
+
+MatrixX3d read_field_ply(const std::string& path, int num_faces) {
+  const std::string bytes = read_file_bytes(path);
+  const std::string expected_vertex = "property double x\nproperty double y\nproperty double z\n";
+  const std::string expected_face = "property list uchar int vertex_indices\nproperty double fx\nproperty double fy\nproperty double fz\nend_header\n";
+  const size_t header_end = bytes.find("end_header\n");
+  if (bytes.compare(0, 4, "ply\n") != 0 || header_end == std::string::npos ||
+      bytes.find("format binary_little_endian 1.0\n") == std::string::npos || bytes.find(expected_face) == std::string::npos ||
+      bytes.find(expected_vertex) == std::string::npos)
+    throw Error(path + ": not a field PLY written by trivcon (expected face properties fx fy fz after vertex_indices)");
+  int nv = -1, nf = -1;
+  std::istringstream header(bytes.substr(0, header_end));
+  std::string line;
+  while (std::getline(header, line)) {
+    if (sscanf(line.c_str(), "element vertex %d", &nv) == 1) continue;
+    if (sscanf(line.c_str(), "element face %d", &nf) == 1) continue;
+  }
+  if (nf != num_faces) throw Error(path + ": has " + std::to_string(nf) + " faces, the mesh has " + std::to_string(num_faces));
+  size_t pos = header_end + std::strlen("end_header\n") + static_cast<size_t>(nv) * 24;
+  MatrixX3d d(num_faces, 3);
+  for (int f = 0; f < num_faces; ++f) {
+    if (pos >= bytes.size()) throw Error(path + ": truncated at byte " + std::to_string(pos) + " (face " + std::to_string(f) + ")");
+    const size_t count = static_cast<unsigned char>(bytes[pos]);
+    pos += 1 + 4 * count;
+    if (pos + 24 > bytes.size()) throw Error(path + ": truncated at byte " + std::to_string(pos) + " (face " + std::to_string(f) + ")");
+    double v[3];
+    std::memcpy(v, bytes.data() + pos, 24);
+    pos += 24;
+    d.row(f) << v[0], v[1], v[2];
+  }
+  return d;
+}
+
+}  // namespace
+
+void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& g, const Field& field) {
+  const int nF = static_cast<int>(F.rows());
+  if (ends_with(path, ".rawfield")) {
+    write_file_atomically(path, [&](std::ostream& out) {
+      out << std::setprecision(17) << field.N << " " << nF << "\n";
+      for (int f = 0; f < nF; ++f) {
+        for (int k = 0; k < field.N; ++k) {
+          const Eigen::Vector3d d = direction_k(g, field, f, k);
+          out << (k ? " " : "") << d.x() << " " << d.y() << " " << d.z();
+        }
+        out << "\n";
+      }
+    });
+  } else if (ends_with(path, ".ply")) {
+    write_file_atomically(path, [&](std::ostream& out) {
+      out << "ply\nformat binary_little_endian 1.0\ncomment trivcon field, N " << field.N << "\nelement vertex " << V.rows()
+          << "\nproperty double x\nproperty double y\nproperty double z\nelement face " << nF
+          << "\nproperty list uchar int vertex_indices\nproperty double fx\nproperty double fy\nproperty double fz\nend_header\n";
+      for (int v = 0; v < V.rows(); ++v)
+        for (int k = 0; k < 3; ++k) put_double(out, V(v, k));
+      for (int f = 0; f < nF; ++f) {
+        out.put(3);
+        for (int k = 0; k < 3; ++k) {
+          const int32_t id = F(f, k);
+          out.write(reinterpret_cast<const char*>(&id), 4);
+        }
+        const Eigen::Vector3d d = direction_k(g, field, f, 0);
+        for (int k = 0; k < 3; ++k) put_double(out, d(k));
+      }
+    });
+  } else {
+    write_file_atomically(path, [&](std::ostream& out) {
+      out << "# trivcon field: per face, the first of N unit directions (x y z, world coordinates)\n# N " << field.N
+          << "\n# faces " << nF << "\n"
+          << std::setprecision(17);
+      for (int f = 0; f < nF; ++f) {
+        const Eigen::Vector3d d = direction_k(g, field, f, 0);
+        out << d.x() << " " << d.y() << " " << d.z() << "\n";
+      }
+    });
+  }
+}
+
+MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file) {
+  if (N_in_file) *N_in_file = 0;
+  if (ends_with(path, ".ply")) return read_field_ply(path, num_faces);
+  MatrixX3d d(num_faces, 3);
+  if (ends_with(path, ".rawfield")) {
+    TextLines lines(path);
+    if (!lines.next()) throw Error(path + ": empty file (expected the header 'N F')");
+    const std::vector<double> header = parse_numbers(lines, 2);
+    const int N = static_cast<int>(header[0]);
+    if (header[0] != N || N < 1 || N > 1000) throw Error(lines.where() + ": malformed N in the header");
+    if (header[1] != num_faces)
+      throw Error(lines.where() + ": the field has " + std::to_string(static_cast<long long>(header[1])) + " faces, the mesh has " +
+                  std::to_string(num_faces));
+    if (N_in_file) *N_in_file = N;
+    for (int f = 0; f < num_faces; ++f) {
+      if (!lines.next()) throw Error(path + ": truncated after line " + std::to_string(lines.number) + " (face " + std::to_string(f) + ")");
+      const std::vector<double> v = parse_numbers(lines, 3 * N);
+      d.row(f) << v[0], v[1], v[2];
+    }
+    if (lines.next()) throw Error(lines.where() + ": more lines than faces");
+    return d;
+  }
+  // Text: read "# N n" from the comments.
+  {
+    std::istringstream in(read_file_bytes(path));
+    std::string line;
+    while (std::getline(in, line) && !line.empty() && line[0] == '#')
+      if (line.rfind("# N ", 0) == 0 && N_in_file) *N_in_file = std::atoi(line.c_str() + 4);
+  }
+  TextLines lines(path);
+  for (int f = 0; f < num_faces; ++f) {
+    if (!lines.next()) throw Error(path + ": has " + std::to_string(f) + " directions, the mesh has " + std::to_string(num_faces) + " faces");
+    const std::vector<double> v = parse_numbers(lines, 3);
+    d.row(f) << v[0], v[1], v[2];
+  }
+  if (lines.next()) throw Error(lines.where() + ": more lines than the mesh has faces (" + std::to_string(num_faces) + ")");
+  return d;
+}
+
+void write_connection(const std::string& path, const Topology& t, const Eigen::VectorXd& x, int N) {
+  std::vector<int> order;
+  for (int e = 0; e < t.num_edges; ++e)
+    if (!t.is_boundary_edge(e)) order.push_back(e);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return std::make_pair(t.edge_vertices(a, 0), t.edge_vertices(a, 1)) < std::make_pair(t.edge_vertices(b, 0), t.edge_vertices(b, 1));
+  });
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << "# trivcon connection: per interior edge i < j, the adjustment angle x (radians); a direction at angle b in\n"
+           "# the face holding half-edge i->j is carried to b + rho - x in the other face\n# N "
+        << N << "\n"
+        << std::setprecision(17);
+    for (int e : order) out << t.edge_vertices(e, 0) << " " << t.edge_vertices(e, 1) << " " << x(e) << "\n";
+  });
+}
+
+Eigen::VectorXd read_connection(const std::string& path, const Topology& t) {
+  // Edge lookup by (i, j) through the CSR vertex → edges adjacency.
+  auto find_edge = [&](int i, int j) {
+    if (i < 0 || i >= t.num_vertices) return -1;
+    for (int a = t.vertex_edge_offsets[i]; a < t.vertex_edge_offsets[i + 1]; ++a) {
+      const int e = t.vertex_edges[a];
+      if (t.edge_vertices(e, 0) == std::min(i, j) && t.edge_vertices(e, 1) == std::max(i, j)) return e;
+    }
+    return -1;
+  };
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(t.num_edges);
+  std::vector<char> seen(t.num_edges, 0);
+  TextLines lines(path);
+  while (lines.next()) {
+    const std::vector<double> v = parse_numbers(lines, 3);
+    const int i = static_cast<int>(v[0]), j = static_cast<int>(v[1]);
+    const int e = (v[0] == i && v[1] == j && i < j) ? find_edge(i, j) : -1;
+    if (e < 0 || t.is_boundary_edge(e)) throw Error(lines.where() + ": (" + std::to_string(i) + ", " + std::to_string(j) + ") is not an interior edge with i < j");
+    if (seen[e]) throw Error(lines.where() + ": edge (" + std::to_string(i) + ", " + std::to_string(j) + ") is listed twice");
+    seen[e] = 1;
+    x(e) = v[2];
+  }
+  for (int e = 0; e < t.num_edges; ++e)
+    if (!t.is_boundary_edge(e) && !seen[e])
+      throw Error(path + ": interior edge (" + std::to_string(t.edge_vertices(e, 0)) + ", " + std::to_string(t.edge_vertices(e, 1)) + ") is missing");
+  return x;
+}
+
+void write_field_lines(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& g, const Field& field) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << "# trivcon field: one segment per face and direction, from the face centroid\n" << std::setprecision(9);
+    for (int f = 0; f < F.rows(); ++f) {
+      const Eigen::Vector3d p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
+      const Eigen::Vector3d c = (p0 + p1 + p2) / 3;
+      const double length = 0.4 * ((p1 - p0).norm() + (p2 - p1).norm() + (p0 - p2).norm()) / 3;
+      out << "v " << c.x() << " " << c.y() << " " << c.z() << "\n";
+      for (int k = 0; k < field.N; ++k) {
+        const Eigen::Vector3d q = c + length * direction_k(g, field, f, k);
+        out << "v " << q.x() << " " << q.y() << " " << q.z() << "\n";
+      }
+    }
+    long long base = 1;
+    for (int f = 0; f < F.rows(); ++f, base += field.N + 1)
+      for (int k = 0; k < field.N; ++k) out << "l " << base << " " << base + 1 + k << "\n";
+  });
+}
+
+}  // namespace trivcon

@@ -1,0 +1,139 @@
+#include "trivcon/geometry.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace trivcon {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegenerateArea = 1e-14;  // relative to the longest edge squared
+
+// Intrinsic corner angles with the documented conventions for degenerate triangles.
+Eigen::Vector3d corner_angles_of(const Eigen::Vector3d p[3]) {
+  const Eigen::Vector3d e[3] = {p[1] - p[0], p[2] - p[1], p[0] - p[2]};  // e[k]: corner k → k+1
+  const double len2[3] = {e[0].squaredNorm(), e[1].squaredNorm(), e[2].squaredNorm()};
+  const int zero_edges = (len2[0] == 0) + (len2[1] == 0) + (len2[2] == 0);
+  if (zero_edges >= 2) return Eigen::Vector3d::Constant(kPi / 3);
+  if (zero_edges == 1) {
+    Eigen::Vector3d a = Eigen::Vector3d::Constant(kPi / 2);
+    for (int k = 0; k < 3; ++k)
+      if (len2[k] == 0) a((k + 2) % 3) = 0;  // edge k is opposite corner k+2
+    return a;
+  }
+  Eigen::Vector3d a;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d u = e[k], w = -e[(k + 2) % 3];  // the two edges leaving corner k
+    a(k) = std::atan2(u.cross(w).norm(), u.dot(w));
+  }
+  return a;
+}
+}  // namespace
+
+double wrap_angle(double a) {
+  a = std::fmod(a, 2 * kPi);
+  if (a <= -kPi) a += 2 * kPi;
+  if (a > kPi) a -= 2 * kPi;
+  return a;
+}
+
+double Geometry::angle_in_face(int f, const Eigen::Vector3d& d) const {
+  return std::atan2(d.dot(frame_y.row(f)), d.dot(frame_x.row(f)));
+}
+
+Eigen::Vector3d Geometry::direction_in_face(int f, double beta) const {
+  return std::cos(beta) * frame_x.row(f).transpose() + std::sin(beta) * frame_y.row(f).transpose();
+}
+
+Geometry compute_geometry(const MatrixX3d& V, const Topology& t) {
+  const int nF = t.num_faces, nE = t.num_edges, nV = t.num_vertices;
+  Geometry g;
+  g.corner_angles.resize(nF, 3);
+  g.half_edge_angle.resize(nF, 3);
+  g.face_area.resize(nF);
+  g.degenerate_face.assign(nF, 0);
+  g.frame_x.resize(nF, 3);
+  g.frame_y.resize(nF, 3);
+  g.normal.resize(nF, 3);
+  MatrixX3d cot(nF, 3);  // cotangent of each corner angle, 0 for degenerate faces
+  std::vector<Eigen::Vector3d> raw_normal(nF);
+  for (int f = 0; f < nF; ++f) {
+    const Eigen::Vector3d p[3] = {V.row(t.F(f, 0)), V.row(t.F(f, 1)), V.row(t.F(f, 2))};
+    const Eigen::Vector3d a = corner_angles_of(p);
+    g.corner_angles.row(f) = a;
+    g.half_edge_angle.row(f) << 0.0, kPi - a(1), kPi + a(0);
+    const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+    raw_normal[f] = n;
+    const double longest2 = std::max({(p[1] - p[0]).squaredNorm(), (p[2] - p[1]).squaredNorm(), (p[0] - p[2]).squaredNorm()});
+    const double area = 0.5 * n.norm();
+    const bool degenerate = !(area > kDegenerateArea * longest2) || (p[1] - p[0]).squaredNorm() == 0 ||
+                            (p[2] - p[1]).squaredNorm() == 0 || (p[0] - p[2]).squaredNorm() == 0;
+    g.degenerate_face[f] = degenerate;
+    g.degenerate_faces += degenerate;
+    g.zero_area_faces += n.squaredNorm() == 0;
+    g.face_area(f) = degenerate ? 0.0 : area;
+    for (int k = 0; k < 3; ++k) {
+      if (degenerate) {
+        cot(f, k) = 0;
+        continue;
+      }
+      const Eigen::Vector3d u = p[(k + 1) % 3] - p[k], w = p[(k + 2) % 3] - p[k];
+      cot(f, k) = u.dot(w) / u.cross(w).norm();
+    }
+  }
+  // Frames. A degenerate face borrows the summed normal of its edge neighbours (any unit vector
+  // perpendicular to its first edge as a last resort), so every output stays finite.
+  for (int f = 0; f < nF; ++f) {
+    Eigen::Vector3d n = raw_normal[f];
+    if (g.degenerate_face[f]) {
+      n.setZero();
+      for (int k = 0; k < 3; ++k) {
+        const int e = t.face_edges(f, k);
+        for (int s = 0; s < 2; ++s) {
+          const int h = t.edge_faces(e, s);
+          if (h >= 0 && h != f && !g.degenerate_face[h]) n += raw_normal[h];
+        }
+      }
+    }
+    Eigen::Vector3d x = V.row(t.F(f, 1)) - V.row(t.F(f, 0));
+    if (x.squaredNorm() == 0) x = V.row(t.F(f, 2)) - V.row(t.F(f, 0));
+    if (x.squaredNorm() == 0) x = Eigen::Vector3d::UnitX();
+    x.normalize();
+    n -= n.dot(x) * x;
+    if (!(n.squaredNorm() > 0)) {
+      n = x.cross(Eigen::Vector3d::UnitX());
+      if (n.squaredNorm() < 1e-6) n = x.cross(Eigen::Vector3d::UnitY());
+    }
+    n.normalize();
+    g.frame_x.row(f) = x;
+    g.normal.row(f) = n;
+    g.frame_y.row(f) = n.cross(x);
+  }
+
+  g.angle_defect.setZero(nV);
+  for (int v = 0; v < nV; ++v) {
+    if (t.vertex_component[v] < 0) continue;
+    g.angle_defect(v) = t.is_boundary_vertex(v) ? kPi : 2 * kPi;
+  }
+  for (int f = 0; f < nF; ++f)
+    for (int k = 0; k < 3; ++k) g.angle_defect(t.F(f, k)) -= g.corner_angles(f, k);
+
+  g.rho.setZero(nE);
+  g.cotan_weight.setZero(nE);
+  for (int e = 0; e < nE; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    int kL = 0, kR = 0;
+    while (t.face_edges(L, kL) != e) ++kL;
+    while (t.face_edges(R, kR) != e) ++kR;
+    g.rho(e) = wrap_angle(g.half_edge_angle(R, kR) + kPi - g.half_edge_angle(L, kL));
+    // The corner opposite edge k of a face is corner k+2.
+    const double cl = cot(L, (kL + 2) % 3), cr = cot(R, (kR + 2) % 3);
+    if (cl + cr < 0) ++g.negative_cotan_edges;
+    g.cotan_weight(e) = 0.5 * (std::max(cl, 0.0) + std::max(cr, 0.0));
+  }
+  return g;
+}
+
+}  // namespace trivcon

@@ -1,0 +1,284 @@
+// Connectivity and validation in (near) linear time: half-edges are bucketed by their smaller vertex
+// (counting sort), so matching the two sides of an edge costs O(degree) per vertex.
+#include "trivcon/topology.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "trivcon/error.h"
+
+namespace trivcon {
+namespace {
+
+// Union-find with path halving; used for face fans around vertices.
+struct DisjointSets {
+  std::vector<int> parent;
+  explicit DisjointSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  }
+  void unite(int a, int b) {
+    a = find(a), b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+std::string face_string(const MatrixX3i& F, int f) {
+  std::ostringstream s;
+  s << "(" << F(f, 0) << ", " << F(f, 1) << ", " << F(f, 2) << ")";
+  return s.str();
+}
+
+void check_face_indices(const MatrixX3i& F, int num_vertices) {
+  for (int f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      if (F(f, k) < 0 || F(f, k) >= num_vertices)
+        throw Error("vertex index " + std::to_string(F(f, k)) + " out of range in face " + std::to_string(f) +
+                    " (mesh has " + std::to_string(num_vertices) + " vertices)");
+    }
+    if (F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 2) == F(f, 0))
+      throw Error("face " + std::to_string(f) + " has a repeated vertex " + face_string(F, f));
+  }
+}
+
+// Groups the 3F half-edges (h = 3f + k, from corner k to k+1) into undirected edges. Returns the edge
+// id of every half-edge; edges are numbered in order of first appearance.
+std::vector<int> match_half_edges(const MatrixX3i& F, int num_vertices, int& num_edges) {
+  const int H = static_cast<int>(F.rows()) * 3;
+  auto from = [&](int h) { return F(h / 3, h % 3); };
+  auto to = [&](int h) { return F(h / 3, (h % 3 + 1) % 3); };
+  std::vector<int> offset(num_vertices + 1, 0);
+  for (int h = 0; h < H; ++h) ++offset[std::min(from(h), to(h)) + 1];
+  for (int v = 0; v < num_vertices; ++v) offset[v + 1] += offset[v];
+  std::vector<int> bucket(H);
+  {
+    std::vector<int> fill(offset.begin(), offset.end() - 1);
+    for (int h = 0; h < H; ++h) bucket[fill[std::min(from(h), to(h))]++] = h;  // h increasing within a bucket
+  }
+  // first_of[h]: the first half-edge (smallest h) of h's edge.
+  std::vector<int> first_of(H, -1);
+  for (int v = 0; v < num_vertices; ++v) {
+    for (int a = offset[v]; a < offset[v + 1]; ++a) {
+      const int ha = bucket[a];
+      if (first_of[ha] >= 0) continue;
+      first_of[ha] = ha;
+      const int other = std::max(from(ha), to(ha));
+      for (int b = a + 1; b < offset[v + 1]; ++b) {
+        const int hb = bucket[b];
+        if (first_of[hb] < 0 && std::max(from(hb), to(hb)) == other) first_of[hb] = ha;
+      }
+    }
+  }
+  std::vector<int> edge_of(H);
+  num_edges = 0;
+  for (int h = 0; h < H; ++h) edge_of[h] = first_of[h] == h ? num_edges++ : edge_of[first_of[h]];
+  return edge_of;
+}
+
+}  // namespace
+
+void check_finite(const MatrixX3d& V) {
+  for (int v = 0; v < V.rows(); ++v)
+    for (int k = 0; k < 3; ++k)
+      if (!std::isfinite(V(v, k))) throw Error("non-finite coordinate in vertex " + std::to_string(v));
+}
+
+int Topology::euler_characteristic() const {
+  int chi = 0;
+  for (const auto& c : components) chi += c.euler_characteristic;
+  return chi;
+}
+
+Topology build_topology(const MatrixX3i& F_in, int num_vertices) {
+  check_face_indices(F_in, num_vertices);
+  Topology t;
+  t.num_vertices = num_vertices;
+  t.num_faces = static_cast<int>(F_in.rows());
+  const int nF = t.num_faces, H = 3 * nF;
+  std::vector<int> edge_of = match_half_edges(F_in, num_vertices, t.num_edges);
+  const int nE = t.num_edges;
+
+  // Half-edges of every edge (at most two on a manifold).
+  std::vector<int> edge_count(nE, 0);
+  std::vector<std::array<int, 2>> edge_half(nE, {-1, -1});
+  for (int h = 0; h < H; ++h) {
+    const int e = edge_of[h];
+    if (edge_count[e] < 2) edge_half[e][edge_count[e]] = h;
+    ++edge_count[e];
+  }
+  for (int e = 0; e < nE; ++e) {
+    if (edge_count[e] <= 2) continue;
+    const int h0 = edge_half[e][0];
+    int a = F_in(h0 / 3, h0 % 3), b = F_in(h0 / 3, (h0 % 3 + 1) % 3);
+    std::ostringstream s;
+    s << "non-manifold edge (" << std::min(a, b) << ", " << std::max(a, b) << ") shared by " << edge_count[e] << " faces (";
+    int listed = 0;
+    for (int h = 0; h < H && listed < edge_count[e]; ++h)
+      if (edge_of[h] == e) s << (listed++ ? ", " : "") << h / 3;
+    s << ")";
+    throw Error(s.str());
+  }
+
+  // Non-manifold vertices: corners (f, k) at the same vertex are joined across every edge with two
+  // faces; a manifold vertex has one group (one fan).
+  {
+    DisjointSets corners(H);
+    for (int e = 0; e < nE; ++e) {
+      if (edge_count[e] != 2) continue;
+      const int h0 = edge_half[e][0], h1 = edge_half[e][1];
+      const int f0 = h0 / 3, f1 = h1 / 3;
+      for (int end = 0; end < 2; ++end) {
+        const int v = end == 0 ? F_in(f0, h0 % 3) : F_in(f0, (h0 % 3 + 1) % 3);
+        int c1 = -1;
+        for (int k = 0; k < 3; ++k)
+          if (F_in(f1, k) == v) c1 = 3 * f1 + k;
+        int c0 = end == 0 ? h0 : 3 * f0 + (h0 % 3 + 1) % 3;
+        corners.unite(c0, c1);
+      }
+    }
+    std::vector<int> fans(num_vertices, 0);
+    for (int c = 0; c < H; ++c)
+      if (corners.find(c) == c) ++fans[F_in(c / 3, c % 3)];
+    for (int v = 0; v < num_vertices; ++v)
+      if (fans[v] > 1)
+        throw Error("non-manifold vertex " + std::to_string(v) + ": its faces form " + std::to_string(fans[v]) +
+                    " separate fans");
+  }
+
+  // Components and orientation: breadth-first over faces; flip[g] says whether g must be reversed to
+  // agree with the component's first face.
+  auto same_direction = [&](int h0, int h1) {
+    return F_in(h0 / 3, h0 % 3) == F_in(h1 / 3, h1 % 3);
+  };
+  t.face_component.assign(nF, -1);
+  std::vector<char> flip(nF, 0);
+  std::vector<int> queue;
+  queue.reserve(nF);
+  for (int root = 0; root < nF; ++root) {
+    if (t.face_component[root] >= 0) continue;
+    const int c = static_cast<int>(t.components.size());
+    t.components.emplace_back();
+    t.components.back().first_face = root;
+    const size_t begin = queue.size();
+    queue.push_back(root);
+    t.face_component[root] = c;
+    for (size_t q = begin; q < queue.size(); ++q) {
+      const int f = queue[q];
+      for (int k = 0; k < 3; ++k) {
+        const int h = 3 * f + k, e = edge_of[h];
+        if (edge_count[e] != 2) continue;
+        const int h2 = edge_half[e][0] == h ? edge_half[e][1] : edge_half[e][0];
+        const int g = h2 / 3;
+        const char want = flip[f] ^ (same_direction(h, h2) ? 1 : 0);
+        if (t.face_component[g] < 0) {
+          t.face_component[g] = c;
+          flip[g] = want;
+          queue.push_back(g);
+        } else if (flip[g] != want) {
+          const int a = F_in(f, k), b = F_in(f, (k + 1) % 3);
+          throw Error("non-orientable component " + std::to_string(c) + " (containing face " + std::to_string(root) +
+                      "): faces " + std::to_string(std::min(f, g)) + " and " + std::to_string(std::max(f, g)) +
+                      " cannot be oriented consistently across edge (" + std::to_string(std::min(a, b)) + ", " +
+                      std::to_string(std::max(a, b)) + ")");
+        }
+      }
+    }
+    // Keep the orientation of the majority (ties: the first face's).
+    size_t flipped = 0;
+    for (size_t q = begin; q < queue.size(); ++q) flipped += flip[queue[q]];
+    if (2 * flipped > queue.size() - begin)
+      for (size_t q = begin; q < queue.size(); ++q) flip[queue[q]] ^= 1;
+  }
+
+  // Oriented faces and their edges.
+  t.F = F_in;
+  t.face_edges.resize(nF, 3);
+  for (int f = 0; f < nF; ++f) {
+    if (flip[f]) {
+      t.flipped_faces.push_back(f);
+      std::swap(t.F(f, 1), t.F(f, 2));
+      t.face_edges.row(f) << edge_of[3 * f + 2], edge_of[3 * f + 1], edge_of[3 * f];
+    } else {
+      t.face_edges.row(f) << edge_of[3 * f], edge_of[3 * f + 1], edge_of[3 * f + 2];
+    }
+  }
+  t.edge_vertices.resize(nE, 2);
+  t.edge_faces.setConstant(nE, 2, -1);
+  for (int f = 0; f < nF; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int e = t.face_edges(f, k), a = t.F(f, k), b = t.F(f, (k + 1) % 3);
+      t.edge_vertices.row(e) << std::min(a, b), std::max(a, b);
+      t.edge_faces(e, a < b ? 0 : 1) = f;
+    }
+  }
+
+  // Vertices: component, adjacency (CSR), unreferenced.
+  t.vertex_component.assign(num_vertices, -1);
+  t.vertex_face_offsets.assign(num_vertices + 1, 0);
+  t.vertex_edge_offsets.assign(num_vertices + 1, 0);
+  for (int f = 0; f < nF; ++f)
+    for (int k = 0; k < 3; ++k) {
+      t.vertex_component[t.F(f, k)] = t.face_component[f];
+      ++t.vertex_face_offsets[t.F(f, k) + 1];
+    }
+  for (int e = 0; e < nE; ++e) {
+    ++t.vertex_edge_offsets[t.edge_vertices(e, 0) + 1];
+    ++t.vertex_edge_offsets[t.edge_vertices(e, 1) + 1];
+  }
+  for (int v = 0; v < num_vertices; ++v) {
+    t.vertex_face_offsets[v + 1] += t.vertex_face_offsets[v];
+    t.vertex_edge_offsets[v + 1] += t.vertex_edge_offsets[v];
+  }
+  t.vertex_faces.resize(H);
+  t.vertex_edges.resize(2 * static_cast<size_t>(nE));
+  {
+    std::vector<int> fill(t.vertex_face_offsets.begin(), t.vertex_face_offsets.end() - 1);
+    for (int f = 0; f < nF; ++f)
+      for (int k = 0; k < 3; ++k) t.vertex_faces[fill[t.F(f, k)]++] = f;
+    fill.assign(t.vertex_edge_offsets.begin(), t.vertex_edge_offsets.end() - 1);
+    for (int e = 0; e < nE; ++e)
+      for (int k = 0; k < 2; ++k) t.vertex_edges[fill[t.edge_vertices(e, k)]++] = e;
+  }
+  for (int v = 0; v < num_vertices; ++v)
+    if (t.vertex_component[v] < 0) t.unreferenced_vertices.push_back(v);
+
+  // Boundary loops: on a manifold every boundary vertex has exactly one outgoing boundary half-edge.
+  std::vector<int> next(num_vertices, -1);
+  for (int e = 0; e < nE; ++e) {
+    if (!t.is_boundary_edge(e)) continue;
+    const int f = t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1);
+    for (int k = 0; k < 3; ++k)
+      if (t.face_edges(f, k) == e) next[t.F(f, k)] = t.F(f, (k + 1) % 3);
+  }
+  t.vertex_boundary_loop.assign(num_vertices, -1);
+  for (int v = 0; v < num_vertices; ++v) {
+    if (next[v] < 0 || t.vertex_boundary_loop[v] >= 0) continue;
+    const int loop = static_cast<int>(t.boundary_loops.size());
+    t.boundary_loops.emplace_back();
+    for (int u = v; t.vertex_boundary_loop[u] < 0; u = next[u]) {
+      t.vertex_boundary_loop[u] = loop;
+      t.boundary_loops.back().push_back(u);
+    }
+    t.components[t.vertex_component[v]].boundary_loops.push_back(loop);
+  }
+
+  // Per-component counts and invariants.
+  for (int f = 0; f < nF; ++f) ++t.components[t.face_component[f]].faces;
+  for (int v = 0; v < num_vertices; ++v)
+    if (t.vertex_component[v] >= 0) ++t.components[t.vertex_component[v]].vertices;
+  for (int e = 0; e < nE; ++e) {
+    const int f = t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1);
+    ++t.components[t.face_component[f]].edges;
+  }
+  for (auto& c : t.components) {
+    c.euler_characteristic = c.vertices - c.edges + c.faces;
+    c.genus = (2 - c.euler_characteristic - static_cast<int>(c.boundary_loops.size())) / 2;
+  }
+  return t;
+}
+
+}  // namespace trivcon

@@ -1,0 +1,26 @@
+// Shared helpers for the test programs.
+#pragma once
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace trivcon::test {
+
+// Absolute path of ../shared/data/meshes/NAME, or "" when the shared folder is absent.
+std::string shared_mesh(const std::string& name);
+// GTEST_SKIP()s the calling test with a message when the shared meshes are absent.
+#define TRIVCON_REQUIRE_SHARED()                                                                        \
+  if (::trivcon::test::shared_mesh("SOURCES.md").empty())                                               \
+  GTEST_SKIP() << "../shared/data/meshes not found next to the repository: skipping real-mesh test"
+
+// A fresh directory for this test's files (under the build tree).
+std::string temp_dir(const std::string& name);
+
+struct CommandResult {
+  int status = 0;  // exit status
+  std::string out, err;
+};
+// Runs the trivcon program with the arguments (a shell-quoted string), capturing stdout and stderr.
+CommandResult run_cli(const std::string& args);
+
+}  // namespace trivcon::test
