@@ -1,10 +1,11 @@
 #include "trivcon/solver.h"
 
-#include <Eigen/CholmodSupport>
+#include <cholmod.h>
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <SuiteSparseQR.hpp>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <numeric>
 
@@ -18,91 +19,181 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// Dense Y = L⁻¹ B is kept between edits (saving one sparse solve per edit) only up to this size.
-constexpr double kMaxStoredSchurBytes = 512.0 * 1024 * 1024;
-constexpr int kSchurBlock = 64;  // right-hand sides per CHOLMOD solve when forming the Schur complement
 }  // namespace
 
 // The constraint system in "active edge" space (interior edges with w_e > 0): Dt (m × nD) and
 // Ct (m × nC) are the transposed constraint rows, so x_active = W (Dt λ + Ct μ).
 struct ConnectionSolver::Engine {
   virtual ~Engine() = default;
-  // r₀: the values of the C rows' right-hand sides that minimise the energy for these vertex rows.
-  virtual Eigen::VectorXd optimal_cycle_rhs(const Eigen::VectorXd& b_D) const = 0;
-  virtual Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const Eigen::VectorXd& b_C) const = 0;  // x on active edges
+  // Returns x on the active edges for vertex right-hand sides b_D; the cycle right-hand sides b_C are
+  // asked from `choose`, given r₀: the real b_C that minimises the energy for this b_D.
+  using CycleRhsChooser = std::function<Eigen::VectorXd(const Eigen::VectorXd& r0)>;
+  virtual Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const = 0;
   Eigen::MatrixXd P;  // ((A W Aᵀ)⁻¹) restricted to the C rows = S⁻¹
 };
 
 namespace {
 
-// Cholesky of the interior-vertex Laplacian + dense Schur complement for the cycle rows.
+// One supernodal Cholesky factorization R Rᵀ = Π M Πᵀ of the whole normal matrix
+//   M = A W Aᵀ = [ D W Dᵀ   D W Cᵀ ]
+//                [ C W Dᵀ   C W Cᵀ ],
+// with the vertex rows ordered by CHOLMOD (AMD or METIS, chosen on D W Dᵀ alone) and the cycle rows C
+// forced last. Then the trailing block R_CC of the factor is the Cholesky factor of the Schur
+// complement S, so P = S⁻¹ = R_CC⁻ᵀ R_CC⁻¹ costs O(|C|³) with no extra solves, and an edit needs one
+// forward and one backward substitution: the forward part of the vertex rows does not depend on b_C.
 struct CholeskyEngine : ConnectionSolver::Engine {
-  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> chol;
-  SparseMatrix Dt, Ct, B;  // B = D W Cᵀ (nD × nC)
+  mutable cholmod_common cc;
+  cholmod_factor* factor = nullptr;
+  SparseMatrix Dt, Ct;
   Eigen::VectorXd w;
-  Eigen::MatrixXd Y;       // L⁻¹ B, when small enough to keep
-  bool keep_Y = false;
+  int nD = 0, nC = 0;
+  Eigen::MatrixXd R_CC;  // lower triangular
 
   CholeskyEngine(const SparseMatrix& Dt_, const SparseMatrix& Ct_, const Eigen::VectorXd& w_, SetupTimings& timings)
       : Dt(Dt_), Ct(Ct_), w(w_) {
+    cholmod_start(&cc);
+    cc.print = 0;
+    cc.supernodal = CHOLMOD_SUPERNODAL;
+    cc.final_ll = 1;
+    nD = static_cast<int>(Dt.cols()), nC = static_cast<int>(Ct.cols());
+    const int n = nD + nC;
     auto t0 = Clock::now();
-    const SparseMatrix WDt = w.asDiagonal() * Dt;
-    const SparseMatrix L = SparseMatrix(Dt.transpose()) * WDt;
-    B = SparseMatrix(WDt.transpose()) * Ct;
-    const Eigen::MatrixXd G = Eigen::MatrixXd(SparseMatrix(Ct.transpose()) * (w.asDiagonal() * Ct));
+    SparseMatrix M = normal_matrix();  // upper triangle
     timings.assemble += seconds_since(t0);
+    if (n == 0) return;
 
     t0 = Clock::now();
-    if (L.rows() > 0) {
-      chol.compute(L);
-      if (chol.info() != Eigen::Success)
-        throw Error("CHOLMOD could not factor the Laplacian of the interior vertices (" + std::to_string(L.rows()) +
-                    " rows): it is not positive definite");
+    // Fill-reducing order of the vertex block, then the cycle rows.
+    std::vector<int> perm(n);
+    {
+      SparseMatrix MDD = M.topLeftCorner(nD, nD);
+      cholmod_sparse A = view(MDD);
+      std::iota(perm.begin(), perm.end(), 0);
+      if (nD > 0) {
+        cholmod_factor* symbolic = cholmod_analyze(&A, &cc);
+        check(symbolic != nullptr, "CHOLMOD could not analyse the vertex Laplacian");
+        const int* p = static_cast<const int*>(symbolic->Perm);
+        std::copy(p, p + nD, perm.begin());
+        cholmod_free_factor(&symbolic, &cc);
+      }
     }
+    cholmod_sparse A = view(M);
+    const int saved_nmethods = cc.nmethods, saved_postorder = cc.postorder;
+    cc.nmethods = 1;
+    cc.method[0].ordering = CHOLMOD_GIVEN;
+    cc.postorder = 0;  // keep the cycle rows last
+    factor = cholmod_analyze_p(&A, perm.data(), nullptr, 0, &cc);
+    cc.nmethods = saved_nmethods, cc.postorder = saved_postorder;
+    check(factor != nullptr, "CHOLMOD could not analyse the constraint system");
+    cholmod_factorize(&A, factor, &cc);
+    if (cc.status == CHOLMOD_NOT_POSDEF || factor->minor < factor->n) {
+      const int row = static_cast<int>(factor->minor);
+      throw Error(row < static_cast<int>(perm.size()) && perm[row] >= nD
+                      ? "the holonomy of the generators and boundary loops cannot be controlled independently with these weights "
+                        "(the constraint system is singular); try --weights unit"
+                      : "CHOLMOD found the constraint system not positive definite; try --weights unit");
+    }
+    check(cc.status == CHOLMOD_OK && factor->is_super && factor->is_ll, "CHOLMOD factorization failed");
     timings.factor += seconds_since(t0);
 
     t0 = Clock::now();
-    const int nD = static_cast<int>(L.rows()), nC = static_cast<int>(Ct.cols());
-    keep_Y = static_cast<double>(nD) * nC * 8.0 <= kMaxStoredSchurBytes;
-    if (keep_Y) Y.resize(nD, nC);
-    Eigen::MatrixXd S = G;
-    for (int c0 = 0; c0 < nC && nD > 0; c0 += kSchurBlock) {
-      const int k = std::min(kSchurBlock, nC - c0);
-      const Eigen::MatrixXd Bk = Eigen::MatrixXd(B.middleCols(c0, k));
-      const Eigen::MatrixXd Yk = chol.solve(Bk);
-      if (chol.info() != Eigen::Success) throw Error("CHOLMOD solve failed while forming the Schur complement");
-      S.middleCols(c0, k) -= SparseMatrix(B.transpose()) * Yk;
-      if (keep_Y) Y.middleCols(c0, k) = Yk;
-    }
+    extract_cycle_block();
     if (nC > 0) {
-      S = 0.5 * (S + S.transpose());
-      Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
-      const Eigen::VectorXd d = ldlt.vectorD();
-      const double scale = S.diagonal().cwiseAbs().maxCoeff();
-      if (ldlt.info() != Eigen::Success || !(d.minCoeff() > 1e-13 * scale))
-        throw Error("the holonomy of the generators and boundary loops cannot be controlled independently with these "
-                    "weights (singular Schur complement); try --weights unit");
-      P = ldlt.solve(Eigen::MatrixXd::Identity(nC, nC));
-      P = 0.5 * (P + P.transpose());
+      const double min_diag = R_CC.diagonal().minCoeff(), max_diag = R_CC.diagonal().maxCoeff();
+      if (!(min_diag > 1e-8 * max_diag))
+        throw Error("the holonomy of the generators and boundary loops is nearly undetermined with these weights "
+                    "(ill-conditioned Schur complement); try --weights unit");
+      const Eigen::MatrixXd Rinv = R_CC.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(nC, nC));
+      P = Rinv.transpose() * Rinv;
     }
     timings.schur += seconds_since(t0);
   }
+  ~CholeskyEngine() override {
+    if (factor) cholmod_free_factor(&factor, &cc);
+    cholmod_finish(&cc);
+  }
 
-  Eigen::VectorXd solve_L(const Eigen::VectorXd& b) const {
-    if (b.size() == 0) return b;
-    Eigen::VectorXd y = chol.solve(b);
-    if (chol.info() != Eigen::Success) throw Error("CHOLMOD solve failed");
-    return y;
+  void check(bool ok, const char* what) const {
+    if (!ok) throw Error(std::string(what) + " (CHOLMOD status " + std::to_string(cc.status) + ")");
   }
-  Eigen::VectorXd optimal_cycle_rhs(const Eigen::VectorXd& b_D) const override {
-    return B.transpose() * solve_L(b_D);
+
+  static cholmod_sparse view(SparseMatrix& M) {
+    M.makeCompressed();
+    cholmod_sparse s{};
+    s.nrow = M.rows(), s.ncol = M.cols(), s.nzmax = M.nonZeros();
+    s.p = M.outerIndexPtr(), s.i = M.innerIndexPtr(), s.x = M.valuePtr();
+    s.stype = 1, s.itype = CHOLMOD_INT, s.xtype = CHOLMOD_REAL, s.dtype = CHOLMOD_DOUBLE, s.sorted = 1, s.packed = 1;
+    return s;
   }
-  Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const Eigen::VectorXd& b_C) const override {
-    const Eigen::VectorXd lambda0 = solve_L(b_D);
-    const Eigen::VectorXd mu = P * (b_C - B.transpose() * lambda0);
-    const Eigen::VectorXd lambda = keep_Y ? Eigen::VectorXd(lambda0 - Y * mu) : solve_L(b_D - B * mu);
-    return w.asDiagonal() * (Dt * lambda + Ct * mu);
+
+  // Upper triangle of A W Aᵀ, assembled directly from the edges (A = [D; C] through Dt and Ct).
+  SparseMatrix normal_matrix() const {
+    const int m = static_cast<int>(Dt.rows());
+    const Eigen::SparseMatrix<double, Eigen::RowMajor> Drows = Dt, Crows = Ct;  // row a: the rows of A touching edge a
+    std::vector<Triplet> trip;
+    trip.reserve(static_cast<size_t>(m) * 4);
+    std::vector<std::pair<int, double>> col;
+    for (int a = 0; a < m; ++a) {
+      // Entries of column a of A: (row, coefficient), vertex rows then cycle rows.
+      col.clear();
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Drows, a); it; ++it) col.emplace_back(static_cast<int>(it.col()), it.value());
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Crows, a); it; ++it) col.emplace_back(nD + static_cast<int>(it.col()), it.value());
+      for (const auto& [r1, v1] : col)
+        for (const auto& [r2, v2] : col)
+          if (r1 <= r2) trip.emplace_back(r1, r2, v1 * v2 * w(a));
+    }
+    SparseMatrix M(nD + nC, nD + nC);
+    M.setFromTriplets(trip.begin(), trip.end());
+    return M;
+  }
+
+  // R_CC: the factor's entries at rows and columns ≥ nD (in factor order), read from the supernodes.
+  void extract_cycle_block() {
+    R_CC = Eigen::MatrixXd::Zero(nC, nC);
+    if (nC == 0) return;
+    const int* super = static_cast<const int*>(factor->super);
+    const int* pi = static_cast<const int*>(factor->pi);
+    const int* px = static_cast<const int*>(factor->px);
+    const int* rows = static_cast<const int*>(factor->s);
+    const double* x = static_cast<const double*>(factor->x);
+    for (size_t s = 0; s < factor->nsuper; ++s) {
+      const int first = super[s], ncol = super[s + 1] - super[s], nrow = pi[s + 1] - pi[s];
+      for (int c = 0; c < ncol; ++c) {
+        const int col = first + c;
+        if (col < nD) continue;
+        for (int r = c; r < nrow; ++r) R_CC(rows[pi[s] + r] - nD, col - nD) = x[px[s] + r + static_cast<size_t>(c) * nrow];
+      }
+    }
+  }
+
+  // Solves with the factor pieces: sys is CHOLMOD_P, CHOLMOD_L, CHOLMOD_Lt or CHOLMOD_Pt.
+  Eigen::VectorXd apply(int sys, const Eigen::VectorXd& b) const {
+    cholmod_dense B{};
+    B.nrow = b.size(), B.ncol = 1, B.nzmax = b.size(), B.d = b.size();
+    B.x = const_cast<double*>(b.data());
+    B.xtype = CHOLMOD_REAL, B.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* X = cholmod_solve(sys, factor, &B, &cc);
+    check(X != nullptr && cc.status == CHOLMOD_OK, "CHOLMOD solve failed");
+    Eigen::VectorXd out = Eigen::Map<Eigen::VectorXd>(static_cast<double*>(X->x), b.size());
+    cholmod_free_dense(&X, &cc);
+    return out;
+  }
+
+  Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const override {
+    const int n = nD + nC;
+    if (n == 0) return Eigen::VectorXd::Zero(Dt.rows());
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+    b.head(nD) = b_D;
+    // Forward substitution with b_C = 0: z_D is final; z_C = z_C0 + R_CC⁻¹ b_C for any b_C (the cycle
+    // rows come last, in their own order, so positions ≥ nD of Πb are b_C).
+    Eigen::VectorXd z = apply(CHOLMOD_L, apply(CHOLMOD_P, b));
+    if (nC > 0) {
+      const Eigen::VectorXd z_C0 = z.tail(nC);
+      const Eigen::VectorXd b_C = choose(-(R_CC * z_C0));  // the energy ‖z‖² is least at b_C = −R_CC z_C0
+      z.tail(nC) = z_C0 + R_CC.triangularView<Eigen::Lower>().solve(b_C);
+    }
+    const Eigen::VectorXd y = apply(CHOLMOD_Pt, apply(CHOLMOD_Lt, z));  // [λ; μ]
+    return w.asDiagonal() * (Dt * y.head(nD) + Ct * y.tail(nC));
   }
 };
 
@@ -170,16 +261,14 @@ struct QREngine : ConnectionSolver::Engine {
     cholmod_l_free_dense(&B, &cc), cholmod_l_free_dense(&Z, &cc), cholmod_l_free_dense(&X, &cc);
     return y;
   }
-  Eigen::VectorXd optimal_cycle_rhs(const Eigen::VectorXd& b_D) const override {
-    if (nC == 0) return Eigen::VectorXd();
+  Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const override {
     Eigen::VectorXd b = Eigen::VectorXd::Zero(nD + nC);
     b.head(nD) = b_D;
-    const Eigen::VectorXd gradient = responses.transpose() * min_norm_y(b);  // λ_C at b_C = 0
-    return -P.ldlt().solve(gradient);
-  }
-  Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const Eigen::VectorXd& b_C) const override {
-    Eigen::VectorXd b(nD + nC);
-    b << b_D, b_C;
+    if (nC > 0) {
+      // The energy is ‖y‖²; its gradient in b_C at b_C = 0 is 2 λ_C = 2 responsesᵀ y.
+      const Eigen::VectorXd gradient = responses.transpose() * min_norm_y(b);
+      b.tail(nC) = choose(-P.ldlt().solve(gradient));
+    }
     return sqrt_w.asDiagonal() * min_norm_y(b);
   }
 };
@@ -378,13 +467,11 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
     }
   }
   Eigen::VectorXd n_C = n0;
-  if (nC > 0) {
-    const Eigen::VectorXd r0 = engine_->optimal_cycle_rhs(b_D);
+  const Eigen::VectorXd x_active = engine_->solve(b_D, [&](const Eigen::VectorXd& r0) {
     const Eigen::VectorXd u = (H - r0) / step;
     n_C += M * nearest_lattice_point(engine_->P, u, n0, M).cast<double>();
-  }
-  const Eigen::VectorXd b_C = H - step * n_C;
-  const Eigen::VectorXd x_active = engine_->solve(b_D, b_C);
+    return Eigen::VectorXd(H - step * n_C);
+  });
 
   Connection result;
   result.N = N;

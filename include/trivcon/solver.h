@@ -8,13 +8,14 @@
 //   generator γ:            Σ_e c_e x_e  = z_γ − 2π k_γ      (z_γ = levi_civita_holonomy)
 // Objective: minimise Σ x_e² / w_e (w = cotan or unit weights); an edge with w_e = 0 gets x_e = 0.
 //
-// Default route (SolverKind::Cholesky): x = W (Dᵀ λ + Cᵀ μ), where D holds the interior-vertex rows
-// and C the loop and generator rows. D W Dᵀ is the cotan Laplacian on interior vertices; on a closed
-// component one vertex row is dropped (Gauss–Bonnet makes it redundant), and on a component with
-// boundary one loop row is (its index follows from the others). It is factored once with CHOLMOD
-// (supernodal, OpenBLAS); C is eliminated through the small dense Schur complement S = CWCᵀ − CWDᵀ
-// (DWDᵀ)⁻¹DWCᵀ. A new prescription only changes the right-hand side: one or two sparse triangular
-// solves per edit.
+// Default route (SolverKind::Cholesky): x = W Aᵀ y with (A W Aᵀ) y = b, where A = [D; C] holds the
+// interior-vertex rows D and the cycle rows C (loops, generators). D W Dᵀ is the cotan Laplacian on
+// interior vertices; on a closed component one vertex row is dropped (Gauss–Bonnet makes it redundant),
+// and on a component with boundary one loop row is (its index follows from the others). A W Aᵀ is
+// factored once by CHOLMOD (supernodal, OpenBLAS), the vertex rows in a fill-reducing order (AMD or
+// METIS, chosen by CHOLMOD) and the cycle rows last, so that the trailing block of the factor is the
+// Cholesky factor of the Schur complement S = CWCᵀ − CWDᵀ(DWDᵀ)⁻¹DWCᵀ. A new prescription only changes
+// b: one forward and one backward substitution per edit, nothing is refactored.
 // Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
 // system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
 //
