@@ -282,7 +282,8 @@ Eigen::VectorXi nearest_lattice_point(const Eigen::MatrixXd& P, const Eigen::Vec
   if (k == 0) return t;
   const Eigen::MatrixXd Q = M.transpose() * P * M;
   const Eigen::VectorXd real_opt = Q.ldlt().solve(M.transpose() * P * (u - n0));
-  for (int i = 0; i < k; ++i) t(i) = static_cast<int>(std::lround(real_opt(i)));
+  // Halves round up, with a margin, so that routes whose round-off differs choose alike on exact ties.
+  for (int i = 0; i < k; ++i) t(i) = static_cast<int>(std::floor(real_opt(i) + 0.5 + 1e-7));
   Eigen::VectorXd g = Q * t.cast<double>() - M.transpose() * P * (u - n0);  // ½ gradient
   const double tolerance = 1e-12 * std::max(1.0, Q.diagonal().maxCoeff());
   for (int pass = 0; pass < 1000; ++pass) {
