@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "summary.h"
+#include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
 #include "trivcon/field_io.h"
@@ -48,9 +49,17 @@ struct SolveOptions {
   std::string weights = "cotan", solver = "cholesky";
   std::vector<int> root_faces;
   std::vector<double> root_angles;
+  std::vector<std::string> fixes;
+  bool align_boundary = false;
   std::string field_out, connection_out, lines_out, report;
   bool quiet = false;
 };
+
+// --fix takes "F:x,y,z" / "F:angle=A" specs and files; a spec starts with a face id and a colon.
+bool is_fix_spec(const std::string& s) {
+  const size_t colon = s.find(':');
+  return colon != std::string::npos && colon > 0 && s.find_first_not_of("0123456789") == colon;
+}
 
 std::string fmt(double v) {
   std::ostringstream s;
@@ -71,21 +80,28 @@ void run_solve(const SolveOptions& o) {
   SolverOptions options;
   options.weights = o.weights == "unit" ? WeightKind::Unit : WeightKind::Cotan;
   options.solver = o.solver == "qr" ? SolverKind::QR : SolverKind::Cholesky;
-  const FieldDesigner designer(mesh.V, mesh.F, options);
-  const Design d = designer.design(prescription, roots);
+  FieldDesigner designer(mesh.V, mesh.F, options);
+  IndexPrescription with_fixed = prescription;
+  if (o.align_boundary) with_fixed.fixed = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
+  std::map<int, double> explicit_fixed;  // --fix wins over --align-boundary on the same face
+  for (const auto& f : o.fixes) {
+    if (is_fix_spec(f)) add_fixed_direction(f, designer.topology(), designer.geometry(), explicit_fixed);
+    else read_fixed_directions(f, designer.topology(), designer.geometry(), explicit_fixed);
+  }
+  for (auto [f, angle] : explicit_fixed) with_fixed.fixed[f] = angle;
+  if (!with_fixed.fixed.empty()) {
+    std::vector<int> faces;
+    for (auto [f, angle] : with_fixed.fixed) faces.push_back(f);
+    designer.set_fixed_faces(faces);
+  }
+  const Design d = designer.design(with_fixed, roots);
   const Topology& t = designer.topology();
   const Connection& c = d.connection;
 
   // Verification: constraint residuals relative to the right-hand sides, transport, indices.
   const double tolerance = 1e-9 * std::max(1.0, c.rhs_scale);
   const double residual = std::max(c.max_vertex_residual, c.max_cycle_residual);
-  std::vector<int> unexplained;  // index mismatches not explained by a turn of ≥ π/N across an edge of the vertex
-  for (int v : d.index_mismatch_vertices) {
-    bool large = false;
-    for (int a = t.vertex_edge_offsets[v]; a < t.vertex_edge_offsets[v + 1]; ++a)
-      large |= std::abs(c.x(t.vertex_edges[a])) >= 3.14159265358979323846 / prescription.N;
-    if (!large) unexplained.push_back(v);
-  }
+  const std::vector<int>& unexplained = d.unexplained_mismatch_vertices;
 
   auto t1 = Clock::now();
   if (!o.field_out.empty()) write_field(o.field_out, mesh.V, mesh.F, designer.geometry(), d.field);
@@ -111,6 +127,13 @@ void run_solve(const SolveOptions& o) {
   for (size_t l = 0; l < c.loop_index.size(); ++l)
     loops.push_back({{"id", l}, {"index", format_index(c.loop_index[l], prescription.N)}, {"chosen", static_cast<bool>(c.loop_chosen[l])}});
   report["boundary_loops"] = loops;
+  nlohmann::ordered_json conflicts = nlohmann::ordered_json::array();
+  for (const FixedConflict& k : d.conflicts) conflicts.push_back({{"face_a", k.face_a}, {"face_b", k.face_b}, {"turn", k.turn}});
+  report["fixed"] = {{"faces", with_fixed.fixed.size()},
+                     {"align_boundary", o.align_boundary},
+                     {"paths", designer.solver().fixed_paths().size()},
+                     {"max_error", d.max_fixed_error},
+                     {"conflicts", conflicts}};
   report["energy"] = c.energy;
   report["residuals"] = {{"max_vertex", c.max_vertex_residual},
                          {"max_cycle", c.max_cycle_residual},
@@ -137,6 +160,9 @@ void run_solve(const SolveOptions& o) {
               << t.boundary_loops.size() << " boundary loop(s)\n"
               << "N " << prescription.N << ", " << prescription.vertex.size() << " singular vertices, weights " << o.weights << ", solver "
               << o.solver << "\n"
+              << (with_fixed.fixed.empty() ? std::string()
+                                           : std::to_string(with_fixed.fixed.size()) + " fixed faces, max deviation " + fmt(d.max_fixed_error) +
+                                                 " rad, " + std::to_string(d.conflicts.size()) + " sharp turns between adjacent fixed faces\n")
               << "energy " << std::setprecision(10) << c.energy << "\n"
               << "max residual " << fmt(residual) << " rad (vertex " << fmt(c.max_vertex_residual) << ", cycles " << fmt(c.max_cycle_residual)
               << "), transport mismatch " << fmt(d.transport_mismatch) << " rad\n"
@@ -148,7 +174,7 @@ void run_solve(const SolveOptions& o) {
               << " s, cycles " << fmt(pt.cycles) << " s, setup " << fmt(pt.setup) << " s, solve " << fmt(d.solve_seconds) << " s, field "
               << fmt(d.field_seconds) << " s\n";
   }
-  if (residual > tolerance || d.transport_mismatch > tolerance || !unexplained.empty()) {
+  if (residual > tolerance || d.transport_mismatch > tolerance || d.max_fixed_error > tolerance || !unexplained.empty()) {
     std::cerr << "trivcon: verification failed: residual " << residual << ", transport mismatch " << d.transport_mismatch << ", "
               << unexplained.size() << " unexplained index mismatches\n";
     exit_code = 3;
@@ -212,6 +238,10 @@ void register_solve(CLI::App& app) {
   o.prescription.add_to(cmd, true);
   cmd->add_option("--weights", o.weights, "cotan (default: clamped cotangent weights) or unit")->check(CLI::IsMember({"cotan", "unit"}));
   cmd->add_option("--solver", o.solver, "cholesky (default) or qr (the paper's SuiteSparseQR route)")->check(CLI::IsMember({"cholesky", "qr"}));
+  cmd->add_option("--fix", o.fixes,
+                  "Fixed direction: F:x,y,z (world, projected to the face), F:angle=A (radians, face frame), or a file with "
+                  "'FACE x y z' / 'FACE angle=A' lines; repeatable");
+  cmd->add_flag("--align-boundary", o.align_boundary, "Fix every face with a boundary edge to that edge's direction");
   cmd->add_option("--root-face", o.root_faces, "Face where propagation starts (one per component at most; repeatable)");
   cmd->add_option("--root-angle", o.root_angles, "Angle (radians, in the root face's frame) of the field at the matching --root-face");
   cmd->add_option("--field-out", o.field_out, "Field file: .txt (x y z per face), .rawfield (Directional) or .ply");

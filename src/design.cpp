@@ -1,7 +1,10 @@
 #include "trivcon/design.h"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
+
+#include "trivcon/error.h"
 
 namespace trivcon {
 
@@ -10,7 +13,7 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 }  // namespace
 
-FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptions options) : V_(V) {
+FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptions options) : V_(V), options_(options) {
   auto t0 = Clock::now();
   check_finite(V_);
   topology_ = build_topology(F, static_cast<int>(V_.rows()));
@@ -21,18 +24,42 @@ FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptio
   t0 = Clock::now();
   cycles_ = compute_cycles(topology_);
   timings_.cycles = seconds_since(t0);
-  t0 = Clock::now();
-  solver_ = std::make_unique<ConnectionSolver>(topology_, geometry_, cycles_, options);
-  timings_.setup = seconds_since(t0);
+}
+
+void FieldDesigner::set_fixed_faces(const std::vector<int>& faces) {
+  fixed_faces_ = faces;
+  solver_.reset();
+  solver();
+}
+
+const ConnectionSolver& FieldDesigner::solver() const {
+  if (!solver_) {
+    const auto t0 = Clock::now();
+    solver_ = std::make_unique<ConnectionSolver>(topology_, geometry_, cycles_, options_, fixed_faces_);
+    timings_.setup = seconds_since(t0);
+  }
+  return *solver_;
 }
 
 Design FieldDesigner::design(const IndexPrescription& prescription, const std::vector<std::pair<int, double>>& roots) const {
   Design d;
   auto t0 = Clock::now();
-  d.connection = solver_->solve(prescription);
+  d.connection = solver().solve(prescription);
   d.solve_seconds = seconds_since(t0);
   t0 = Clock::now();
-  d.field = propagate_field(topology_, geometry_, d.connection.x, prescription.N, roots);
+  // Components with fixed faces start at their smallest fixed face, with its direction.
+  std::vector<std::pair<int, double>> starts = roots;
+  std::vector<char> rooted(topology_.components.size(), 0);
+  for (auto [f, angle] : roots)
+    if (f >= 0 && f < topology_.num_faces) rooted[topology_.face_component[f]] = 1;
+  for (auto [f, angle] : prescription.fixed) {
+    const int c = topology_.face_component[f];
+    if (rooted[c] == 1)
+      throw Error("component " + std::to_string(c) + " has fixed faces: its field starts at fixed face " + std::to_string(f) +
+                  ", so it takes no root face");
+    if (rooted[c] == 0) starts.emplace_back(f, angle), rooted[c] = 2;
+  }
+  d.field = propagate_field(topology_, geometry_, d.connection.x, prescription.N, starts);
   d.field_seconds = seconds_since(t0);
   t0 = Clock::now();
   d.indices = field_indices(topology_, geometry_, cycles_, d.field);
@@ -42,8 +69,18 @@ Design FieldDesigner::design(const IndexPrescription& prescription, const std::v
     auto it = prescription.vertex.find(v);
     if (d.indices.vertex[v] != (it == prescription.vertex.end() ? 0 : it->second)) d.index_mismatch_vertices.push_back(v);
   }
-  const double half_period = 3.14159265358979323846 / prescription.N;
-  for (int e = 0; e < topology_.num_edges; ++e) d.large_turn_edges += std::abs(d.connection.x(e)) >= half_period;
+  // A turn of exactly ±π/N is ambiguous for the field (both give the same N-direction), hence the margin.
+  const double half_period = 3.14159265358979323846 / prescription.N - 1e-9;
+  auto large = [&](int e) { return std::abs(d.connection.x(e)) >= half_period; };
+  for (int e = 0; e < topology_.num_edges; ++e) d.large_turn_edges += large(e);
+  for (int v : d.index_mismatch_vertices) {
+    bool explained = false;
+    for (int a = topology_.vertex_edge_offsets[v]; a < topology_.vertex_edge_offsets[v + 1]; ++a) explained |= large(topology_.vertex_edges[a]);
+    if (!explained) d.unexplained_mismatch_vertices.push_back(v);
+  }
+  for (auto [f, angle] : prescription.fixed)
+    d.max_fixed_error = std::max(d.max_fixed_error, std::abs(reduce_angle(d.field.angle(f) - angle, prescription.N)));
+  d.conflicts = fixed_conflicts(topology_, geometry_, prescription.fixed, prescription.N);
   d.verify_seconds = seconds_since(t0);
   return d;
 }

@@ -10,6 +10,9 @@
 #include <numeric>
 
 #include "trivcon/error.h"
+#include "trivcon/field.h"
+#include <algorithm>
+#include <map>
 
 namespace trivcon {
 
@@ -29,7 +32,14 @@ struct ConnectionSolver::Engine {
   // asked from `choose`, given r₀: the real b_C that minimises the energy for this b_D.
   using CycleRhsChooser = std::function<Eigen::VectorXd(const Eigen::VectorXd& r0)>;
   virtual Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const = 0;
-  Eigen::MatrixXd P;  // ((A W Aᵀ)⁻¹) restricted to the C rows = S⁻¹
+
+  // P = S⁻¹ = ((A W Aᵀ)⁻¹) restricted to the cycle rows: the energy's quadratic form in their right-hand sides.
+  virtual Eigen::VectorXd apply_P(const Eigen::VectorXd& v) const = 0;
+  virtual Eigen::VectorXd P_column(int i) const = 0;
+  virtual Eigen::MatrixXd dense_P() const = 0;
+  // A triangular T with P = Tᵀ T (for rounding one index at a time, Babai's nearest plane).
+  virtual const Eigen::MatrixXd& P_factor(bool& lower) const = 0;
+  Eigen::VectorXd P_diagonal;
 };
 
 namespace {
@@ -47,7 +57,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   SparseMatrix Dt, Ct;
   Eigen::VectorXd w;
   int nD = 0, nC = 0;
-  Eigen::MatrixXd R_CC;  // lower triangular
+  Eigen::MatrixXd R_CC, R_inv;  // lower triangular; P = R_invᵀ R_inv
 
   CholeskyEngine(const SparseMatrix& Dt_, const SparseMatrix& Ct_, const Eigen::VectorXd& w_, SetupTimings& timings)
       : Dt(Dt_), Ct(Ct_), w(w_) {
@@ -89,8 +99,8 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     if (cc.status == CHOLMOD_NOT_POSDEF || factor->minor < factor->n) {
       const int row = static_cast<int>(factor->minor);
       throw Error(row < static_cast<int>(perm.size()) && perm[row] >= nD
-                      ? "the holonomy of the generators and boundary loops cannot be controlled independently with these weights "
-                        "(the constraint system is singular); try --weights unit"
+                      ? "the holonomy of the generators, boundary loops or fixed-direction paths cannot be controlled independently "
+                        "with these weights (the constraint system is singular); try --weights unit"
                       : "CHOLMOD found the constraint system not positive definite; try --weights unit");
     }
     check(cc.status == CHOLMOD_OK && factor->is_super && factor->is_ll, "CHOLMOD factorization failed");
@@ -101,10 +111,10 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     if (nC > 0) {
       const double min_diag = R_CC.diagonal().minCoeff(), max_diag = R_CC.diagonal().maxCoeff();
       if (!(min_diag > 1e-8 * max_diag))
-        throw Error("the holonomy of the generators and boundary loops is nearly undetermined with these weights "
+        throw Error("the holonomy of the generators, boundary loops or fixed-direction paths is nearly undetermined with these weights "
                     "(ill-conditioned Schur complement); try --weights unit");
-      const Eigen::MatrixXd Rinv = R_CC.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(nC, nC));
-      P = Rinv.transpose() * Rinv;
+      R_inv = R_CC.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(nC, nC));
+      P_diagonal = R_inv.colwise().squaredNorm().transpose();
     }
     timings.schur += seconds_since(t0);
   }
@@ -179,6 +189,21 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     return out;
   }
 
+  Eigen::VectorXd apply_P(const Eigen::VectorXd& v) const override {
+    const Eigen::VectorXd r = R_inv.triangularView<Eigen::Lower>() * v;
+    return R_inv.triangularView<Eigen::Lower>().transpose() * r;
+  }
+  Eigen::VectorXd P_column(int i) const override {
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(nC);
+    r.tail(nC - i) = R_inv.col(i).tail(nC - i);
+    return R_inv.triangularView<Eigen::Lower>().transpose() * r;
+  }
+  Eigen::MatrixXd dense_P() const override { return R_inv.transpose() * R_inv.triangularView<Eigen::Lower>(); }
+  const Eigen::MatrixXd& P_factor(bool& lower) const override {
+    lower = true;
+    return R_inv;
+  }
+
   Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const override {
     const int n = nD + nC;
     if (n == 0) return Eigen::VectorXd::Zero(Dt.rows());
@@ -204,6 +229,16 @@ struct QREngine : ConnectionSolver::Engine {
   Eigen::VectorXd sqrt_w;
   int nD = 0, nC = 0, m = 0;
   Eigen::MatrixXd responses;  // y for each unit C right-hand side (m × nC)
+  Eigen::MatrixXd P;
+
+  Eigen::VectorXd apply_P(const Eigen::VectorXd& v) const override { return P * v; }
+  Eigen::VectorXd P_column(int i) const override { return P.col(i); }
+  Eigen::MatrixXd dense_P() const override { return P; }
+  Eigen::MatrixXd P_lower;  // P = P_lowerᵀ P_lower
+  const Eigen::MatrixXd& P_factor(bool& lower) const override {
+    lower = true;
+    return P_lower;
+  }
 
   QREngine(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w, SetupTimings& timings) {
     auto t0 = Clock::now();
@@ -238,6 +273,15 @@ struct QREngine : ConnectionSolver::Engine {
       responses.col(c) = min_norm_y(b);
     }
     P = responses.transpose() * responses;
+    P_diagonal = P.diagonal();
+    if (nC > 0) {
+      // P = Tᵀ T with T lower triangular, as the Cholesky route has it (R_CC⁻¹): the Cholesky factor of P
+      // with rows and columns reversed, reversed back.
+      const Eigen::MatrixXd reversed = P.reverse();
+      Eigen::LLT<Eigen::MatrixXd> llt(reversed);
+      if (llt.info() != Eigen::Success) throw Error("the cycle rows of the constraint system are dependent; try --weights unit");
+      P_lower = Eigen::MatrixXd(llt.matrixU()).reverse();
+    }
     timings.schur += seconds_since(t0);
   }
   ~QREngine() override {
@@ -273,26 +317,58 @@ struct QREngine : ConnectionSolver::Engine {
   }
 };
 
-// Minimises (u − n₀ − M t)ᵀ P (u − n₀ − M t) over integer t: round the real minimiser, then take
-// single ±1 steps while they lower the value.
-Eigen::VectorXi nearest_lattice_point(const Eigen::MatrixXd& P, const Eigen::VectorXd& u, const Eigen::VectorXd& n0,
-                                      const Eigen::MatrixXd& M) {
+// Rounds the real minimiser u of ‖T (u − n)‖² to integers one coordinate at a time, each given the
+// ones already rounded and with the others still real (Babai's nearest plane): with T lower triangular
+// from the first coordinate on, with T upper triangular from the last one back.
+Eigen::VectorXi babai_round(const Eigen::MatrixXd& T, bool lower, const Eigen::VectorXd& u) {
+  const int k = static_cast<int>(u.size());
+  Eigen::VectorXi n(k);
+  Eigen::VectorXd v(k);  // u − n of the coordinates already rounded
+  // Halves round up, with a margin, so that routes whose round-off differs choose alike on exact ties.
+  auto round = [](double x) { return static_cast<int>(std::floor(x + 0.5 + 1e-7)); };
+  for (int step = 0; step < k; ++step) {
+    const int i = lower ? step : k - 1 - step;
+    const double shift = lower ? T.row(i).head(i).dot(v.head(i)) : T.row(i).tail(k - 1 - i).dot(v.tail(k - 1 - i));
+    n(i) = round(u(i) + shift / T(i, i));
+    v(i) = u(i) - n(i);
+  }
+  return n;
+}
+
+// Minimises (u − n₀ − M t)ᵀ P (u − n₀ − M t) over integer t: Babai rounding of the real minimiser, then
+// single ±1 steps while they lower the value. When every cycle row is free (M = I, the usual case of
+// editing singularities) this costs O(|C|²) per step through the engine's P products; otherwise P is formed.
+Eigen::VectorXi nearest_lattice_point(const ConnectionSolver::Engine& engine, const Eigen::VectorXd& u, const Eigen::VectorXd& n0,
+                                      const Eigen::MatrixXd& M, bool identity) {
   const int k = static_cast<int>(M.cols());
   Eigen::VectorXi t = Eigen::VectorXi::Zero(k);
   if (k == 0) return t;
-  const Eigen::MatrixXd Q = M.transpose() * P * M;
-  const Eigen::VectorXd real_opt = Q.ldlt().solve(M.transpose() * P * (u - n0));
-  // Halves round up, with a margin, so that routes whose round-off differs choose alike on exact ties.
-  for (int i = 0; i < k; ++i) t(i) = static_cast<int>(std::floor(real_opt(i) + 0.5 + 1e-7));
-  Eigen::VectorXd g = Q * t.cast<double>() - M.transpose() * P * (u - n0);  // ½ gradient
-  const double tolerance = 1e-12 * std::max(1.0, Q.diagonal().maxCoeff());
+  Eigen::MatrixXd Q;
+  Eigen::VectorXd g, diagonal;  // g: half the gradient at t
+  if (identity) {
+    bool lower = true;
+    const Eigen::MatrixXd& T = engine.P_factor(lower);
+    t = babai_round(T, lower, u);
+    g = engine.apply_P(t.cast<double>() - u);
+    diagonal = engine.P_diagonal;
+  } else {
+    const Eigen::MatrixXd PM = engine.dense_P() * M;
+    Q = M.transpose() * PM;
+    const Eigen::VectorXd rhs = PM.transpose() * (u - n0);
+    const Eigen::LLT<Eigen::MatrixXd> llt(Q);
+    const Eigen::VectorXd real_opt = llt.solve(rhs);
+    t = babai_round(llt.matrixU(), false, real_opt);
+    g = Q * t.cast<double>() - rhs;
+    diagonal = Q.diagonal();
+  }
+  const double tolerance = 1e-12 * std::max(1.0, diagonal.maxCoeff());
   for (int pass = 0; pass < 1000; ++pass) {
     bool improved = false;
     for (int i = 0; i < k; ++i) {
       for (int d : {1, -1}) {
-        if (2 * d * g(i) + Q(i, i) < -tolerance) {
+        if (2 * d * g(i) + diagonal(i) < -tolerance) {
           t(i) += d;
-          g += d * Q.col(i);
+          g += d * (identity ? engine.P_column(i) : Eigen::VectorXd(Q.col(i)));
           improved = true;
         }
       }
@@ -304,7 +380,8 @@ Eigen::VectorXi nearest_lattice_point(const Eigen::MatrixXd& P, const Eigen::Vec
 
 }  // namespace
 
-ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geometry, const Cycles& cycles, SolverOptions options)
+ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geometry, const Cycles& cycles, SolverOptions options,
+                                   const std::vector<int>& fixed_faces)
     : topology_(topology), geometry_(geometry), cycles_(cycles), options_(options) {
   const Topology& t = topology;
   const int nV = t.num_vertices, nE = t.num_edges;
@@ -314,6 +391,38 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
     if (!t.is_boundary_edge(e)) weights_(e) = options.weights == WeightKind::Unit ? 1.0 : geometry.cotan_weight(e);
   for (size_t l = 0; l < t.boundary_loops.size(); ++l) loop_curvature_.push_back(loop_curvature(t, geometry, static_cast<int>(l)));
   for (const DualCycle& g : cycles.generators) generator_holonomy_.push_back(levi_civita_holonomy(g, geometry));
+  fixed_faces_ = fixed_faces;
+  std::sort(fixed_faces_.begin(), fixed_faces_.end());
+  fixed_faces_.erase(std::unique(fixed_faces_.begin(), fixed_faces_.end()), fixed_faces_.end());
+  for (int f : fixed_faces_)
+    if (f < 0 || f >= t.num_faces)
+      throw Error("fixed face " + std::to_string(f) + " out of range (mesh has " + std::to_string(t.num_faces) + " faces)");
+  {
+    std::vector<char> usable(nE, 0);
+    for (int e = 0; e < nE; ++e) usable[e] = weights_(e) > 0;
+    paths_ = fixed_face_paths(t, fixed_faces_, usable);
+  }
+
+  // A cycle or fixed-face path made only of zero-weight edges could not turn the field at all; its edges
+  // get a small positive weight (1e-6 × the median positive weight), so that it turns there only when
+  // nothing else can.
+  {
+    std::vector<double> positive;
+    for (int e = 0; e < nE; ++e)
+      if (weights_(e) > 0) positive.push_back(weights_(e));
+    double epsilon = 1e-6;
+    if (!positive.empty()) {
+      std::nth_element(positive.begin(), positive.begin() + positive.size() / 2, positive.end());
+      epsilon = 1e-6 * positive[positive.size() / 2];
+    }
+    auto regularize = [&](const DualCycle& c) {
+      if (std::any_of(c.edges.begin(), c.edges.end(), [&](int e) { return weights_(e) > 0; })) return;
+      for (int e : c.edges) weights_(e) = epsilon, ++regularized_edges_;
+    };
+    for (const DualCycle& c : cycles.loops) regularize(c);
+    for (const DualCycle& c : cycles.generators) regularize(c);
+    for (const FixedPath& p : paths_) regularize(p.path);
+  }
 
   // Active edges, vertex rows (one dropped per closed component), loop rows (one dropped per component
   // with boundary: the longest loop, ties to the smallest id), generator rows.
@@ -335,13 +444,18 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
   }
   for (int v = 0; v < nV; ++v)
     if (t.is_interior_vertex(v) && dropped_vertex_[t.vertex_component[v]] != v) vertex_row_[v] = num_vertex_rows_++;
+  // Cycle rows, fixed-face paths first: free indices are rounded in this order (see nearest_lattice_point),
+  // and a path between nearby fixed faces is well determined, while a loop or generator index is only
+  // determined once the paths around it are.
+  for (int k = 0; k < static_cast<int>(paths_.size()); ++k) rows_.push_back({RowKind::Path, k});
   for (size_t l = 0; l < t.boundary_loops.size(); ++l)
-    if (dropped_loop_[t.vertex_component[t.boundary_loops[l][0]]] != static_cast<int>(l)) loop_rows_.push_back(static_cast<int>(l));
+    if (dropped_loop_[t.vertex_component[t.boundary_loops[l][0]]] != static_cast<int>(l)) rows_.push_back({RowKind::Loop, static_cast<int>(l)});
+  for (int g = 0; g < num_generators(); ++g) rows_.push_back({RowKind::Generator, g});
 
   check_weight_connectivity();
 
   const int m = static_cast<int>(active_edges_.size());
-  const int nC = static_cast<int>(loop_rows_.size() + cycles.generators.size());
+  const int nC = static_cast<int>(rows_.size());
   SparseMatrix Dt(m, num_vertex_rows_), Ct(m, nC);
   {
     std::vector<Triplet> trip;
@@ -372,8 +486,8 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
 ConnectionSolver::~ConnectionSolver() = default;
 
 const DualCycle& ConnectionSolver::cycle_of_row(int r) const {
-  const int nL = static_cast<int>(loop_rows_.size());
-  return r < nL ? cycles_.loops[loop_rows_[r]] : cycles_.generators[r - nL];
+  const Row& row = rows_[r];
+  return row.kind == RowKind::Loop ? cycles_.loops[row.id] : row.kind == RowKind::Generator ? cycles_.generators[row.id] : paths_[row.id].path;
 }
 
 // Every vertex row must reach a boundary vertex or the dropped vertex of its component through edges of
@@ -405,8 +519,18 @@ void ConnectionSolver::check_weight_connectivity() const {
 Connection ConnectionSolver::solve(const IndexPrescription& prescription) const {
   const Topology& t = topology_;
   validate_prescription(t, num_generators(), prescription);
+  if (prescription.fixed.size() != fixed_faces_.size() ||
+      !std::equal(fixed_faces_.begin(), fixed_faces_.end(), prescription.fixed.begin(), [](int f, const auto& kv) { return f == kv.first; }))
+    throw Error("the fixed faces of the prescription (" + std::to_string(prescription.fixed.size()) + ") are not those the solver was set up with (" +
+                std::to_string(fixed_faces_.size()) + "): fixing other faces changes the matrix, set up a new solver");
+  for (auto [f, angle] : prescription.fixed)
+    if (!std::isfinite(angle)) throw Error("fixed angle of face " + std::to_string(f) + " is not finite");
   const int N = prescription.N;
   const double step = 2 * kPi / N;
+  auto path_holonomy = [&](int k) {  // what the x along path k must add up to, before the 2π/N turns
+    const FixedPath& path = paths_[k];
+    return levi_civita_holonomy(path.path, geometry_) - (prescription.fixed.at(path.to_face) - prescription.fixed.at(path.from_face));
+  };
   auto vertex_n = [&](int v) {
     auto it = prescription.vertex.find(v);
     return it == prescription.vertex.end() ? 0 : it->second;
@@ -415,35 +539,35 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   for (int v = 0; v < t.num_vertices; ++v)
     if (vertex_row_[v] >= 0) b_D(vertex_row_[v]) = geometry_.angle_defect(v) - step * vertex_n(v);
 
-  // Cycle rows: holonomy H, and which indices are free. Loops of a component must sum, with its
-  // vertex indices, to χ: the dropped loop takes the remainder. If the dropped loop is prescribed, one
-  // free loop of the component ("pivot") takes the remainder instead.
-  const int nL = static_cast<int>(loop_rows_.size()), nG = num_generators(), nC = nL + nG;
+  // Cycle rows: the holonomy H they must match (their right-hand side is H − (2π/N) n), and which n are
+  // free. Loops of a component must sum, with its vertex indices, to χ: the dropped loop takes the
+  // remainder. If the dropped loop is prescribed, one free loop of the component ("pivot") takes it instead.
+  const int nC = static_cast<int>(rows_.size());
   Eigen::VectorXd H(nC), n0 = Eigen::VectorXd::Zero(nC);
-  std::vector<int> free_rows;
-  std::vector<int> loop_row_of(t.boundary_loops.size(), -1);
-  for (int r = 0; r < nL; ++r) loop_row_of[loop_rows_[r]] = r;
+  std::vector<int> free_rows, loop_row_of(t.boundary_loops.size(), -1);
   std::vector<int> component_vertex_sum(t.components.size(), 0);
   for (auto [v, n] : prescription.vertex) component_vertex_sum[t.vertex_component[v]] += n;
   for (int r = 0; r < nC; ++r) {
-    if (r < nL) {
-      const int l = loop_rows_[r];
-      H(r) = loop_curvature_[l];
-      auto it = prescription.loop.find(l);
-      if (it != prescription.loop.end()) n0(r) = it->second; else free_rows.push_back(r);
-    } else {
-      const int g = r - nL;
-      H(r) = generator_holonomy_[g];
-      auto it = prescription.generator.find(g);
-      if (it != prescription.generator.end()) n0(r) = it->second; else free_rows.push_back(r);
+    const Row& row = rows_[r];
+    const std::map<int, int>* given = nullptr;
+    if (row.kind == RowKind::Loop) {
+      H(r) = loop_curvature_[row.id];
+      loop_row_of[row.id] = r;
+      given = &prescription.loop;
+    } else if (row.kind == RowKind::Generator) {
+      H(r) = generator_holonomy_[row.id];
+      given = &prescription.generator;
+    } else {  // transport from one fixed face to the next must turn γ_from onto γ_to
+      H(r) = path_holonomy(row.id);
     }
+    auto it = given ? given->find(row.id) : prescription.loop.end();
+    if (given && it != given->end()) n0(r) = it->second;
+    else free_rows.push_back(r);
   }
-  // Parametrisation n = n0 + M t over the free rows.
   std::vector<int> pivot_of_component(t.components.size(), -1);
   for (size_t c = 0; c < t.components.size(); ++c) {
     const int dl = dropped_loop_[c];
     if (dl < 0 || !prescription.loop.count(dl)) continue;
-    // The dropped loop is prescribed: the first free loop of the component becomes the pivot.
     int sum = N * t.components[c].euler_characteristic - component_vertex_sum[c] - prescription.loop.at(dl);
     for (int l : t.components[c].boundary_loops) {
       if (l == dl) continue;
@@ -452,25 +576,21 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
     }
     if (pivot_of_component[c] >= 0) n0(pivot_of_component[c]) = sum;
   }
+  // Parametrisation n = n0 + M t of the free rows.
   std::vector<int> params;
-  for (int r : free_rows) {
-    const int c = r < nL ? t.vertex_component[t.boundary_loops[loop_rows_[r]][0]] : cycles_.generators[r - nL].component;
-    if (r < nL && pivot_of_component[c] == r) continue;
-    params.push_back(r);
-  }
+  for (int r : free_rows)
+    if (rows_[r].kind != RowKind::Loop || pivot_of_component[component_of_row(r)] != r) params.push_back(r);
   Eigen::MatrixXd M = Eigen::MatrixXd::Zero(nC, static_cast<Eigen::Index>(params.size()));
   for (size_t k = 0; k < params.size(); ++k) {
     const int r = params[k];
     M(r, k) = 1;
-    if (r < nL) {
-      const int c = t.vertex_component[t.boundary_loops[loop_rows_[r]][0]];
-      if (pivot_of_component[c] >= 0) M(pivot_of_component[c], k) = -1;
-    }
+    if (rows_[r].kind == RowKind::Loop && pivot_of_component[component_of_row(r)] >= 0) M(pivot_of_component[component_of_row(r)], k) = -1;
   }
+  const bool identity = static_cast<int>(params.size()) == nC;
   Eigen::VectorXd n_C = n0;
   const Eigen::VectorXd x_active = engine_->solve(b_D, [&](const Eigen::VectorXd& r0) {
     const Eigen::VectorXd u = (H - r0) / step;
-    n_C += M * nearest_lattice_point(engine_->P, u, n0, M).cast<double>();
+    n_C += M * nearest_lattice_point(*engine_, u, n0, M, identity).cast<double>();
     return Eigen::VectorXd(H - step * n_C);
   });
 
@@ -478,17 +598,29 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   result.N = N;
   result.x.setZero(t.num_edges);
   for (size_t a = 0; a < active_edges_.size(); ++a) result.x(active_edges_[a]) = x_active(a);
-  result.generator_index.resize(nG);
-  result.generator_chosen.resize(nG);
-  for (int g = 0; g < nG; ++g) {
-    result.generator_index[g] = static_cast<int>(std::lround(n_C(nL + g)));
-    result.generator_chosen[g] = !prescription.generator.count(g);
-  }
+  const int nG = num_generators();
+  result.generator_index.assign(nG, 0);
+  result.generator_chosen.assign(nG, 0);
   result.loop_index.assign(t.boundary_loops.size(), 0);
   result.loop_chosen.assign(t.boundary_loops.size(), 0);
-  for (int r = 0; r < nL; ++r) {
-    result.loop_index[loop_rows_[r]] = static_cast<int>(std::lround(n_C(r)));
-    result.loop_chosen[loop_rows_[r]] = !prescription.loop.count(loop_rows_[r]);
+  result.path_turn.assign(paths_.size(), 0);
+  double path_residual = 0;
+  for (int r = 0; r < nC; ++r) {
+    const Row& row = rows_[r];
+    const int n = static_cast<int>(std::lround(n_C(r)));
+    if (row.kind == RowKind::Loop) {
+      result.loop_index[row.id] = n;
+      result.loop_chosen[row.id] = !prescription.loop.count(row.id);
+    } else if (row.kind == RowKind::Generator) {
+      result.generator_index[row.id] = n;
+      result.generator_chosen[row.id] = !prescription.generator.count(row.id);
+    } else {
+      result.path_turn[row.id] = n;
+      const DualCycle& path = paths_[row.id].path;
+      double sum = 0;
+      for (size_t k = 0; k < path.edges.size(); ++k) sum += path.signs[k] * result.x(path.edges[k]);
+      path_residual = std::max(path_residual, std::abs(sum - (H(r) - step * n)));
+    }
   }
   for (size_t c = 0; c < t.components.size(); ++c) {
     const int dl = dropped_loop_[c];
@@ -505,7 +637,14 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   for (int g = 0; g < nG; ++g) used.generator[g] = result.generator_index[g];
   for (size_t l = 0; l < t.boundary_loops.size(); ++l) used.loop[static_cast<int>(l)] = result.loop_index[l];
   verify_connection(t, geometry_, cycles_, used, result);
+  result.max_cycle_residual = std::max(result.max_cycle_residual, path_residual);
   return result;
+}
+
+int ConnectionSolver::component_of_row(int r) const {
+  const Row& row = rows_[r];
+  if (row.kind == RowKind::Loop) return topology_.vertex_component[topology_.boundary_loops[row.id][0]];
+  return row.kind == RowKind::Generator ? cycles_.generators[row.id].component : paths_[row.id].path.component;
 }
 
 void verify_connection(const Topology& t, const Geometry& geometry, const Cycles& cycles, const IndexPrescription& prescription,

@@ -1,9 +1,13 @@
 // trivcon/design.h: the whole pipeline on plain (V, F) — validate, prepare once, then design fields.
 //
-//   trivcon::FieldDesigner designer(V, F);          // topology, geometry, cycles, factorization
+//   trivcon::FieldDesigner designer(V, F);          // topology, geometry, cycles (factorization on first use)
 //   trivcon::IndexPrescription p;  p.N = 4;  p.vertex[12] = 1;  ...
 //   trivcon::Design d = designer.design(p);          // a re-solve: milliseconds
 //   d.field.angle, d.connection.x, d.indices ...
+//
+// Fixed directions (trivcon/constraints.h): call set_fixed_faces() with the faces once (it refactors), then
+// give their angles in each prescription's `fixed` map; each component with fixed faces starts its field
+// at its smallest fixed face, with that face's angle.
 //
 // Every design is verified: the largest holonomy residual over all vertex, loop and generator cycles,
 // the field's mismatch with the connection across every dual edge, and the indices read back from the
@@ -13,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "trivcon/constraints.h"
 #include "trivcon/cycles.h"
 #include "trivcon/field.h"
 #include "trivcon/geometry.h"
@@ -28,6 +33,10 @@ struct Design {
   double transport_mismatch = 0;         // max over dual edges, radians (mod 2π/N)
   std::vector<int> index_mismatch_vertices;  // interior vertices whose field index differs from the prescription
   int large_turn_edges = 0;              // edges with |x_e| ≥ π/N (where a field cannot show the index)
+  // Mismatches at vertices none of whose edges turns by π/N or more (less 1e-9): these would be real errors.
+  std::vector<int> unexplained_mismatch_vertices;
+  double max_fixed_error = 0;            // largest |field − fixed direction| modulo 2π/N over fixed faces
+  std::vector<FixedConflict> conflicts;  // adjacent fixed faces the field must turn sharply between
   double solve_seconds = 0, field_seconds = 0, verify_seconds = 0;
 };
 
@@ -39,6 +48,8 @@ class FieldDesigner {
  public:
   // Validates (finite coordinates, manifold, orientable) and prepares; throws trivcon::Error.
   FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptions options = {});
+  // Sets the faces whose direction prescriptions fix, and sets up (factors) the solver for them.
+  void set_fixed_faces(const std::vector<int>& faces);
 
   Design design(const IndexPrescription& prescription, const std::vector<std::pair<int, double>>& roots = {}) const;
 
@@ -46,7 +57,7 @@ class FieldDesigner {
   const Topology& topology() const { return topology_; }
   const Geometry& geometry() const { return geometry_; }
   const Cycles& cycles() const { return cycles_; }
-  const ConnectionSolver& solver() const { return *solver_; }
+  const ConnectionSolver& solver() const;  // set up on first use
   const PrepareTimings& timings() const { return timings_; }
 
  private:
@@ -54,8 +65,10 @@ class FieldDesigner {
   Topology topology_;
   Geometry geometry_;
   Cycles cycles_;
-  std::unique_ptr<ConnectionSolver> solver_;
-  PrepareTimings timings_;
+  SolverOptions options_;
+  mutable std::unique_ptr<ConnectionSolver> solver_;
+  mutable PrepareTimings timings_;
+  std::vector<int> fixed_faces_;
 };
 
 }  // namespace trivcon

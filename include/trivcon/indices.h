@@ -26,6 +26,8 @@ struct IndexPrescription {
   std::map<int, int> vertex;     // vertex id → n (index n/N); absent: 0
   std::map<int, int> generator;  // generator id → n; absent: chosen to make the field smoothest
   std::map<int, int> loop;       // boundary loop id → n; absent: chosen to make the field smoothest
+  std::map<int, double> fixed;   // face → direction (angle in the face's frame) the field must have there,
+                                 // modulo 2π/N (trivcon/constraints.h)
 };
 
 // Parses an index "3", "-1", "1/4", "-3/2" into units of 1/N; throws naming `where` when it is not

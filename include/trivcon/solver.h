@@ -6,7 +6,9 @@
 //   interior vertex v:      Σ_e s_ve x_e = K_v − 2π k_v      (s_ve = +1 if v is e's larger id, else −1)
 //   boundary loop ℓ:        Σ_e c_e x_e  = K_ℓ − 2π k_ℓ      (c: the loop cycle, K_ℓ its loop_curvature)
 //   generator γ:            Σ_e c_e x_e  = z_γ − 2π k_γ      (z_γ = levi_civita_holonomy)
-// Objective: minimise Σ x_e² / w_e (w = cotan or unit weights); an edge with w_e = 0 gets x_e = 0.
+// Objective: minimise Σ x_e² / w_e (w = cotan or unit weights); an edge with w_e = 0 gets x_e = 0, except
+// the edges of a cycle or fixed-face path that has no edge of positive weight: those get 1e-6 × the
+// median positive weight, so the field can still turn there when nothing else can (regularized_edges()).
 //
 // Default route (SolverKind::Cholesky): x = W Aᵀ y with (A W Aᵀ) y = b, where A = [D; C] holds the
 // interior-vertex rows D and the cycle rows C (loops, generators). D W Dᵀ is the cotan Laplacian on
@@ -28,6 +30,7 @@
 #include <memory>
 #include <vector>
 
+#include "trivcon/constraints.h"
 #include "trivcon/cycles.h"
 #include "trivcon/geometry.h"
 #include "trivcon/indices.h"
@@ -50,6 +53,7 @@ struct Connection {
   std::vector<int> loop_index;         // n per boundary loop, as used
   std::vector<char> generator_chosen;  // 1 where the solver chose the index
   std::vector<char> loop_chosen;
+  std::vector<int> path_turn;          // per fixed-face path, the whole number j of 1/N turns chosen
   double energy = 0;                   // Σ x_e² / w_e
   // Verification: largest |Σ coefficient · x − right-hand side| over all interior vertices (including
   // the dropped ones), all loops and all generators, and the scale of the right-hand sides.
@@ -65,7 +69,10 @@ class ConnectionSolver {
   // Builds and factors everything that does not depend on the prescription. Throws trivcon::Error if
   // the weights leave part of the surface unable to carry curvature (a vertex or a region joined to the
   // rest only by zero-weight edges) or if a factorization fails.
-  ConnectionSolver(const Topology& topology, const Geometry& geometry, const Cycles& cycles, SolverOptions options = {});
+  // `fixed_faces`: faces whose direction each prescription fixes (trivcon/constraints.h); they change the
+  // matrix, their angles only the right-hand side.
+  ConnectionSolver(const Topology& topology, const Geometry& geometry, const Cycles& cycles, SolverOptions options = {},
+                   const std::vector<int>& fixed_faces = {});
   ~ConnectionSolver();
   ConnectionSolver(const ConnectionSolver&) = delete;
   ConnectionSolver& operator=(const ConnectionSolver&) = delete;
@@ -79,6 +86,10 @@ class ConnectionSolver {
   // Levi-Civita holonomy the constraints use: K_ℓ per loop, z_γ per generator.
   const std::vector<double>& loop_curvatures() const { return loop_curvature_; }
   const std::vector<double>& generator_holonomies() const { return generator_holonomy_; }
+  const std::vector<int>& fixed_faces() const { return fixed_faces_; }
+  // Zero-weight edges given a small weight because a cycle or fixed-face path had no other edge.
+  int regularized_edges() const { return regularized_edges_; }
+  const std::vector<FixedPath>& fixed_paths() const { return paths_; }
 
   struct Engine;  // the factorization (Cholesky + Schur, or QR)
 
@@ -98,8 +109,17 @@ class ConnectionSolver {
   std::vector<int> vertex_row_;                  // row of each vertex, −1 if none
   int num_vertex_rows_ = 0;
   std::vector<int> dropped_vertex_, dropped_loop_;  // per component, −1 if none
-  std::vector<int> loop_rows_;                   // loop id of each loop row
+  enum class RowKind { Loop, Generator, Path };
+  struct Row {
+    RowKind kind;
+    int id;  // loop, generator or path id
+  };
+  std::vector<Row> rows_;                        // the cycle rows C
+  std::vector<int> fixed_faces_;
+  std::vector<FixedPath> paths_;
+  int regularized_edges_ = 0;
   const DualCycle& cycle_of_row(int r) const;
+  int component_of_row(int r) const;
   void check_weight_connectivity() const;
 };
 

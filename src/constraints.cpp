@@ -1,0 +1,182 @@
+#include "trivcon/constraints.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "trivcon/error.h"
+#include "trivcon/field.h"
+#include "trivcon/io.h"
+
+namespace trivcon {
+
+std::vector<FixedPath> fixed_face_paths(const Topology& t, const std::vector<int>& fixed, const std::vector<char>& usable) {
+  const int nF = t.num_faces;
+  std::vector<int> region(nF, -1), parent_edge(nF, -1), parent_face(nF, -1), depth(nF, 0);
+  std::vector<int> queue;
+  queue.reserve(nF);
+  for (size_t i = 0; i < fixed.size(); ++i) {
+    region[fixed[i]] = static_cast<int>(i);
+    queue.push_back(fixed[i]);
+  }
+  for (size_t q = 0; q < queue.size(); ++q) {  // multi-source breadth-first growth
+    const int f = queue[q];
+    for (int k = 0; k < 3; ++k) {
+      const int e = t.face_edges(f, k);
+      if (t.is_boundary_edge(e) || !usable[e]) continue;
+      const int g = t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
+      if (region[g] >= 0) continue;
+      region[g] = region[f], parent_edge[g] = e, parent_face[g] = f, depth[g] = depth[f] + 1;
+      queue.push_back(g);
+    }
+  }
+  // Links between regions: interior edges whose faces lie in different regions, shortest first.
+  struct Link {
+    int rigid, length, edge;  // rigid: across an unusable edge (only when nothing else links two regions)
+  };
+  std::vector<Link> links;
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    if (region[L] >= 0 && region[R] >= 0 && region[L] != region[R]) links.push_back({usable[e] ? 0 : 1, depth[L] + depth[R] + 1, e});
+  }
+  std::sort(links.begin(), links.end(), [](const Link& a, const Link& b) {
+    return std::tie(a.rigid, a.length, a.edge) < std::tie(b.rigid, b.length, b.edge);
+  });
+  std::vector<int> set(fixed.size());
+  std::iota(set.begin(), set.end(), 0);
+  auto find = [&](int a) {
+    while (set[a] != a) a = set[a] = set[set[a]];
+    return a;
+  };
+  std::vector<FixedPath> paths;
+  for (const Link& link : links) {
+    const int e = link.edge, L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    const int a = find(region[L]), b = find(region[R]);
+    if (a == b) continue;
+    set[std::max(a, b)] = std::min(a, b);
+    FixedPath p;
+    p.from_face = fixed[region[L]];
+    p.to_face = fixed[region[R]];
+    p.path.component = t.face_component[L];
+    // From the fixed face down to L: collect L's ancestry, then walk it from the top.
+    std::vector<int> up;
+    for (int f = L; parent_face[f] >= 0; f = parent_face[f]) up.push_back(f);
+    for (auto it = up.rbegin(); it != up.rend(); ++it) {
+      const int edge = parent_edge[*it];
+      p.path.edges.push_back(edge);
+      p.path.signs.push_back(t.edge_faces(edge, 0) == parent_face[*it] ? 1 : -1);  // parent → child
+    }
+    p.path.edges.push_back(e);
+    p.path.signs.push_back(1);  // L → R
+    for (int f = R; parent_face[f] >= 0; f = parent_face[f]) {
+      const int edge = parent_edge[f];
+      p.path.edges.push_back(edge);
+      p.path.signs.push_back(t.edge_faces(edge, 0) == f ? 1 : -1);  // child → parent
+    }
+    paths.push_back(std::move(p));
+  }
+  return paths;
+}
+
+double fixed_angle_from_direction(const Geometry& g, int face, const Eigen::Vector3d& d) {
+  if (!d.allFinite()) throw Error("fixed direction of face " + std::to_string(face) + " is not finite");
+  if (d.squaredNorm() == 0) throw Error("fixed direction of face " + std::to_string(face) + " is zero");
+  const double along = std::hypot(d.dot(g.frame_x.row(face)), d.dot(g.frame_y.row(face)));
+  if (!(along > 1e-9 * d.norm()))
+    throw Error("fixed direction of face " + std::to_string(face) + " is perpendicular to the face: nothing is left after projection");
+  return g.angle_in_face(face, d);
+}
+
+namespace {
+
+int parse_face(const std::string& text, const Topology& t, const std::string& where) {
+  char* end = nullptr;
+  const long long f = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0') throw Error(where + ": malformed face id '" + text + "'");
+  if (f < 0 || f >= t.num_faces)
+    throw Error(where + ": face " + text + " out of range (mesh has " + std::to_string(t.num_faces) + " faces)");
+  return static_cast<int>(f);
+}
+
+double parse_number(const std::string& text, const std::string& where) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0') throw Error(where + ": malformed number '" + text + "'");
+  if (!std::isfinite(v)) throw Error(where + ": number '" + text + "' is not finite");
+  return v;
+}
+
+// "angle=A" or three numbers → angle in the face's frame.
+double parse_direction(const std::vector<std::string>& fields, int face, const Geometry& g, const std::string& where) {
+  if (fields.size() == 1 && fields[0].rfind("angle=", 0) == 0) return parse_number(fields[0].substr(6), where);
+  if (fields.size() != 3) throw Error(where + ": expected 'x y z' or 'angle=A' after the face id");
+  const Eigen::Vector3d d(parse_number(fields[0], where), parse_number(fields[1], where), parse_number(fields[2], where));
+  try {
+    return fixed_angle_from_direction(g, face, d);
+  } catch (const Error& e) {
+    throw Error(where + ": " + e.what());
+  }
+}
+
+void insert_fixed(std::map<int, double>& fixed, int face, double angle, const std::string& where) {
+  if (!fixed.emplace(face, angle).second) throw Error(where + ": face " + std::to_string(face) + " is fixed twice");
+}
+
+}  // namespace
+
+void read_fixed_directions(const std::string& path, const Topology& t, const Geometry& g, std::map<int, double>& fixed) {
+  std::istringstream in(read_file_bytes(path));
+  std::string line;
+  for (int line_no = 1; std::getline(in, line); ++line_no) {
+    const std::string where = path + ":" + std::to_string(line_no);
+    std::istringstream fields(line.substr(0, line.find('#')));
+    std::vector<std::string> tokens;
+    for (std::string tok; fields >> tok;) tokens.push_back(tok);
+    if (tokens.empty()) continue;
+    const int face = parse_face(tokens[0], t, where);
+    insert_fixed(fixed, face, parse_direction({tokens.begin() + 1, tokens.end()}, face, g, where), where);
+  }
+}
+
+void add_fixed_direction(const std::string& spec, const Topology& t, const Geometry& g, std::map<int, double>& fixed) {
+  const std::string where = "--fix " + spec;
+  const size_t colon = spec.find(':');
+  if (colon == std::string::npos) throw Error(where + ": expected F:x,y,z or F:angle=A");
+  const int face = parse_face(spec.substr(0, colon), t, where);
+  std::vector<std::string> tokens;
+  std::istringstream rest(spec.substr(colon + 1));
+  for (std::string tok; std::getline(rest, tok, ',');) tokens.push_back(tok);
+  insert_fixed(fixed, face, parse_direction(tokens, face, g, where), where);
+}
+
+std::map<int, double> boundary_alignment(const MatrixX3d& V, const Topology& t, const Geometry& g) {
+  std::map<int, double> fixed;
+  for (int f = 0; f < t.num_faces; ++f) {
+    double longest = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (!t.is_boundary_edge(t.face_edges(f, k))) continue;
+      // f's boundary half-edge runs corner k → k+1, the direction of its boundary loop.
+      const double length = (V.row(t.F(f, (k + 1) % 3)) - V.row(t.F(f, k))).squaredNorm();
+      if (length > longest) longest = length, fixed[f] = g.half_edge_angle(f, k);
+    }
+  }
+  return fixed;
+}
+
+std::vector<FixedConflict> fixed_conflicts(const Topology& t, const Geometry& g, const std::map<int, double>& fixed, int N) {
+  std::vector<FixedConflict> out;
+  const double limit = 3.14159265358979323846 / (2 * N);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    auto a = fixed.find(L), b = fixed.find(R);
+    if (a == fixed.end() || b == fixed.end()) continue;
+    const double turn = reduce_angle(b->second - a->second - g.rho(e), N);
+    if (std::abs(turn) > limit) out.push_back({L, R, turn});
+  }
+  return out;
+}
+
+}  // namespace trivcon

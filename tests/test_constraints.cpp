@@ -1,0 +1,259 @@
+// Fixed directions (paper Section 2.8) and boundary alignment: exact at the fixed faces, still exactly the
+// prescribed singularities, optimal, and as fast to edit as without constraints.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "support.h"
+#include "trivcon/constraints.h"
+#include "trivcon/design.h"
+#include "trivcon/error.h"
+#include "trivcon/generate.h"
+
+using namespace trivcon;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::vector<int> keys(const std::map<int, double>& m) {
+  std::vector<int> k;
+  for (auto [f, a] : m) k.push_back(f);
+  return k;
+}
+
+// Constraint rows, fixed faces, index read-back.
+void expect_exact(const FieldDesigner& d, const Design& r, const IndexPrescription& p, bool indices_from_field = true) {
+  const double scale = std::max(1.0, r.connection.rhs_scale);
+  EXPECT_LE(r.connection.max_vertex_residual, 1e-9 * scale);
+  EXPECT_LE(r.connection.max_cycle_residual, 1e-9 * scale);
+  EXPECT_LE(r.transport_mismatch, 1e-9 * scale);
+  EXPECT_LE(r.max_fixed_error, 1e-9);
+  for (auto [f, angle] : p.fixed) ASSERT_LE(std::abs(reduce_angle(r.field.angle(f) - angle, p.N)), 1e-9) << "face " << f;
+  EXPECT_TRUE(r.unexplained_mismatch_vertices.empty());
+  if (indices_from_field) {
+    for (int v = 0; v < d.topology().num_vertices; ++v) {
+      if (!d.topology().is_interior_vertex(v)) continue;
+      ASSERT_EQ(r.indices.vertex[v], p.vertex.count(v) ? p.vertex.at(v) : 0) << "vertex " << v;
+    }
+  }
+}
+
+// x is W-orthogonal to every exact dual 1-form vanishing on the constrained paths: the face sums vanish
+// at every face that is not fixed (whose edges are all interior with positive weight).
+double max_free_face_optimality(const FieldDesigner& d, const Design& r, const std::map<int, double>& fixed) {
+  const Topology& t = d.topology();
+  const Eigen::VectorXd& w = d.solver().weights();
+  double worst = 0, scale = 1;
+  for (int e = 0; e < t.num_edges; ++e)
+    if (w(e) > 0) scale = std::max(scale, std::abs(r.connection.x(e) / w(e)));
+  for (int f = 0; f < t.num_faces; ++f) {
+    if (fixed.count(f)) continue;
+    double sum = 0;
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) {
+      const int e = t.face_edges(f, k);
+      if (t.is_boundary_edge(e) || !(w(e) > 0)) {
+        ok = false;
+      } else {
+        sum += (t.edge_faces(e, 0) == f ? 1 : -1) * r.connection.x(e) / w(e);
+      }
+    }
+    if (ok) worst = std::max(worst, std::abs(sum));
+  }
+  return worst / scale;
+}
+
+}  // namespace
+
+TEST(Constraints, AlignBoundaryDiskAnnulusHoles) {
+  struct Case {
+    std::string name;
+    Mesh mesh;
+    int N;
+    std::map<int, int> vertex;  // singularities for the boundary-tangent field
+    WeightKind weights;
+  };
+  const Mesh disk = make_disk(16, 16), annulus = make_annulus(10, 60), holes = make_holed_grid(40, 2);
+  std::vector<Case> cases;
+  for (int N : {1, 2, 4}) {
+    cases.push_back({"disk", disk, N, {{0, N}}, WeightKind::Cotan});  // a tangent field on a disk: +1 at the centre
+    cases.push_back({"annulus", annulus, N, {}, WeightKind::Cotan});   // concentric: no singularity
+  }
+  // A square with two square holes: the tangent cross field needs no singularity.
+  cases.push_back({"holes", holes, 4, {}, WeightKind::Cotan});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name + " N=" + std::to_string(c.N));
+    FieldDesigner d(c.mesh.V, c.mesh.F, SolverOptions{c.weights, SolverKind::Cholesky});
+    IndexPrescription p;
+    p.N = c.N;
+    p.vertex = c.vertex;
+    p.fixed = boundary_alignment(c.mesh.V, d.topology(), d.geometry());
+    int boundary_faces = 0;
+    for (int f = 0; f < d.topology().num_faces; ++f)
+      for (int k = 0; k < 3; ++k)
+        if (d.topology().is_boundary_edge(d.topology().face_edges(f, k))) {
+          ++boundary_faces;
+          break;
+        }
+    EXPECT_EQ(static_cast<int>(p.fixed.size()), boundary_faces);
+    d.set_fixed_faces(keys(p.fixed));
+    const Design r = d.design(p);
+    expect_exact(d, r, p);
+    EXPECT_LE(max_free_face_optimality(d, r, p.fixed), 1e-9);
+    // The field runs along the boundary: at a face with one boundary edge, one of its N directions is that edge.
+    const Topology& t = d.topology();
+    for (auto [f, angle] : p.fixed) {
+      for (int k = 0; k < 3; ++k) {
+        if (!t.is_boundary_edge(t.face_edges(f, k))) continue;
+        const Eigen::Vector3d edge = (c.mesh.V.row(t.F(f, (k + 1) % 3)) - c.mesh.V.row(t.F(f, k))).normalized();
+        const Eigen::Vector3d dir = d.geometry().direction_in_face(f, r.field.angle(f));
+        const double a = std::atan2(edge.cross(dir).dot(d.geometry().normal.row(f)), edge.dot(dir));
+        EXPECT_LE(std::abs(reduce_angle(a, c.N)), 1e-9) << "face " << f;
+        break;
+      }
+    }
+  }
+}
+
+// The QR route agrees, with constraints too.
+TEST(Constraints, QrRouteAgrees) {
+  const Mesh m = make_annulus(8, 40);
+  FieldDesigner chol(m.V, m.F), qr(m.V, m.F, SolverOptions{WeightKind::Cotan, SolverKind::QR});
+  IndexPrescription p;
+  p.N = 4;
+  p.fixed = boundary_alignment(m.V, chol.topology(), chol.geometry());
+  p.fixed[100] = 0.3;  // and one interior face
+  chol.set_fixed_faces(keys(p.fixed));
+  qr.set_fixed_faces(keys(p.fixed));
+  const Design a = chol.design(p), b = qr.design(p);
+  expect_exact(qr, b, p, false);
+  EXPECT_EQ(a.connection.path_turn, b.connection.path_turn);
+  EXPECT_LE((a.connection.x - b.connection.x).cwiseAbs().maxCoeff(), 1e-8 * std::max(1.0, a.connection.x.cwiseAbs().maxCoeff()));
+}
+
+// Fixing faces to the directions the unconstrained field already has changes nothing; fixing them to
+// other directions never lowers the energy.
+TEST(Constraints, FixingTheFieldsOwnDirectionsChangesNothing) {
+  for (const Mesh& m : {make_icosphere(3), make_torus(40, 20), make_disk(12, 6)}) {
+    FieldDesigner free_designer(m.V, m.F);
+    IndexPrescription p;
+    p.N = 4;
+    if (free_designer.topology().boundary_loops.empty() && free_designer.topology().euler_characteristic() == 2)
+      for (int v : {0, 1, 2, 3, 4, 5, 6, 7}) p.vertex[v] = 1;
+    const Design free_design = free_designer.design(p);
+    IndexPrescription q = p;
+    for (int f = 0; f < free_designer.topology().num_faces; f += 37) q.fixed[f] = free_design.field.angle(f) + kPi / 2 * (f % 3);
+    FieldDesigner fixed_designer(m.V, m.F);
+    fixed_designer.set_fixed_faces(keys(q.fixed));
+    const Design same = fixed_designer.design(q);
+    expect_exact(fixed_designer, same, q, false);
+    EXPECT_NEAR(same.connection.energy, free_design.connection.energy, 1e-9 * std::max(1.0, free_design.connection.energy));
+    EXPECT_LE((same.connection.x - free_design.connection.x).cwiseAbs().maxCoeff(), 1e-8);
+    for (auto& [f, angle] : q.fixed) angle += 0.4 * std::sin(f);
+    const Design other = fixed_designer.design(q);
+    expect_exact(fixed_designer, other, q, false);
+    EXPECT_GE(other.connection.energy, free_design.connection.energy - 1e-9);
+  }
+}
+
+// Singularities only change the right-hand side: editing them after fixing faces reuses the factorization.
+TEST(Constraints, EditingSingularitiesKeepsTheSetup) {
+  const Mesh m = make_icosphere(4);
+  FieldDesigner d(m.V, m.F);
+  IndexPrescription p;
+  p.N = 1;
+  for (int f = 0; f < d.topology().num_faces; f += 101) p.fixed[f] = 0.1 * f;
+  d.set_fixed_faces(keys(p.fixed));
+  const ConnectionSolver* solver = &d.solver();
+  for (int edit = 0; edit < 5; ++edit) {
+    p.vertex = {{edit * 7, 1}, {edit * 13 + 100, 1}};
+    const Design r = d.design(p);
+    expect_exact(d, r, p);
+    EXPECT_EQ(&d.solver(), solver);
+    EXPECT_LE(max_free_face_optimality(d, r, p.fixed), 1e-9);
+  }
+}
+
+TEST(Constraints, InvariantUnderRenumbering) {
+  const Mesh m = make_annulus(8, 40);
+  std::vector<int> vperm, fperm;
+  const Mesh m2 = permute(m, 3, &vperm, &fperm);
+  FieldDesigner d1(m.V, m.F), d2(m2.V, m2.F);
+  IndexPrescription p1, p2;
+  p1.N = p2.N = 2;
+  p1.fixed = boundary_alignment(m.V, d1.topology(), d1.geometry());
+  p2.fixed = boundary_alignment(m2.V, d2.topology(), d2.geometry());
+  ASSERT_EQ(p1.fixed.size(), p2.fixed.size());
+  for (auto [f, a] : p1.fixed) EXPECT_TRUE(p2.fixed.count(fperm[f]));
+  d1.set_fixed_faces(keys(p1.fixed));
+  d2.set_fixed_faces(keys(p2.fixed));
+  const Design r1 = d1.design(p1), r2 = d2.design(p2);
+  expect_exact(d2, r2, p2);
+  EXPECT_NEAR(r1.connection.energy, r2.connection.energy, 1e-8 * std::max(1.0, r1.connection.energy));
+}
+
+TEST(Constraints, ConflictsBetweenAdjacentFixedFacesAreReported) {
+  const Mesh m = make_disk(10, 6);
+  FieldDesigner d(m.V, m.F);
+  const Topology& t = d.topology();
+  int e = 0;
+  while (t.is_boundary_edge(e)) ++e;
+  const int a = t.edge_faces(e, 0), b = t.edge_faces(e, 1);
+  IndexPrescription p;
+  p.N = 4;
+  p.fixed[a] = 0.0;
+  p.fixed[b] = d.geometry().rho(e) + kPi / 4;  // 45° off after transport: as far as a cross field can be
+  d.set_fixed_faces(keys(p.fixed));
+  const Design r = d.design(p);
+  expect_exact(d, r, p, false);
+  ASSERT_EQ(r.conflicts.size(), 1u);
+  EXPECT_EQ(r.conflicts[0].face_a, a);
+  EXPECT_EQ(r.conflicts[0].face_b, b);
+  EXPECT_NEAR(std::abs(r.conflicts[0].turn), kPi / 4, 1e-9);
+}
+
+TEST(Constraints, Errors) {
+  const Mesh m = make_disk(4, 6);
+  FieldDesigner d(m.V, m.F);
+  std::map<int, double> fixed;
+  auto message = [&](const std::string& spec) {
+    try {
+      add_fixed_direction(spec, d.topology(), d.geometry(), fixed);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message("1000:1,0,0"), "--fix 1000:1,0,0: face 1000 out of range (mesh has " + std::to_string(m.F.rows()) + " faces)");
+  EXPECT_EQ(message("3:0,0,0"), "--fix 3:0,0,0: fixed direction of face 3 is zero");
+  EXPECT_EQ(message("3:0,0,1"), "--fix 3:0,0,1: fixed direction of face 3 is perpendicular to the face: nothing is left after projection");
+  EXPECT_EQ(message("3:nan,0,1"), "--fix 3:nan,0,1: number 'nan' is not finite");
+  EXPECT_EQ(message("3:1,0"), "--fix 3:1,0: expected 'x y z' or 'angle=A' after the face id");
+  EXPECT_EQ(message("3:angle=0.5"), "no error");
+  EXPECT_NEAR(fixed.at(3), 0.5, 1e-15);
+  EXPECT_EQ(message("3:1,0,0"), "--fix 3:1,0,0: face 3 is fixed twice");
+  // A prescription whose fixed faces differ from the set-up.
+  IndexPrescription p;
+  p.N = 4;
+  p.fixed[5] = 0;
+  try {
+    d.design(p);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "the fixed faces of the prescription (1) are not those the solver was set up with (0): fixing other faces changes the "
+                           "matrix, set up a new solver");
+  }
+}
+
+// World directions are projected onto the face.
+TEST(Constraints, DirectionProjection) {
+  const Mesh m = make_icosphere(2);
+  FieldDesigner d(m.V, m.F);
+  const Geometry& g = d.geometry();
+  for (int f : {0, 17, 200}) {
+    const Eigen::Vector3d in_plane = g.direction_in_face(f, 1.1);
+    EXPECT_NEAR(fixed_angle_from_direction(g, f, in_plane + 5.0 * g.normal.row(f).transpose()), 1.1, 1e-12);
+  }
+}
