@@ -1,5 +1,8 @@
 // trivcon solve MESH [options]   and   trivcon check MESH FIELD [options]
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
+#include <sstream>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -51,6 +54,7 @@ struct SolveOptions {
   std::vector<double> root_angles;
   std::vector<std::string> fixes;
   bool align_boundary = false;
+  std::string sing_batch;
   std::string field_out, connection_out, lines_out, report;
   bool quiet = false;
 };
@@ -67,49 +71,105 @@ std::string fmt(double v) {
   return s.str();
 }
 
-void run_solve(const SolveOptions& o) {
-  nlohmann::ordered_json report;
-  auto t0 = Clock::now();
-  const MeshData mesh = load_mesh(o.mesh);
-  const double read_seconds = seconds_since(t0);
-  const IndexPrescription prescription = o.prescription.build();
-  if (o.root_angles.size() > o.root_faces.size()) throw Error("--root-angle given without a matching --root-face");
-  std::vector<std::pair<int, double>> roots;
-  for (size_t i = 0; i < o.root_faces.size(); ++i) roots.emplace_back(o.root_faces[i], i < o.root_angles.size() ? o.root_angles[i] : 0.0);
+// Output paths for one prescription of a batch: "{name}" in a path is replaced by the item's name;
+// without it, ".NAME" goes before the extension (field.txt → field.NAME.txt). Single solves keep paths.
+std::string output_path(const std::string& path, const std::string& name) {
+  if (path.empty() || name.empty()) return path;
+  const size_t brace = path.find("{name}");
+  if (brace != std::string::npos) return path.substr(0, brace) + name + path.substr(brace + 6);
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return path + "." + name;
+  return path.substr(0, dot) + "." + name + path.substr(dot);
+}
 
-  SolverOptions options;
-  options.weights = o.weights == "unit" ? WeightKind::Unit : WeightKind::Cotan;
-  options.solver = o.solver == "qr" ? SolverKind::QR : SolverKind::Cholesky;
-  FieldDesigner designer(mesh.V, mesh.F, options);
-  IndexPrescription with_fixed = prescription;
-  if (o.align_boundary) with_fixed.fixed = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
-  std::map<int, double> explicit_fixed;  // --fix wins over --align-boundary on the same face
-  for (const auto& f : o.fixes) {
-    if (is_fix_spec(f)) add_fixed_direction(f, designer.topology(), designer.geometry(), explicit_fixed);
-    else read_fixed_directions(f, designer.topology(), designer.geometry(), explicit_fixed);
+struct BatchItem {
+  std::string name;
+  IndexPrescription prescription;
+};
+
+// --sing-batch: a directory of singularity files (sorted by name; each named by its file name without
+// extension), or a JSON-lines file: one object per line, {"name": "a", "sing": {"12": "1/4", ...},
+// "generator": {"0": "1"}, "boundary": {"1": "0"}} ("generator"/"boundary" optional). Each item's
+// prescription starts from the command line's (-N, --generator, --boundary); its singularities replace
+// those of -s/--sing.
+std::vector<BatchItem> read_batch(const std::string& path, const IndexPrescription& base) {
+  std::vector<BatchItem> items;
+  namespace fs = std::filesystem;
+  if (fs::is_directory(path)) {
+    std::vector<fs::path> files;
+    for (const auto& entry : fs::directory_iterator(path))
+      if (entry.is_regular_file()) files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    for (const fs::path& f : files) {
+      BatchItem item{f.stem().string(), base};
+      item.prescription.vertex.clear();
+      read_singularities(f.string(), item.prescription);
+      items.push_back(std::move(item));
+    }
+    if (items.empty()) throw Error("--sing-batch " + path + ": the directory has no files");
+    return items;
   }
-  for (auto [f, angle] : explicit_fixed) with_fixed.fixed[f] = angle;
-  if (!with_fixed.fixed.empty()) {
-    std::vector<int> faces;
-    for (auto [f, angle] : with_fixed.fixed) faces.push_back(f);
-    designer.set_fixed_faces(faces);
+  std::istringstream in(read_file_bytes(path));
+  std::string line;
+  for (int line_no = 1; std::getline(in, line); ++line_no) {
+    const std::string where = path + ":" + std::to_string(line_no);
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(line);
+    } catch (const nlohmann::json::exception& e) {
+      throw Error(where + ": not a JSON object (" + std::string(e.what()) + ")");
+    }
+    if (!j.is_object() || !j.contains("name") || !j["name"].is_string() || !j.contains("sing") || !j["sing"].is_object())
+      throw Error(where + ": expected {\"name\": \"...\", \"sing\": {\"VERTEX\": \"INDEX\", ...}}");
+    BatchItem item{j["name"].get<std::string>(), base};
+    if (item.name.empty() || item.name.find('/') != std::string::npos) throw Error(where + ": the name must be non-empty without '/'");
+    item.prescription.vertex.clear();
+    auto add = [&](const char* key, void (*adder)(const std::string&, IndexPrescription&)) {
+      if (!j.contains(key)) return;
+      if (!j[key].is_object()) throw Error(where + ": \"" + key + "\" must be an object");
+      for (const auto& [id, index] : j[key].items()) {
+        const std::string value = index.is_string() ? index.get<std::string>() : index.dump();
+        try {
+          adder(id + ":" + value, item.prescription);
+        } catch (const Error& e) {
+          throw Error(where + ": " + e.what());
+        }
+      }
+    };
+    add("sing", add_vertex_index);
+    add("generator", add_generator_index);
+    add("boundary", add_loop_index);
+    items.push_back(std::move(item));
   }
-  const Design d = designer.design(with_fixed, roots);
+  if (items.empty()) throw Error("--sing-batch " + path + ": no items");
+  return items;
+}
+
+// Solves one prescription on the prepared designer, writes its outputs, prints its summary; returns
+// whether verification passed.
+bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& designer, const IndexPrescription& prescription,
+               const std::vector<std::pair<int, double>>& roots, const std::string& name, double read_seconds) {
+  const Design d = designer.design(prescription, roots);
   const Topology& t = designer.topology();
   const Connection& c = d.connection;
 
-  // Verification: constraint residuals relative to the right-hand sides, transport, indices.
+  // Verification: constraint residuals relative to the right-hand sides, transport, fixed faces, indices.
   const double tolerance = 1e-9 * std::max(1.0, c.rhs_scale);
   const double residual = std::max(c.max_vertex_residual, c.max_cycle_residual);
   const std::vector<int>& unexplained = d.unexplained_mismatch_vertices;
+  const bool ok = residual <= tolerance && d.transport_mismatch <= tolerance && d.max_fixed_error <= tolerance && unexplained.empty();
 
   auto t1 = Clock::now();
-  if (!o.field_out.empty()) write_field(o.field_out, mesh.V, mesh.F, designer.geometry(), d.field);
-  if (!o.connection_out.empty()) write_connection(o.connection_out, t, c.x, prescription.N);
-  if (!o.lines_out.empty()) write_field_lines(o.lines_out, mesh.V, mesh.F, designer.geometry(), d.field);
+  if (!o.field_out.empty()) write_field(output_path(o.field_out, name), mesh.V, mesh.F, designer.geometry(), d.field);
+  if (!o.connection_out.empty()) write_connection(output_path(o.connection_out, name), t, c.x, prescription.N);
+  if (!o.lines_out.empty()) write_field_lines(output_path(o.lines_out, name), mesh.V, mesh.F, designer.geometry(), d.field);
   const double write_seconds = seconds_since(t1);
 
+  nlohmann::ordered_json report;
   report["mesh"] = mesh_summary(o.mesh, mesh, t, designer.geometry());
+  if (!name.empty()) report["name"] = name;
   report["N"] = prescription.N;
   report["weights"] = o.weights;
   report["solver"] = o.solver;
@@ -129,9 +189,10 @@ void run_solve(const SolveOptions& o) {
   report["boundary_loops"] = loops;
   nlohmann::ordered_json conflicts = nlohmann::ordered_json::array();
   for (const FixedConflict& k : d.conflicts) conflicts.push_back({{"face_a", k.face_a}, {"face_b", k.face_b}, {"turn", k.turn}});
-  report["fixed"] = {{"faces", with_fixed.fixed.size()},
+  report["fixed"] = {{"faces", prescription.fixed.size()},
                      {"align_boundary", o.align_boundary},
                      {"paths", designer.solver().fixed_paths().size()},
+                     {"regularized_edges", designer.solver().regularized_edges()},
                      {"max_error", d.max_fixed_error},
                      {"conflicts", conflicts}};
   report["energy"] = c.energy;
@@ -151,18 +212,17 @@ void run_solve(const SolveOptions& o) {
                        {"cycles", pt.cycles},      {"setup", pt.setup},           {"setup_assemble", st.assemble},
                        {"setup_factor", st.factor}, {"setup_schur", st.schur},    {"solve", d.solve_seconds},
                        {"field", d.field_seconds}, {"verify", d.verify_seconds}, {"write", write_seconds}};
+  report["verified"] = ok;
   if (!o.report.empty())
-    write_file_atomically(o.report, [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+    write_file_atomically(output_path(o.report, name), [&](std::ostream& out) { out << report.dump(2) << "\n"; });
 
   if (!o.quiet) {
-    std::cout << "mesh " << o.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
-              << " component(s), chi " << t.euler_characteristic() << ", " << designer.cycles().generators.size() << " generator(s), "
-              << t.boundary_loops.size() << " boundary loop(s)\n"
-              << "N " << prescription.N << ", " << prescription.vertex.size() << " singular vertices, weights " << o.weights << ", solver "
+    if (!name.empty()) std::cout << "== " << name << "\n";
+    std::cout << "N " << prescription.N << ", " << prescription.vertex.size() << " singular vertices, weights " << o.weights << ", solver "
               << o.solver << "\n"
-              << (with_fixed.fixed.empty() ? std::string()
-                                           : std::to_string(with_fixed.fixed.size()) + " fixed faces, max deviation " + fmt(d.max_fixed_error) +
-                                                 " rad, " + std::to_string(d.conflicts.size()) + " sharp turns between adjacent fixed faces\n")
+              << (prescription.fixed.empty() ? std::string()
+                                             : std::to_string(prescription.fixed.size()) + " fixed faces, max deviation " + fmt(d.max_fixed_error) +
+                                                   " rad, " + std::to_string(d.conflicts.size()) + " sharp turns between adjacent fixed faces\n")
               << "energy " << std::setprecision(10) << c.energy << "\n"
               << "max residual " << fmt(residual) << " rad (vertex " << fmt(c.max_vertex_residual) << ", cycles " << fmt(c.max_cycle_residual)
               << "), transport mismatch " << fmt(d.transport_mismatch) << " rad\n"
@@ -170,15 +230,59 @@ void run_solve(const SolveOptions& o) {
     if (!d.index_mismatch_vertices.empty())
       std::cout << " (" << d.index_mismatch_vertices.size() - unexplained.size()
                 << " at vertices where the connection turns by pi/N or more across an edge, which a per-face field cannot show)";
-    std::cout << "\ntime: read " << fmt(read_seconds) << " s, topology " << fmt(pt.topology) << " s, geometry " << fmt(pt.geometry)
-              << " s, cycles " << fmt(pt.cycles) << " s, setup " << fmt(pt.setup) << " s, solve " << fmt(d.solve_seconds) << " s, field "
-              << fmt(d.field_seconds) << " s\n";
+    std::cout << "\ntime: solve " << fmt(d.solve_seconds) << " s, field " << fmt(d.field_seconds) << " s\n";
   }
-  if (residual > tolerance || d.transport_mismatch > tolerance || d.max_fixed_error > tolerance || !unexplained.empty()) {
-    std::cerr << "trivcon: verification failed: residual " << residual << ", transport mismatch " << d.transport_mismatch << ", "
-              << unexplained.size() << " unexplained index mismatches\n";
-    exit_code = 3;
+  if (!ok)
+    std::cerr << "trivcon: verification failed" << (name.empty() ? "" : " for " + name) << ": residual " << residual << ", transport mismatch "
+              << d.transport_mismatch << ", fixed faces off by " << d.max_fixed_error << ", " << unexplained.size()
+              << " unexplained index mismatches\n";
+  return ok;
+}
+
+void run_solve(const SolveOptions& o) {
+  auto t0 = Clock::now();
+  const MeshData mesh = load_mesh(o.mesh);
+  const double read_seconds = seconds_since(t0);
+  IndexPrescription prescription = o.prescription.build();
+  if (o.root_angles.size() > o.root_faces.size()) throw Error("--root-angle given without a matching --root-face");
+  std::vector<std::pair<int, double>> roots;
+  for (size_t i = 0; i < o.root_faces.size(); ++i) roots.emplace_back(o.root_faces[i], i < o.root_angles.size() ? o.root_angles[i] : 0.0);
+  std::vector<BatchItem> batch;
+  if (!o.sing_batch.empty()) batch = read_batch(o.sing_batch, prescription);
+
+  SolverOptions options;
+  options.weights = o.weights == "unit" ? WeightKind::Unit : WeightKind::Cotan;
+  options.solver = o.solver == "qr" ? SolverKind::QR : SolverKind::Cholesky;
+  FieldDesigner designer(mesh.V, mesh.F, options);
+  if (o.align_boundary) prescription.fixed = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
+  std::map<int, double> explicit_fixed;  // --fix wins over --align-boundary on the same face
+  for (const auto& f : o.fixes) {
+    if (is_fix_spec(f)) add_fixed_direction(f, designer.topology(), designer.geometry(), explicit_fixed);
+    else read_fixed_directions(f, designer.topology(), designer.geometry(), explicit_fixed);
   }
+  for (auto [f, angle] : explicit_fixed) prescription.fixed[f] = angle;
+  std::vector<int> fixed_faces;
+  for (auto [f, angle] : prescription.fixed) fixed_faces.push_back(f);
+  designer.set_fixed_faces(fixed_faces);  // the one factorization
+
+  const Topology& t = designer.topology();
+  const PrepareTimings& pt = designer.timings();
+  if (!o.quiet)
+    std::cout << "mesh " << o.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
+              << " component(s), chi " << t.euler_characteristic() << ", " << designer.cycles().generators.size() << " generator(s), "
+              << t.boundary_loops.size() << " boundary loop(s)\n"
+              << "time: read " << fmt(read_seconds) << " s, topology " << fmt(pt.topology) << " s, geometry " << fmt(pt.geometry) << " s, cycles "
+              << fmt(pt.cycles) << " s, setup " << fmt(pt.setup) << " s\n";
+  bool ok = true;
+  if (batch.empty()) {
+    ok = solve_one(o, mesh, designer, prescription, roots, "", read_seconds);
+  } else {
+    for (BatchItem& item : batch) {
+      item.prescription.fixed = prescription.fixed;
+      ok &= solve_one(o, mesh, designer, item.prescription, roots, item.name, read_seconds);
+    }
+  }
+  if (!ok) exit_code = 3;
 }
 
 struct CheckOptions {
@@ -242,6 +346,9 @@ void register_solve(CLI::App& app) {
                   "Fixed direction: F:x,y,z (world, projected to the face), F:angle=A (radians, face frame), or a file with "
                   "'FACE x y z' / 'FACE angle=A' lines; repeatable");
   cmd->add_flag("--align-boundary", o.align_boundary, "Fix every face with a boundary edge to that edge's direction");
+  cmd->add_option("--sing-batch", o.sing_batch,
+                  "Solve many singularity sets with one factorization: a directory of singularity files, or a JSON-lines file; "
+                  "outputs get the item's name ({name} in a path, or before the extension)");
   cmd->add_option("--root-face", o.root_faces, "Face where propagation starts (one per component at most; repeatable)");
   cmd->add_option("--root-angle", o.root_angles, "Angle (radians, in the root face's frame) of the field at the matching --root-face");
   cmd->add_option("--field-out", o.field_out, "Field file: .txt (x y z per face), .rawfield (Directional) or .ply");
