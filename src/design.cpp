@@ -23,6 +23,7 @@ FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptio
   timings_.geometry = seconds_since(t0);
   t0 = Clock::now();
   cycles_ = compute_cycles(topology_);
+  plan_ = plan_propagation(topology_);
   timings_.cycles = seconds_since(t0);
 }
 
@@ -59,7 +60,7 @@ Design FieldDesigner::design(const IndexPrescription& prescription, const std::v
                   ", so it takes no root face");
     if (rooted[c] == 0) starts.emplace_back(f, angle), rooted[c] = 2;
   }
-  d.field = propagate_field(topology_, geometry_, d.connection.x, prescription.N, starts);
+  d.field = propagate_field(topology_, geometry_, plan_, d.connection.x, prescription.N, starts);
   d.field_seconds = seconds_since(t0);
   t0 = Clock::now();
   d.indices = field_indices(topology_, geometry_, cycles_, d.field);

@@ -22,35 +22,19 @@ double reduce_angle(double a, int N) {
   return a;
 }
 
-Field propagate_field(const Topology& t, const Geometry& g, const Eigen::VectorXd& x, int N,
-                      const std::vector<std::pair<int, double>>& roots) {
-  Field field;
-  field.N = N;
-  field.angle.setZero(t.num_faces);
+PropagationPlan plan_propagation(const Topology& t) {
+  PropagationPlan plan;
+  plan.order.reserve(t.num_faces);
+  plan.parent.assign(t.num_faces, -1);
+  plan.edge.assign(t.num_faces, -1);
+  plan.sign.assign(t.num_faces, 0);
   std::vector<char> seen(t.num_faces, 0);
-  std::vector<std::pair<int, double>> starts;
-  for (auto [f, angle] : roots) {
-    if (f < 0 || f >= t.num_faces)
-      throw Error("root face " + std::to_string(f) + " out of range (mesh has " + std::to_string(t.num_faces) + " faces)");
-    if (!std::isfinite(angle)) throw Error("root angle of face " + std::to_string(f) + " is not finite");
-    starts.emplace_back(f, angle);
-  }
-  std::vector<char> component_rooted(t.components.size(), 0);
-  for (auto [f, angle] : starts) {
-    if (component_rooted[t.face_component[f]])
-      throw Error("two root faces given for component " + std::to_string(t.face_component[f]));
-    component_rooted[t.face_component[f]] = 1;
-  }
-  for (size_t c = 0; c < t.components.size(); ++c)
-    if (!component_rooted[c]) starts.emplace_back(t.components[c].first_face, 0.0);
-  std::vector<int> queue;
-  queue.reserve(t.num_faces);
-  for (auto [root, angle] : starts) {
-    field.angle(root) = wrap_positive(angle);
-    seen[root] = 1;
-    queue.assign(1, root);
-    for (size_t q = 0; q < queue.size(); ++q) {
-      const int f = queue[q];
+  for (const ComponentInfo& c : t.components) {
+    plan.component_begin.push_back(static_cast<int>(plan.order.size()));
+    seen[c.first_face] = 1;
+    plan.order.push_back(c.first_face);
+    for (size_t q = plan.component_begin.back(); q < plan.order.size(); ++q) {
+      const int f = plan.order[q];
       for (int k = 0; k < 3; ++k) {
         const int e = t.face_edges(f, k);
         if (t.is_boundary_edge(e)) continue;
@@ -58,13 +42,40 @@ Field propagate_field(const Topology& t, const Geometry& g, const Eigen::VectorX
         const int h = from_left ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
         if (seen[h]) continue;
         seen[h] = 1;
-        const double turn = g.rho(e) - x(e);
-        field.angle(h) = wrap_positive(field.angle(f) + (from_left ? turn : -turn));
-        queue.push_back(h);
+        plan.parent[h] = f, plan.edge[h] = e, plan.sign[h] = from_left ? 1 : -1;
+        plan.order.push_back(h);
       }
     }
   }
+  plan.component_begin.push_back(static_cast<int>(plan.order.size()));
+  return plan;
+}
+
+Field propagate_field(const Topology& t, const Geometry& g, const PropagationPlan& plan, const Eigen::VectorXd& x, int N,
+                      const std::vector<std::pair<int, double>>& roots) {
+  Field field;
+  field.N = N;
+  field.angle.setZero(t.num_faces);
+  // Angles are summed unwrapped along the tree (exact up to round-off) and wrapped once at the end.
+  for (int f : plan.order)
+    if (plan.parent[f] >= 0) field.angle(f) = field.angle(plan.parent[f]) + plan.sign[f] * (g.rho(plan.edge[f]) - x(plan.edge[f]));
+  std::vector<char> rooted(t.components.size(), 0);
+  for (auto [f, angle] : roots) {
+    if (f < 0 || f >= t.num_faces)
+      throw Error("root face " + std::to_string(f) + " out of range (mesh has " + std::to_string(t.num_faces) + " faces)");
+    if (!std::isfinite(angle)) throw Error("root angle of face " + std::to_string(f) + " is not finite");
+    const int c = t.face_component[f];
+    if (rooted[c]) throw Error("two root faces given for component " + std::to_string(c));
+    rooted[c] = 1;
+    const double shift = angle - field.angle(f);
+    for (int i = plan.component_begin[c]; i < plan.component_begin[c + 1]; ++i) field.angle(plan.order[i]) += shift;
+  }
+  for (int f = 0; f < t.num_faces; ++f) field.angle(f) = wrap_positive(field.angle(f));
   return field;
+}
+
+Field propagate_field(const Topology& t, const Geometry& g, const Eigen::VectorXd& x, int N, const std::vector<std::pair<int, double>>& roots) {
+  return propagate_field(t, g, plan_propagation(t), x, N, roots);
 }
 
 MatrixX3d field_directions(const Geometry& g, const Field& field) {

@@ -65,6 +65,7 @@ class FieldDesigner {
   Topology topology_;
   Geometry geometry_;
   Cycles cycles_;
+  PropagationPlan plan_;
   SolverOptions options_;
   mutable std::unique_ptr<ConnectionSolver> solver_;
   mutable PrepareTimings timings_;

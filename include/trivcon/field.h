@@ -31,6 +31,20 @@ struct Field {
 Field propagate_field(const Topology& topology, const Geometry& geometry, const Eigen::VectorXd& x, int N,
                       const std::vector<std::pair<int, double>>& roots = {});
 
+// The spanning tree of propagate_field, built once per mesh so that each new connection costs one
+// linear pass: faces in breadth-first order from each component's smallest face (components one after
+// another), with the edge and direction by which each face is reached. A root elsewhere, or another
+// root angle, only rotates its component's field by a constant.
+struct PropagationPlan {
+  std::vector<int> order;            // faces, component by component
+  std::vector<int> component_begin;  // where each component starts in `order` (size components + 1)
+  std::vector<int> parent, edge;     // per face: the face it is reached from and across which edge (−1 at roots)
+  std::vector<signed char> sign;     // +1 when crossing from L to R
+};
+PropagationPlan plan_propagation(const Topology& topology);
+Field propagate_field(const Topology& topology, const Geometry& geometry, const PropagationPlan& plan, const Eigen::VectorXd& x, int N,
+                      const std::vector<std::pair<int, double>>& roots = {});
+
 // World-space unit vectors (F × 3) of the first direction of each face.
 MatrixX3d field_directions(const Geometry& geometry, const Field& field);
 // Angles of world-space vectors projected onto each face (a zero or non-finite vector is an error naming the face).
