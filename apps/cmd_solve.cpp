@@ -13,6 +13,7 @@
 #include "trivcon/design.h"
 #include "trivcon/error.h"
 #include "trivcon/field_io.h"
+#include "trivcon/render.h"
 
 namespace trivcon::cli {
 
@@ -55,7 +56,7 @@ struct SolveOptions {
   std::vector<std::string> fixes;
   bool align_boundary = false;
   std::string sing_batch;
-  std::string field_out, connection_out, lines_out, report;
+  std::string field_out, connection_out, lines_out, report, png;
   bool quiet = false;
 };
 
@@ -165,6 +166,10 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   if (!o.field_out.empty()) write_field(output_path(o.field_out, name), mesh.V, mesh.F, designer.geometry(), d.field);
   if (!o.connection_out.empty()) write_connection(output_path(o.connection_out, name), t, c.x, prescription.N);
   if (!o.lines_out.empty()) write_field_lines(output_path(o.lines_out, name), mesh.V, mesh.F, designer.geometry(), d.field);
+  if (!o.png.empty()) {  // the prescription's singularities, drawn with the default view of `trivcon render`
+    std::vector<std::pair<int, int>> singular(prescription.vertex.begin(), prescription.vertex.end());
+    write_png(output_path(o.png, name), render_field(mesh.V, t, designer.geometry(), d.field, singular));
+  }
   const double write_seconds = seconds_since(t1);
 
   nlohmann::ordered_json report;
@@ -354,6 +359,7 @@ void register_solve(CLI::App& app) {
   cmd->add_option("--field-out", o.field_out, "Field file: .txt (x y z per face), .rawfield (Directional) or .ply");
   cmd->add_option("--connection-out", o.connection_out, "Connection file: 'i j x' per interior edge");
   cmd->add_option("--lines-out", o.lines_out, "OBJ with a short segment per face and direction");
+  cmd->add_option("--png", o.png, "Picture of the field (as `trivcon render` with its defaults)");
   cmd->add_option("--report", o.report, "JSON report: sizes, topology, indices used, energy, residuals, timings");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");
   cmd->callback([] { run_solve(o); });

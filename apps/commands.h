@@ -13,6 +13,7 @@ extern int exit_code;  // set by a subcommand that wants a status other than 0
 
 void register_info(CLI::App& app);
 void register_solve(CLI::App& app);  // also `check`
+void register_render(CLI::App& app);
 
 // Reads a mesh file; messages name the file.
 MeshData load_mesh(const std::string& path);

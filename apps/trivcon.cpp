@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   trivcon::cli::register_info(app);
   trivcon::cli::register_solve(app);
+  trivcon::cli::register_render(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds everything, then computes a cross field (N = 4) on the bundled mesh data/cube_sphere.obj with
-# the eight +1/4 singularities of a cube (data/cube_sphere.sing), writes the field files and a report to
-# demo-output/, and prints the summary.
+# the eight +1/4 singularities of a cube (data/cube_sphere.sing), writes the field files, a report and a
+# picture (field.png) to demo-output/, and prints the summary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
@@ -10,6 +10,6 @@ mkdir -p "$out"
 ./build/trivcon info data/cube_sphere.obj
 ./build/trivcon solve data/cube_sphere.obj -N 4 -s data/cube_sphere.sing \
   --field-out "$out/field.txt" --connection-out "$out/connection.txt" --lines-out "$out/field_lines.obj" \
-  --report "$out/report.json"
+  --report "$out/report.json" --png "$out/field.png"
 ./build/trivcon check data/cube_sphere.obj "$out/field.txt" -N 4 -s data/cube_sphere.sing
 echo "== wrote $(ls "$out" | tr '\n' ' ')to $out/"

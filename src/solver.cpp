@@ -18,6 +18,8 @@ namespace trivcon {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
+// Beyond this many fixed-face paths the Cholesky route keeps them out of the dense block.
+constexpr int kMaxDensePaths = 256;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
 using Clock = std::chrono::steady_clock;
@@ -447,7 +449,12 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
   // Cycle rows, fixed-face paths first: free indices are rounded in this order (see nearest_lattice_point),
   // and a path between nearby fixed faces is well determined, while a loop or generator index is only
   // determined once the paths around it are.
-  for (int k = 0; k < static_cast<int>(paths_.size()); ++k) rows_.push_back({RowKind::Path, k});
+  // Many fixed faces (e.g. a whole aligned boundary) would make the dense block large: then the Cholesky
+  // route orders the path rows with the vertex rows (sparse, fill-reducing) and rounds their turns
+  // from the field without them (see solve()).
+  sparse_paths_ = options.solver == SolverKind::Cholesky && static_cast<int>(paths_.size()) > kMaxDensePaths;
+  if (!sparse_paths_)
+    for (int k = 0; k < static_cast<int>(paths_.size()); ++k) rows_.push_back({RowKind::Path, k});
   for (size_t l = 0; l < t.boundary_loops.size(); ++l)
     if (dropped_loop_[t.vertex_component[t.boundary_loops[l][0]]] != static_cast<int>(l)) rows_.push_back({RowKind::Loop, static_cast<int>(l)});
   for (int g = 0; g < num_generators(); ++g) rows_.push_back({RowKind::Generator, g});
@@ -477,10 +484,25 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
   Eigen::VectorXd w(m);
   for (int a = 0; a < m; ++a) w(a) = weights_(active_edges_[a]);
   timings_.assemble += seconds_since(t0);
-  if (options.solver == SolverKind::QR)
+  if (options.solver == SolverKind::QR) {
     engine_ = std::make_unique<QREngine>(Dt, Ct, w, timings_);
-  else
+  } else if (!sparse_paths_) {
     engine_ = std::make_unique<CholeskyEngine>(Dt, Ct, w, timings_);
+  } else {
+    // The vertex rows alone (for the field without path constraints), and vertex + path rows together.
+    SparseMatrix Et(m, static_cast<Eigen::Index>(paths_.size())), DEt(m, num_vertex_rows_ + static_cast<Eigen::Index>(paths_.size()));
+    std::vector<Triplet> trip;
+    for (size_t k = 0; k < paths_.size(); ++k) {
+      const DualCycle& path = paths_[k].path;
+      for (size_t i = 0; i < path.edges.size(); ++i)
+        if (edge_column_[path.edges[i]] >= 0) trip.emplace_back(edge_column_[path.edges[i]], static_cast<int>(k), path.signs[i]);
+    }
+    Et.setFromTriplets(trip.begin(), trip.end());
+    DEt.leftCols(num_vertex_rows_) = Dt;
+    DEt.rightCols(Et.cols()) = Et;
+    relaxed_engine_ = std::make_unique<CholeskyEngine>(Dt, SparseMatrix(m, 0), w, timings_);
+    engine_ = std::make_unique<CholeskyEngine>(DEt, Ct, w, timings_);
+  }
 }
 
 ConnectionSolver::~ConnectionSolver() = default;
@@ -588,7 +610,26 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   }
   const bool identity = static_cast<int>(params.size()) == nC;
   Eigen::VectorXd n_C = n0;
-  const Eigen::VectorXd x_active = engine_->solve(b_D, [&](const Eigen::VectorXd& r0) {
+  Eigen::VectorXd n_E;  // path turns, when the path rows are sparse
+  Eigen::VectorXd b_sparse = b_D;
+  if (sparse_paths_) {
+    // Each path's whole number of turns is rounded from the field without path constraints (and with
+    // real-valued loop and generator holonomies): the vertex rows alone.
+    const Eigen::VectorXd x0 = relaxed_engine_->solve(b_D, [](const Eigen::VectorXd& r0) { return r0; });
+    const int nP = static_cast<int>(paths_.size());
+    n_E.resize(nP);
+    b_sparse.conservativeResize(num_vertex_rows_ + nP);
+    for (int k = 0; k < nP; ++k) {
+      const DualCycle& path = paths_[k].path;
+      double along = 0;
+      for (size_t i = 0; i < path.edges.size(); ++i)
+        if (edge_column_[path.edges[i]] >= 0) along += path.signs[i] * x0(edge_column_[path.edges[i]]);
+      const double h = path_holonomy(k);
+      n_E(k) = std::floor((h - along) / step + 0.5 + 1e-7);
+      b_sparse(num_vertex_rows_ + k) = h - step * n_E(k);
+    }
+  }
+  const Eigen::VectorXd x_active = engine_->solve(b_sparse, [&](const Eigen::VectorXd& r0) {
     const Eigen::VectorXd u = (H - r0) / step;
     n_C += M * nearest_lattice_point(*engine_, u, n0, M, identity).cast<double>();
     return Eigen::VectorXd(H - step * n_C);
@@ -605,6 +646,13 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   result.loop_chosen.assign(t.boundary_loops.size(), 0);
   result.path_turn.assign(paths_.size(), 0);
   double path_residual = 0;
+  for (int k = 0; k < n_E.size(); ++k) {
+    result.path_turn[k] = static_cast<int>(n_E(k));
+    const DualCycle& path = paths_[k].path;
+    double sum = 0;
+    for (size_t i = 0; i < path.edges.size(); ++i) sum += path.signs[i] * result.x(path.edges[i]);
+    path_residual = std::max(path_residual, std::abs(sum - (path_holonomy(k) - step * n_E(k))));
+  }
   for (int r = 0; r < nC; ++r) {
     const Row& row = rows_[r];
     const int n = static_cast<int>(std::lround(n_C(r)));

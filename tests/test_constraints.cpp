@@ -257,3 +257,25 @@ TEST(Constraints, DirectionProjection) {
     EXPECT_NEAR(fixed_angle_from_direction(g, f, in_plane + 5.0 * g.normal.row(f).transpose()), 1.1, 1e-12);
   }
 }
+
+// Many fixed faces: the Cholesky route keeps the path rows sparse and rounds their turns from the field
+// without them (no ±1 improvement of path turns): exact, with the concentric loop indices, and within
+// 1% of the energy of the dense route (QR), which also improves path turns by ±1 steps.
+TEST(Constraints, ManyFixedFacesSparseRoute) {
+  const Mesh m = make_annulus(12, 200);
+  FieldDesigner chol(m.V, m.F), qr(m.V, m.F, SolverOptions{WeightKind::Cotan, SolverKind::QR});
+  for (int N : {1, 4}) {
+    IndexPrescription p;
+    p.N = N;
+    p.fixed = boundary_alignment(m.V, chol.topology(), chol.geometry());
+    ASSERT_GT(p.fixed.size(), 300u);
+    chol.set_fixed_faces(keys(p.fixed));
+    qr.set_fixed_faces(keys(p.fixed));
+    const Design a = chol.design(p), b = qr.design(p);
+    expect_exact(chol, a, p);
+    EXPECT_LE(max_free_face_optimality(chol, a, p.fixed), 1e-9);
+    EXPECT_GE(a.connection.energy, b.connection.energy - 1e-8 * std::max(1.0, b.connection.energy));
+    EXPECT_LE(a.connection.energy, 1.01 * b.connection.energy);
+    EXPECT_EQ(a.connection.loop_index, b.connection.loop_index);
+  }
+}

@@ -102,6 +102,8 @@ class ConnectionSolver {
   std::vector<double> loop_curvature_, generator_holonomy_;
   SetupTimings timings_;
   std::unique_ptr<Engine> engine_;
+  std::unique_ptr<Engine> relaxed_engine_;  // vertex rows only, when the path rows are sparse
+  bool sparse_paths_ = false;
 
   // Rows of the reduced system: interior vertices (minus one per closed component), then the cycle
   // rows C: boundary loops (minus one per component with boundary), then generators.

@@ -1,0 +1,118 @@
+// trivcon render MESH --field F -o picture.png [options]: a picture of a field (trivcon/render.h).
+#include <iostream>
+
+#include "commands.h"
+#include "trivcon/cycles.h"
+#include "trivcon/error.h"
+#include "trivcon/field_io.h"
+#include "trivcon/indices.h"
+#include "trivcon/render.h"
+
+namespace trivcon::cli {
+
+namespace {
+
+struct RenderCommand {
+  std::string mesh, field, output, size = "1200x900", view = "30,20", style = "hedgehog", up = "y", streamlines_out;
+  int N = 0;  // 0: the field file's
+  std::vector<std::string> sing_files, sings;
+  double spacing = 11;
+  bool flat = false, no_legend = false;
+};
+
+// "WxH" → (W, H).
+void parse_size(const std::string& text, RenderOptions& o) {
+  const size_t x = text.find('x');
+  try {
+    size_t end_w = 0, end_h = 0;
+    if (x == std::string::npos) throw std::invalid_argument(text);
+    o.width = std::stoi(text.substr(0, x), &end_w);
+    o.height = std::stoi(text.substr(x + 1), &end_h);
+    if (end_w != x || end_h != text.size() - x - 1) throw std::invalid_argument(text);
+  } catch (const std::logic_error&) {
+    throw Error("--size " + text + ": expected WIDTHxHEIGHT, e.g. 1200x900");
+  }
+}
+
+// "AZ,EL" in degrees.
+void parse_view(const std::string& text, RenderOptions& o) {
+  const size_t comma = text.find(',');
+  try {
+    size_t end_a = 0, end_e = 0;
+    if (comma == std::string::npos) throw std::invalid_argument(text);
+    o.azimuth = std::stod(text.substr(0, comma), &end_a);
+    o.elevation = std::stod(text.substr(comma + 1), &end_e);
+    if (end_a != comma || end_e != text.size() - comma - 1) throw std::invalid_argument(text);
+  } catch (const std::logic_error&) {
+    throw Error("--view " + text + ": expected AZIMUTH,ELEVATION in degrees, e.g. 30,20");
+  }
+}
+
+void run_render(const RenderCommand& c) {
+  const MeshData mesh = load_mesh(c.mesh);
+  check_finite(mesh.V);
+  const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
+  const Geometry g = compute_geometry(mesh.V, t);
+  int file_N = 0;
+  const MatrixX3d directions = read_field(c.field, t.num_faces, &file_N);
+  const int N = c.N > 0 ? c.N : std::max(1, file_N);
+  const Field field = field_from_directions(g, directions, N);
+
+  std::vector<std::pair<int, int>> singularities;
+  if (c.sing_files.empty() && c.sings.empty()) {
+    // Nothing given: mark where the field itself is singular.
+    singularities = singular_vertices(field_indices(t, g, compute_cycles(t), field).vertex);
+  } else {
+    IndexPrescription p;
+    p.N = N;
+    for (const std::string& f : c.sing_files) read_singularities(f, p);
+    for (const std::string& s : c.sings) add_vertex_index(s, p);
+    for (auto [v, n] : p.vertex) {
+      if (v < 0 || v >= t.num_vertices)
+        throw Error("singular vertex " + std::to_string(v) + " out of range (mesh has " + std::to_string(t.num_vertices) + " vertices)");
+      singularities.emplace_back(v, n);
+    }
+  }
+
+  RenderOptions o;
+  parse_size(c.size, o);
+  parse_view(c.view, o);
+  o.up = c.up[0];
+  o.style = c.style == "streamlines" ? FieldStyle::Streamlines : FieldStyle::Hedgehog;
+  o.glyph_spacing = c.spacing;
+  o.smooth_shading = !c.flat;
+  o.legend = !c.no_legend;
+  if (o.style == FieldStyle::Streamlines || !c.streamlines_out.empty()) {
+    const std::vector<Streamline> lines = trace_streamlines(mesh.V, t, g, field, singularities, render_streamline_options(mesh.V, t, o));
+    if (!c.streamlines_out.empty()) write_streamlines_obj(c.streamlines_out, lines);
+    if (o.style == FieldStyle::Streamlines) {
+      write_png(c.output, render_field(mesh.V, t, g, field, singularities, lines, o));
+      return;
+    }
+  }
+  write_png(c.output, render_field(mesh.V, t, g, field, singularities, o));
+}
+
+}  // namespace
+
+void register_render(CLI::App& app) {
+  static RenderCommand c;
+  auto* cmd = app.add_subcommand("render", "Draw a field on its surface to a PNG (hedgehog glyphs or streamlines)");
+  cmd->add_option("mesh", c.mesh, "Mesh file: .obj .off .ply, optionally .gz")->required();
+  cmd->add_option("--field", c.field, "Field: trivcon's .txt or .ply, or Directional's .rawfield")->required();
+  cmd->add_option("-o,--output", c.output, "PNG to write")->required();
+  cmd->add_option("-N,--symmetry", c.N, "Symmetry N (default: the field file's)")->check(CLI::Range(1, 1000));
+  cmd->add_option("-s,--singularities", c.sing_files, "Singularity file to mark (default: the field's own singular vertices)");
+  cmd->add_option("--sing", c.sings, "A singular vertex to mark, V:INDEX; repeatable");
+  cmd->add_option("--size", c.size, "Image size WIDTHxHEIGHT (default 1200x900)");
+  cmd->add_option("--view", c.view, "View direction AZIMUTH,ELEVATION in degrees (default 30,20)");
+  cmd->add_option("--up", c.up, "World axis pointing up in the picture: x, y (default) or z")->check(CLI::IsMember({"x", "y", "z"}));
+  cmd->add_option("--style", c.style, "hedgehog (default) or streamlines")->check(CLI::IsMember({"hedgehog", "streamlines"}));
+  cmd->add_option("--spacing", c.spacing, "Pixels between glyphs or streamlines (default 11, for 900 pixels)")->check(CLI::PositiveNumber);
+  cmd->add_option("--streamlines-out", c.streamlines_out, "Also write the streamlines as OBJ polylines");
+  cmd->add_flag("--flat", c.flat, "Flat shading (one normal per face)");
+  cmd->add_flag("--no-legend", c.no_legend, "Leave out the legend");
+  cmd->callback([] { run_render(c); });
+}
+
+}  // namespace trivcon::cli
