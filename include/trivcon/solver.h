@@ -21,10 +21,15 @@
 // Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
 // system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
 //
+// Fixed-face paths (trivcon/constraints.h) are cycle rows too. With more than 256 of them the Cholesky
+// route puts them with the vertex rows instead (a second, vertex-only factorization gives the field
+// without them, from which each path's whole number of turns is rounded), keeping the dense block small.
+//
 // Free cycle indices (generators and loops not prescribed) are chosen so that the field is smoothest:
 // the energy is a quadratic function of them, E = E₀ + (2π/N)² (u − n)ᵀ P (u − n) with P = S⁻¹; the
-// real minimiser (given the prescribed ones) is rounded to the nearest integers n, then improved by
-// single ±1 steps while the energy decreases.
+// real minimiser (given the prescribed ones) is rounded one index at a time (Babai's nearest plane, fixed-
+// face paths first, each given the ones already rounded and the rest real), then improved by single ±1
+// steps while the energy decreases.
 #pragma once
 #include <Eigen/Core>
 #include <memory>
