@@ -3,6 +3,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -41,6 +43,29 @@ CommandResult run_cli(const std::string& args) {
   r.err = slurp(err);
   std::filesystem::remove_all(base);
   return r;
+}
+
+double max_face_optimality(const FieldDesigner& designer, const Connection& c, const std::map<int, double>& skip) {
+  const Topology& t = designer.topology();
+  const Eigen::VectorXd& w = designer.solver().weights();
+  double worst = 0, scale = 1;
+  for (int e = 0; e < t.num_edges; ++e)
+    if (w(e) > 0) scale = std::max(scale, std::abs(c.x(e) / w(e)));
+  for (int f = 0; f < t.num_faces; ++f) {
+    if (skip.count(f)) continue;
+    double sum = 0;
+    bool interior = true;
+    for (int k = 0; k < 3; ++k) {
+      const int e = t.face_edges(f, k);
+      if (t.is_boundary_edge(e) || !(w(e) > 0)) {
+        interior = false;
+      } else {
+        sum += (t.edge_faces(e, 0) == f ? 1 : -1) * c.x(e) / w(e);
+      }
+    }
+    if (interior) worst = std::max(worst, std::abs(sum));
+  }
+  return worst / scale;
 }
 
 }  // namespace trivcon::test

@@ -40,31 +40,6 @@ void expect_exact(const FieldDesigner& d, const Design& r, const IndexPrescripti
   }
 }
 
-// x is W-orthogonal to every exact dual 1-form vanishing on the constrained paths: the face sums vanish
-// at every face that is not fixed (whose edges are all interior with positive weight).
-double max_free_face_optimality(const FieldDesigner& d, const Design& r, const std::map<int, double>& fixed) {
-  const Topology& t = d.topology();
-  const Eigen::VectorXd& w = d.solver().weights();
-  double worst = 0, scale = 1;
-  for (int e = 0; e < t.num_edges; ++e)
-    if (w(e) > 0) scale = std::max(scale, std::abs(r.connection.x(e) / w(e)));
-  for (int f = 0; f < t.num_faces; ++f) {
-    if (fixed.count(f)) continue;
-    double sum = 0;
-    bool ok = true;
-    for (int k = 0; k < 3; ++k) {
-      const int e = t.face_edges(f, k);
-      if (t.is_boundary_edge(e) || !(w(e) > 0)) {
-        ok = false;
-      } else {
-        sum += (t.edge_faces(e, 0) == f ? 1 : -1) * r.connection.x(e) / w(e);
-      }
-    }
-    if (ok) worst = std::max(worst, std::abs(sum));
-  }
-  return worst / scale;
-}
-
 }  // namespace
 
 TEST(Constraints, AlignBoundaryDiskAnnulusHoles) {
@@ -101,7 +76,7 @@ TEST(Constraints, AlignBoundaryDiskAnnulusHoles) {
     d.set_fixed_faces(keys(p.fixed));
     const Design r = d.design(p);
     expect_exact(d, r, p);
-    EXPECT_LE(max_free_face_optimality(d, r, p.fixed), 1e-9);
+    EXPECT_LE(test::max_face_optimality(d, r.connection, p.fixed), 1e-9);
     // The field runs along the boundary: at a face with one boundary edge, one of its N directions is that edge.
     const Topology& t = d.topology();
     for (auto [f, angle] : p.fixed) {
@@ -172,7 +147,7 @@ TEST(Constraints, EditingSingularitiesKeepsTheSetup) {
     const Design r = d.design(p);
     expect_exact(d, r, p);
     EXPECT_EQ(&d.solver(), solver);
-    EXPECT_LE(max_free_face_optimality(d, r, p.fixed), 1e-9);
+    EXPECT_LE(test::max_face_optimality(d, r.connection, p.fixed), 1e-9);
   }
 }
 
@@ -273,7 +248,7 @@ TEST(Constraints, ManyFixedFacesSparseRoute) {
     qr.set_fixed_faces(keys(p.fixed));
     const Design a = chol.design(p), b = qr.design(p);
     expect_exact(chol, a, p);
-    EXPECT_LE(max_free_face_optimality(chol, a, p.fixed), 1e-9);
+    EXPECT_LE(test::max_face_optimality(chol, a.connection, p.fixed), 1e-9);
     EXPECT_GE(a.connection.energy, b.connection.energy - 1e-8 * std::max(1.0, b.connection.energy));
     EXPECT_LE(a.connection.energy, 1.01 * b.connection.energy);
     EXPECT_EQ(a.connection.loop_index, b.connection.loop_index);

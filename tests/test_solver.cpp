@@ -83,30 +83,6 @@ void expect_exact(const FieldDesigner& d, const Design& r, const IndexPrescripti
   }
 }
 
-// W-orthogonality to exact dual 1-forms: for every face whose edges are all interior with w > 0,
-// Σ σ_fe x_e / w_e = 0 (σ = +1 where f is the edge's L face, −1 where it is R).
-double max_face_optimality(const FieldDesigner& d, const Connection& c) {
-  const Topology& t = d.topology();
-  const Eigen::VectorXd& w = d.solver().weights();
-  double worst = 0, scale = 0;
-  for (int e = 0; e < t.num_edges; ++e)
-    if (w(e) > 0) scale = std::max(scale, std::abs(c.x(e) / w(e)));
-  for (int f = 0; f < t.num_faces; ++f) {
-    double sum = 0;
-    bool ok = true;
-    for (int k = 0; k < 3; ++k) {
-      const int e = t.face_edges(f, k);
-      if (t.is_boundary_edge(e) || !(w(e) > 0)) {
-        ok = false;
-      } else {
-        sum += (t.edge_faces(e, 0) == f ? 1 : -1) * c.x(e) / w(e);
-      }
-    }
-    if (ok) worst = std::max(worst, std::abs(sum));
-  }
-  return worst / std::max(1.0, scale);
-}
-
 struct Case {
   std::string name;
   Mesh mesh;
@@ -199,7 +175,7 @@ TEST(Solver, GeneratedMeshesAreExactAndOptimal) {
                 2 * d.topology().components[k].genus);
     const Design r = d.design(c.prescription);
     expect_exact(d, r, c.prescription);
-    EXPECT_LE(max_face_optimality(d, r.connection), 1e-9);
+    EXPECT_LE(test::max_face_optimality(d, r.connection), 1e-9);
   }
 }
 
@@ -224,7 +200,7 @@ TEST(Solver, UnitWeightsAreExact) {
     const Design r = d.design(c.prescription);
     expect_exact(d, r, c.prescription, false);
     EXPECT_NEAR(r.connection.energy, r.connection.x.squaredNorm(), 1e-9 * std::max(1.0, r.connection.energy));
-    EXPECT_LE(max_face_optimality(d, r.connection), 1e-9);
+    EXPECT_LE(test::max_face_optimality(d, r.connection), 1e-9);
   }
 }
 
@@ -531,7 +507,7 @@ TEST(Solver, SharedMeshes) {
     const IndexPrescription p = gauss_bonnet_prescription(d.topology(), 4);
     const Design r = d.design(p);
     expect_exact(d, r, p, false);
-    EXPECT_LE(max_face_optimality(d, r.connection), 1e-8);
+    EXPECT_LE(test::max_face_optimality(d, r.connection), 1e-8);
     // Index mismatches only where the connection turns by π/N or more next to the vertex.
     EXPECT_TRUE(r.unexplained_mismatch_vertices.empty());
     if (mesh.F.rows() <= 25000) {
