@@ -26,8 +26,11 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 struct PrescriptionOptions {
   int N = 1;
   std::vector<std::string> sing_files, sings, generators, loops;
+  CLI::Option* N_option = nullptr;
+  bool N_given() const { return N_option && N_option->count() > 0; }
+  bool empty() const { return sing_files.empty() && sings.empty() && generators.empty() && loops.empty(); }
   void add_to(CLI::App* cmd, bool with_cycles) {
-    cmd->add_option("-N,--symmetry", N, "Symmetry: 1 vectors, 2 lines, 4 crosses, any N >= 1")->check(CLI::Range(1, 1000));
+    N_option = cmd->add_option("-N,--symmetry", N, "Symmetry: 1 vectors, 2 lines, 4 crosses, any N >= 1")->check(CLI::Range(1, 1000));
     cmd->add_option("-s,--singularities", sing_files,
                     "Singularity file: 'VERTEX INDEX' per line (INDEX integer or p/q), or Directional's .sings");
     cmd->add_option("--sing", sings, "A singular vertex, V:INDEX (e.g. 12:1/4); repeatable");
@@ -148,6 +151,35 @@ std::vector<BatchItem> read_batch(const std::string& path, const IndexPrescripti
   return items;
 }
 
+// The outputs of one solve appear together or not at all: each is written (atomically) beside its final
+// path under a temporary name, and all are renamed into place once every one was written.
+class StagedOutputs {
+ public:
+  std::string path(const std::string& final_path) {
+    // Same folder (so the rename is atomic) and same ending (writers choose the format by extension).
+    const std::filesystem::path p(final_path);
+    staged_.emplace_back((p.parent_path() / (".trivcon-partial." + p.filename().string())).string(), final_path);
+    return staged_.back().first;
+  }
+  void commit() {
+    for (const auto& [temp, final_path] : staged_) {
+      std::error_code error;
+      std::filesystem::rename(temp, final_path, error);
+      if (error) throw Error("cannot write '" + final_path + "': " + error.message());
+    }
+    staged_.clear();
+  }
+  ~StagedOutputs() {
+    for (const auto& [temp, final_path] : staged_) {
+      std::error_code ignored;
+      std::filesystem::remove(temp, ignored);
+    }
+  }
+
+ private:
+  std::vector<std::pair<std::string, std::string>> staged_;
+};
+
 // Solves one prescription on the prepared designer, writes its outputs, prints its summary; returns
 // whether verification passed.
 bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& designer, const IndexPrescription& prescription,
@@ -163,12 +195,13 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   const bool ok = residual <= tolerance && d.transport_mismatch <= tolerance && d.max_fixed_error <= tolerance && unexplained.empty();
 
   auto t1 = Clock::now();
-  if (!o.field_out.empty()) write_field(output_path(o.field_out, name), mesh.V, mesh.F, designer.geometry(), d.field);
-  if (!o.connection_out.empty()) write_connection(output_path(o.connection_out, name), t, c.x, prescription.N);
-  if (!o.lines_out.empty()) write_field_lines(output_path(o.lines_out, name), mesh.V, mesh.F, designer.geometry(), d.field);
+  StagedOutputs staged;
+  if (!o.field_out.empty()) write_field(staged.path(output_path(o.field_out, name)), mesh.V, mesh.F, designer.geometry(), d.field);
+  if (!o.connection_out.empty()) write_connection(staged.path(output_path(o.connection_out, name)), t, c.x, prescription.N);
+  if (!o.lines_out.empty()) write_field_lines(staged.path(output_path(o.lines_out, name)), mesh.V, mesh.F, designer.geometry(), d.field);
   if (!o.png.empty()) {  // the prescription's singularities, drawn with the default view of `trivcon render`
     std::vector<std::pair<int, int>> singular(prescription.vertex.begin(), prescription.vertex.end());
-    write_png(output_path(o.png, name), render_field(mesh.V, t, designer.geometry(), d.field, singular));
+    write_png(staged.path(output_path(o.png, name)), render_field(mesh.V, t, designer.geometry(), d.field, singular));
   }
   const double write_seconds = seconds_since(t1);
 
@@ -219,7 +252,8 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
                        {"field", d.field_seconds}, {"verify", d.verify_seconds}, {"write", write_seconds}};
   report["verified"] = ok;
   if (!o.report.empty())
-    write_file_atomically(output_path(o.report, name), [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+    write_file_atomically(staged.path(output_path(o.report, name)), [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+  staged.commit();
 
   if (!o.quiet) {
     if (!name.empty()) std::cout << "== " << name << "\n";
@@ -282,10 +316,15 @@ void run_solve(const SolveOptions& o) {
   if (batch.empty()) {
     ok = solve_one(o, mesh, designer, prescription, roots, "", read_seconds);
   } else {
-    for (BatchItem& item : batch) {
+    for (BatchItem& item : batch) {  // check every item before writing anything
       item.prescription.fixed = prescription.fixed;
-      ok &= solve_one(o, mesh, designer, item.prescription, roots, item.name, read_seconds);
+      try {
+        validate_prescription(t, static_cast<int>(designer.cycles().generators.size()), item.prescription);
+      } catch (const Error& e) {
+        throw Error("batch item '" + item.name + "': " + e.what());
+      }
     }
+    for (const BatchItem& item : batch) ok &= solve_one(o, mesh, designer, item.prescription, roots, item.name, read_seconds);
   }
   if (!ok) exit_code = 3;
 }
@@ -304,22 +343,27 @@ void run_check(CheckOptions& o) {
   const Cycles cycles = compute_cycles(t);
   int file_N = 0;
   const MatrixX3d directions = read_field(o.field, t.num_faces, &file_N);
-  if (o.prescription.N == 1 && file_N > 1) o.prescription.N = file_N;  // -N not given: take the file's
+  if (o.prescription.N_given() && file_N > 0 && file_N != o.prescription.N)
+    throw Error("the field file " + o.field + " holds an N = " + std::to_string(file_N) + " field but -N " +
+                std::to_string(o.prescription.N) + " was given");
+  if (!o.prescription.N_given() && file_N > 0) o.prescription.N = file_N;
+  // Without a prescription, check only lists the field's singularities.
+  const bool compare = !o.prescription.empty();
   const IndexPrescription p = o.prescription.build();
-  validate_prescription(t, static_cast<int>(cycles.generators.size()), p);
+  if (compare) validate_prescription(t, static_cast<int>(cycles.generators.size()), p);
   const Field field = field_from_directions(g, directions, p.N);
   const FieldIndices idx = field_indices(t, g, cycles, field);
   nlohmann::ordered_json found = nlohmann::ordered_json::array(), differ = nlohmann::ordered_json::array();
   for (int v = 0; v < t.num_vertices; ++v) {
     const int want = p.vertex.count(v) ? p.vertex.at(v) : 0;
     if (idx.vertex[v] != 0) found.push_back({{"vertex", v}, {"index", format_index(idx.vertex[v], p.N)}});
-    if (idx.vertex[v] != want)
+    if (compare && idx.vertex[v] != want)
       differ.push_back({{"vertex", v}, {"found", format_index(idx.vertex[v], p.N)}, {"prescribed", format_index(want, p.N)}});
   }
   nlohmann::ordered_json j;
   j["N"] = p.N;
   j["singularities"] = found;
-  j["differences"] = differ;
+  if (compare) j["differences"] = differ;
   nlohmann::ordered_json loops = nlohmann::ordered_json::array(), gens = nlohmann::ordered_json::array();
   for (size_t l = 0; l < idx.loop.size(); ++l) loops.push_back({{"id", l}, {"index", format_index(idx.loop[l], p.N)}});
   for (size_t i = 0; i < idx.generator.size(); ++i) gens.push_back({{"id", i}, {"index", format_index(idx.generator[i], p.N)}});
@@ -331,7 +375,8 @@ void run_check(CheckOptions& o) {
     std::cout << "N " << p.N << ": " << found.size() << " singular vertices in the field\n";
     for (const auto& s : found) std::cout << "  vertex " << s["vertex"] << " index " << s["index"].get<std::string>() << "\n";
     for (size_t l = 0; l < idx.loop.size(); ++l) std::cout << "  boundary loop " << l << " index " << format_index(idx.loop[l], p.N) << "\n";
-    std::cout << (differ.empty() ? "matches the prescription\n" : std::to_string(differ.size()) + " vertices differ from the prescription\n");
+    if (compare)
+      std::cout << (differ.empty() ? "matches the prescription\n" : std::to_string(differ.size()) + " vertices differ from the prescription\n");
     for (const auto& s : differ)
       std::cout << "  vertex " << s["vertex"] << ": found " << s["found"].get<std::string>() << ", prescribed " << s["prescribed"].get<std::string>() << "\n";
   }
@@ -365,7 +410,8 @@ void register_solve(CLI::App& app) {
   cmd->callback([] { run_solve(o); });
 
   static CheckOptions c;
-  auto* check = app.add_subcommand("check", "Compute the indices of a per-face field (any tool's) and compare with a prescription");
+  auto* check = app.add_subcommand("check",
+                                   "Compute the indices of a per-face field (any tool's); with -s/--sing, compare them with that prescription");
   check->add_option("mesh", c.mesh, "Mesh file")->required();
   check->add_option("field", c.field, "Field: trivcon's .txt or .ply, or Directional's .rawfield")->required();
   c.prescription.add_to(check, false);

@@ -97,7 +97,12 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t) {
       }
     }
     Eigen::Vector3d x = V.row(t.F(f, 1)) - V.row(t.F(f, 0));
-    if (x.squaredNorm() == 0) x = V.row(t.F(f, 2)) - V.row(t.F(f, 0));
+    if (x.squaredNorm() == 0) {
+      // A zero-length first edge: its corner angles are (π/2, π/2, 0), so half_edge_angle puts edge 1 → 2
+      // at π/2; the x axis is a quarter turn clockwise from that edge.
+      const Eigen::Vector3d d = V.row(t.F(f, 2)) - V.row(t.F(f, 1));
+      x = n.squaredNorm() > 0 ? Eigen::Vector3d(d.cross(n)) : d;
+    }
     if (x.squaredNorm() == 0) x = Eigen::Vector3d::UnitX();
     x.normalize();
     n -= n.dot(x) * x;

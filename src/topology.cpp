@@ -46,32 +46,28 @@ void check_face_indices(const MatrixX3i& F, int num_vertices) {
 }
 
 // Groups the 3F half-edges (h = 3f + k, from corner k to k+1) into undirected edges. Returns the edge
-// id of every half-edge; edges are numbered in order of first appearance.
+// id of every half-edge; edges are numbered in order of first appearance. Linear time whatever the
+// valences: a two-pass counting sort orders half-edges by (smaller vertex, larger vertex, h), so the
+// half-edges of one edge become neighbours.
 std::vector<int> match_half_edges(const MatrixX3i& F, int num_vertices, int& num_edges) {
   const int H = static_cast<int>(F.rows()) * 3;
-  auto from = [&](int h) { return F(h / 3, h % 3); };
-  auto to = [&](int h) { return F(h / 3, (h % 3 + 1) % 3); };
-  std::vector<int> offset(num_vertices + 1, 0);
-  for (int h = 0; h < H; ++h) ++offset[std::min(from(h), to(h)) + 1];
-  for (int v = 0; v < num_vertices; ++v) offset[v + 1] += offset[v];
-  std::vector<int> bucket(H);
-  {
-    std::vector<int> fill(offset.begin(), offset.end() - 1);
-    for (int h = 0; h < H; ++h) bucket[fill[std::min(from(h), to(h))]++] = h;  // h increasing within a bucket
-  }
-  // first_of[h]: the first half-edge (smallest h) of h's edge.
-  std::vector<int> first_of(H, -1);
-  for (int v = 0; v < num_vertices; ++v) {
-    for (int a = offset[v]; a < offset[v + 1]; ++a) {
-      const int ha = bucket[a];
-      if (first_of[ha] >= 0) continue;
-      first_of[ha] = ha;
-      const int other = std::max(from(ha), to(ha));
-      for (int b = a + 1; b < offset[v + 1]; ++b) {
-        const int hb = bucket[b];
-        if (first_of[hb] < 0 && std::max(from(hb), to(hb)) == other) first_of[hb] = ha;
-      }
-    }
+  auto lo = [&](int h) { return std::min(F(h / 3, h % 3), F(h / 3, (h % 3 + 1) % 3)); };
+  auto hi = [&](int h) { return std::max(F(h / 3, h % 3), F(h / 3, (h % 3 + 1) % 3)); };
+  auto counting_sort = [&](const std::vector<int>& in, auto key) {  // stable
+    std::vector<int> offset(num_vertices + 1, 0), out(in.size());
+    for (int h : in) ++offset[key(h) + 1];
+    for (int v = 0; v < num_vertices; ++v) offset[v + 1] += offset[v];
+    for (int h : in) out[offset[key(h)]++] = h;
+    return out;
+  };
+  std::vector<int> order(H);
+  std::iota(order.begin(), order.end(), 0);
+  order = counting_sort(counting_sort(order, hi), lo);
+  std::vector<int> first_of(H);  // the first half-edge (smallest h) of h's edge
+  for (int a = 0; a < H; ++a) {
+    const int h = order[a];
+    const bool same_edge = a > 0 && lo(order[a - 1]) == lo(h) && hi(order[a - 1]) == hi(h);
+    first_of[h] = same_edge ? first_of[order[a - 1]] : h;
   }
   std::vector<int> edge_of(H);
   num_edges = 0;
