@@ -408,11 +408,11 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
   // A cycle or fixed-face path made only of zero-weight edges could not turn the field at all; its edges
   // get a small positive weight (1e-6 × the median positive weight), so that it turns there only when
   // nothing else can.
+  double epsilon = 1e-6;
   {
     std::vector<double> positive;
     for (int e = 0; e < nE; ++e)
       if (weights_(e) > 0) positive.push_back(weights_(e));
-    double epsilon = 1e-6;
     if (!positive.empty()) {
       std::nth_element(positive.begin(), positive.begin() + positive.size() / 2, positive.end());
       epsilon = 1e-6 * positive[positive.size() / 2];
@@ -459,7 +459,7 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
     if (dropped_loop_[t.vertex_component[t.boundary_loops[l][0]]] != static_cast<int>(l)) rows_.push_back({RowKind::Loop, static_cast<int>(l)});
   for (int g = 0; g < num_generators(); ++g) rows_.push_back({RowKind::Generator, g});
 
-  check_weight_connectivity();
+  connect_isolated_vertices(epsilon);
 
   const int m = static_cast<int>(active_edges_.size());
   const int nC = static_cast<int>(rows_.size());
@@ -513,29 +513,48 @@ const DualCycle& ConnectionSolver::cycle_of_row(int r) const {
 }
 
 // Every vertex row must reach a boundary vertex or the dropped vertex of its component through edges of
-// positive weight; otherwise the Laplacian is singular and the vertex's curvature has nowhere to go.
-void ConnectionSolver::check_weight_connectivity() const {
+// positive weight; otherwise the Laplacian is singular and the vertex's curvature has nowhere to go
+// (e.g. a vertex surrounded by zero-area faces only). The zero-weight edges at such vertices get the
+// small weight `epsilon`, repeatedly, until every vertex row is reached; then the active edges are
+// recomputed.
+void ConnectionSolver::connect_isolated_vertices(double epsilon) {
   const Topology& t = topology_;
-  std::vector<int> parent(t.num_vertices);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
-  for (int e : active_edges_) parent[find(t.edge_vertices(e, 0))] = find(t.edge_vertices(e, 1));
-  std::vector<char> grounded(t.num_vertices, 0);
-  for (int v = 0; v < t.num_vertices; ++v)
-    if (t.is_boundary_vertex(v)) grounded[find(v)] = 1;
-  for (int v : dropped_vertex_)
-    if (v >= 0) grounded[find(v)] = 1;
-  for (int v = 0; v < t.num_vertices; ++v) {
-    if (vertex_row_[v] < 0 || grounded[find(v)]) continue;
-    int others = 0;
-    for (int u = 0; u < t.num_vertices; ++u) others += (u != v && vertex_row_[u] >= 0 && find(u) == find(v));
-    throw Error("the cotangent weights are zero on every edge joining interior vertex " + std::to_string(v) +
-                (others ? " (and " + std::to_string(others) + " other vertices)" : std::string()) + " to the rest of component " +
-                std::to_string(t.vertex_component[v]) + ", so its curvature cannot be balanced; use --weights unit");
+  bool changed = false;
+  for (int round = 0;; ++round) {
+    std::vector<int> parent(t.num_vertices);
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&](int a) {
+      while (parent[a] != a) a = parent[a] = parent[parent[a]];
+      return a;
+    };
+    for (int e = 0; e < t.num_edges; ++e)
+      if (weights_(e) > 0) parent[find(t.edge_vertices(e, 0))] = find(t.edge_vertices(e, 1));
+    std::vector<char> grounded(t.num_vertices, 0);
+    for (int v = 0; v < t.num_vertices; ++v)
+      if (t.is_boundary_vertex(v)) grounded[find(v)] = 1;
+    for (int v : dropped_vertex_)
+      if (v >= 0) grounded[find(v)] = 1;
+    int added = 0, isolated = -1;
+    for (int v = 0; v < t.num_vertices; ++v) {
+      if (vertex_row_[v] < 0 || grounded[find(v)]) continue;
+      isolated = v;
+      for (int a = t.vertex_edge_offsets[v]; a < t.vertex_edge_offsets[v + 1]; ++a) {
+        const int e = t.vertex_edges[a];
+        if (!t.is_boundary_edge(e) && weights_(e) == 0) weights_(e) = epsilon, ++added;
+      }
+    }
+    if (isolated < 0) break;
+    if (added == 0)  // cannot happen on a connected component; kept as a guard against an endless loop
+      throw Error("interior vertex " + std::to_string(isolated) + " cannot be joined to the rest of component " +
+                  std::to_string(t.vertex_component[isolated]) + " through weighted edges; use --weights unit");
+    regularized_edges_ += added;
+    changed = true;
   }
+  if (!changed) return;
+  active_edges_.clear();
+  edge_column_.assign(t.num_edges, -1);
+  for (int e = 0; e < t.num_edges; ++e)
+    if (weights_(e) > 0) edge_column_[e] = static_cast<int>(active_edges_.size()), active_edges_.push_back(e);
 }
 
 Connection ConnectionSolver::solve(const IndexPrescription& prescription) const {

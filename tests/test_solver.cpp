@@ -517,3 +517,28 @@ TEST(Solver, SharedMeshes) {
     }
   }
 }
+
+// A vertex surrounded only by zero-area faces (as midpoint subdivision makes of the dragon's coincident
+// vertices) has no edge of positive cotan weight: its edges get a small weight and the solve stays exact.
+TEST(Solver, VertexSurroundedByZeroAreaFaces) {
+  Mesh m = make_disk(8, 6);
+  FieldDesigner base(m.V, m.F);
+  int face = 0;  // an interior face whose corners are all interior vertices
+  while (!(base.topology().is_interior_vertex(m.F(face, 0)) && base.topology().is_interior_vertex(m.F(face, 1)) &&
+           base.topology().is_interior_vertex(m.F(face, 2))))
+    ++face;
+  for (int k = 1; k < 3; ++k) m.V.row(m.F(face, k)) = m.V.row(m.F(face, 0));  // collapse it to a point
+  const Mesh sub = subdivide_midpoint(m);
+  FieldDesigner d(sub.V, sub.F);
+  EXPECT_GT(d.geometry().zero_area_faces, 0);
+  IndexPrescription p;
+  p.N = 4;
+  p.vertex[0] = 1;
+  const Design r = d.design(p);
+  EXPECT_GT(d.solver().regularized_edges(), 0);
+  const double scale = std::max(1.0, r.connection.rhs_scale);
+  EXPECT_LE(r.connection.max_vertex_residual, 1e-9 * scale);
+  EXPECT_LE(r.transport_mismatch, 1e-9 * scale);
+  EXPECT_TRUE(r.connection.x.allFinite());
+  EXPECT_TRUE(field_directions(d.geometry(), r.field).allFinite());
+}

@@ -7,8 +7,10 @@
 //   boundary loop ℓ:        Σ_e c_e x_e  = K_ℓ − 2π k_ℓ      (c: the loop cycle, K_ℓ its loop_curvature)
 //   generator γ:            Σ_e c_e x_e  = z_γ − 2π k_γ      (z_γ = levi_civita_holonomy)
 // Objective: minimise Σ x_e² / w_e (w = cotan or unit weights); an edge with w_e = 0 gets x_e = 0, except
-// the edges of a cycle or fixed-face path that has no edge of positive weight: those get 1e-6 × the
-// median positive weight, so the field can still turn there when nothing else can (regularized_edges()).
+// where that would make the constraints unsatisfiable: the edges of a cycle or fixed-face path that has no
+// edge of positive weight, and the edges around a vertex that zero weights cut off from the rest of its
+// component (e.g. one surrounded by zero-area faces) get 1e-6 × the median positive weight, so the field
+// can still turn there when nothing else can (regularized_edges()).
 //
 // Default route (SolverKind::Cholesky): x = W Aᵀ y with (A W Aᵀ) y = b, where A = [D; C] holds the
 // interior-vertex rows D and the cycle rows C (loops, generators). D W Dᵀ is the cotan Laplacian on
@@ -71,9 +73,8 @@ struct SetupTimings {
 
 class ConnectionSolver {
  public:
-  // Builds and factors everything that does not depend on the prescription. Throws trivcon::Error if
-  // the weights leave part of the surface unable to carry curvature (a vertex or a region joined to the
-  // rest only by zero-weight edges) or if a factorization fails.
+  // Builds and factors everything that does not depend on the prescription. Throws trivcon::Error if a
+  // factorization fails (e.g. cycle rows made dependent by the weights).
   // `fixed_faces`: faces whose direction each prescription fixes (trivcon/constraints.h); they change the
   // matrix, their angles only the right-hand side.
   ConnectionSolver(const Topology& topology, const Geometry& geometry, const Cycles& cycles, SolverOptions options = {},
@@ -92,7 +93,7 @@ class ConnectionSolver {
   const std::vector<double>& loop_curvatures() const { return loop_curvature_; }
   const std::vector<double>& generator_holonomies() const { return generator_holonomy_; }
   const std::vector<int>& fixed_faces() const { return fixed_faces_; }
-  // Zero-weight edges given a small weight because a cycle or fixed-face path had no other edge.
+  // Zero-weight edges given a small weight (see above).
   int regularized_edges() const { return regularized_edges_; }
   const std::vector<FixedPath>& fixed_paths() const { return paths_; }
 
@@ -127,7 +128,7 @@ class ConnectionSolver {
   int regularized_edges_ = 0;
   const DualCycle& cycle_of_row(int r) const;
   int component_of_row(int r) const;
-  void check_weight_connectivity() const;
+  void connect_isolated_vertices(double epsilon);
 };
 
 // Residuals of `x` against every constraint for the given indices (n/N): fills the verification fields.
