@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "trivcon/blas.h"
 #include "summary.h"
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
@@ -211,6 +212,7 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   report["N"] = prescription.N;
   report["weights"] = o.weights;
   report["solver"] = o.solver;
+  report["blas_kernels"] = blas_kernels();
   nlohmann::ordered_json sing = nlohmann::ordered_json::array();
   for (auto [v, n] : prescription.vertex) sing.push_back({{"vertex", v}, {"index", format_index(n, prescription.N)}});
   report["singularities"] = sing;

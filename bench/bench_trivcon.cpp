@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "edits.h"
+#include "trivcon/blas.h"
 #include "trivcon/cycles.h"
 #include "trivcon/error.h"
 #include "trivcon/field.h"
@@ -824,6 +825,7 @@ int driver(const std::string& cache, const std::string& dragon, const std::strin
 }  // namespace
 
 int main(int argc, char** argv) {
+  use_native_blas_kernels(argv);  // as the trivcon program does (trivcon/blas.h)
   CLI::App app{"trivcon benchmark: reading, set-up and edits on generated and real meshes"};
   std::string child, spec, cache = "bench-cache", dragon, json_path, only;
   RunOptions o;
@@ -852,7 +854,13 @@ int main(int argc, char** argv) {
   app.add_option("--qr-max-faces", qr_max_faces, "compare with QR on generated meshes up to this size")->capture_default_str();
   app.add_option("--qr-time-limit", o.qr_time_limit, "seconds before a QR set-up is abandoned")->capture_default_str();
   app.add_option("--qr-mem-limit-gb", o.qr_mem_limit_gb, "resident GB before a QR set-up is abandoned")->capture_default_str();
+  bool print_kernels = false;
+  app.add_flag("--blas-kernels", print_kernels, "print the BLAS kernels in use (trivcon/blas.h) and exit");
   CLI11_PARSE(app, argc, argv);
+  if (print_kernels) {
+    std::cout << (blas_kernels().empty() ? "not OpenBLAS" : blas_kernels()) << std::endl;
+    return 0;
+  }
   try {
     if (child == "prepare") return child_prepare(spec, o.ply, o.obj);
     if (child == "run") return child_run(o);

@@ -77,7 +77,7 @@ ARGS=(--cache "$CACHE" --json "$CACHE/results.json" --dragon "$DRAGON")
   echo
   echo "- commit: $(git rev-parse --short HEAD 2>/dev/null || echo unknown)$(git diff --quiet HEAD -- src include bench 2>/dev/null || echo ' (with uncommitted changes in src/include/bench)')"
   echo "- machine: $(nproc) cores, $(awk '/MemTotal/ {printf "%.1f GiB", $2/1048576}' /proc/meminfo), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
-  echo "- BLAS: OpenBLAS $(dpkg-query -W -f='${Version}' libopenblas0-pthread 2>/dev/null || dpkg-query -W -f='${Version}' libopenblas0 2>/dev/null || echo '?') (pthread), threads: ${OPENBLAS_NUM_THREADS:-default}; SuiteSparse $(dpkg-query -W -f='${Version}' libsuitesparse-dev 2>/dev/null || echo '?'); METIS $(dpkg-query -W -f='${Version}' libmetis5 2>/dev/null || echo '?')"
+  echo "- BLAS: OpenBLAS $(dpkg-query -W -f='${Version}' libopenblas0-pthread 2>/dev/null || dpkg-query -W -f='${Version}' libopenblas0 2>/dev/null || echo '?') (pthread), kernels: $("$BUILD_DIR/bench_trivcon" --blas-kernels)$([ -n "${OPENBLAS_CORETYPE:-}" ] && echo " (OPENBLAS_CORETYPE=$OPENBLAS_CORETYPE)"), threads: ${OPENBLAS_NUM_THREADS:-default}; SuiteSparse $(dpkg-query -W -f='${Version}' libsuitesparse-dev 2>/dev/null || echo '?'); METIS $(dpkg-query -W -f='${Version}' libmetis5 2>/dev/null || echo '?')"
   echo "- compiler: $(c++ --version | head -1); $(uname -sr)"
   echo "- load average at start: $(cut -d' ' -f1-3 /proc/loadavg)"
   echo "- command: scripts/bench.sh${QUICK:+$([ "$QUICK" -eq 1 ] && echo ' --quick')}${MESHES:+ --meshes $MESHES} ${EXTRA[*]:-}"

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "support.h"
+#include "trivcon/blas.h"
 #include "trivcon/generate.h"
 #include "trivcon/geometry.h"
 #include "trivcon/io.h"
@@ -558,6 +559,12 @@ TEST(CliSolve, SphereWithTwoPoles) {
   EXPECT_EQ(rep["singularities"], json::parse(R"([{"vertex": 0, "index": "1"}, {"vertex": 85, "index": "1"}])"));
   EXPECT_TRUE(rep["generators"].empty());
   EXPECT_TRUE(rep["boundary_loops"].empty());
+  // The BLAS kernels (trivcon/blas.h): the program re-executes itself rather than run OpenBLAS's generic
+  // kernels on a CPU that supports better ones, unless OPENBLAS_CORETYPE chooses for it.
+  ASSERT_TRUE(rep["blas_kernels"].is_string());
+  if (std::getenv("OPENBLAS_CORETYPE") == nullptr && !native_blas_kernels().empty()) {
+    EXPECT_NE(rep["blas_kernels"].get<std::string>(), "Prescott");
+  }
 
   // Field text: header, one unit vector per face.
   const std::vector<std::string> field = lines_of(slurp(s.field_txt));

@@ -193,6 +193,41 @@ TEST(Solver, QrRouteAgreesWithCholesky) {
   }
 }
 
+// An edit that moves a few singularities updates the stored forward substitution along the elimination
+// tree only (CholeskyEngine::forward_update); one that changes many rows redoes it. Both must give the
+// paper-literal QR solution, with and without cycle rows (sphere; torus: generators; holed grid: loops).
+TEST(Solver, SparseAndFullForwardSubstitutionsAgreeWithQr) {
+  struct Mesh_ {
+    std::string name;
+    Mesh mesh;
+  };
+  const std::vector<Mesh_> meshes = {{"cube_sphere", make_cube_sphere(24, true)},
+                                     {"torus", make_torus(96, 40)},
+                                     {"grid_two_holes", make_holed_grid(60, 2)}};
+  for (const Mesh_& m : meshes) {
+    SCOPED_TRACE(m.name);
+    FieldDesigner chol(m.mesh.V, m.mesh.F);
+    FieldDesigner qr(m.mesh.V, m.mesh.F, SolverOptions{WeightKind::Cotan, SolverKind::QR});
+    const Topology& t = chol.topology();
+    int interior = 0;
+    for (int v = 0; v < t.num_vertices; ++v) interior += t.is_interior_vertex(v);
+    ASSERT_GE(interior, 64 * 8);  // so that 8 singularities take the sparse route, interior / 50 the full one
+    for (int count : {1, 4, interior / 100}) {  // the last one changes too many rows: full substitution
+      SCOPED_TRACE(count);
+      IndexPrescription p = gauss_bonnet_prescription(t, 4);  // the sphere's eight +1/4
+      int placed = 0;
+      for (int v : spread_interior_vertices(t, 2 * count + 16))
+        if (placed < 2 * count && !p.vertex.count(v)) p.vertex[v] = placed++ % 2 ? -1 : 1;
+      ASSERT_EQ(placed, 2 * count);
+      const Design a = chol.design(p), b = qr.design(p);
+      expect_exact(chol, a, p);
+      EXPECT_EQ(a.connection.generator_index, b.connection.generator_index);
+      EXPECT_EQ(a.connection.loop_index, b.connection.loop_index);
+      EXPECT_LE(max_abs(a.connection.x - b.connection.x), 1e-8 * std::max(1.0, max_abs(a.connection.x)));
+    }
+  }
+}
+
 TEST(Solver, UnitWeightsAreExact) {
   for (const Case& c : generated_cases()) {
     SCOPED_TRACE(c.name);

@@ -38,8 +38,10 @@ Field propagate_field(const Topology& topology, const Geometry& geometry, const 
 struct PropagationPlan {
   std::vector<int> order;            // faces, component by component
   std::vector<int> component_begin;  // where each component starts in `order` (size components + 1)
-  std::vector<int> parent, edge;     // per face: the face it is reached from and across which edge (−1 at roots)
-  std::vector<signed char> sign;     // +1 when crossing from L to R
+  // Per position q in `order` (so that a pass reads them in sequence): the position of the face that
+  // order[q] is reached from and the edge it crosses (−1 at roots), and +1 when it crosses from L to R.
+  std::vector<int> parent, edge;
+  std::vector<signed char> sign;
 };
 PropagationPlan plan_propagation(const Topology& topology);
 Field propagate_field(const Topology& topology, const Geometry& geometry, const PropagationPlan& plan, const Eigen::VectorXd& x, int N,

@@ -16,10 +16,12 @@
 // interior-vertex rows D and the cycle rows C (loops, generators). D W Dᵀ is the cotan Laplacian on
 // interior vertices; on a closed component one vertex row is dropped (Gauss–Bonnet makes it redundant),
 // and on a component with boundary one loop row is (its index follows from the others). A W Aᵀ is
-// factored once by CHOLMOD (supernodal, OpenBLAS), the vertex rows in a fill-reducing order (AMD or
-// METIS, chosen by CHOLMOD) and the cycle rows last, so that the trailing block of the factor is the
-// Cholesky factor of the Schur complement S = CWCᵀ − CWDᵀ(DWDᵀ)⁻¹DWCᵀ. A new prescription only changes
-// b: one forward and one backward substitution per edit, nothing is refactored.
+// factored once by CHOLMOD (supernodal, OpenBLAS), the vertex rows in a minimum-degree order (CAMD with
+// the cycle rows constrained last, or AMD when there are none) and the cycle rows last, so that the
+// trailing block of the factor is the Cholesky factor of the Schur complement S = CWCᵀ −
+// CWDᵀ(DWDᵀ)⁻¹DWCᵀ. A new prescription only changes b: nothing is refactored. The forward substitution
+// of the prescription without singularities is stored, so an edit that places a few singularities
+// updates it along their paths in the elimination tree only, then does one full backward substitution.
 // Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
 // system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
 //
@@ -68,6 +70,8 @@ struct Connection {
 };
 
 struct SetupTimings {
+  // assemble: weights, constraint rows, A W Aᵀ; factor: ordering, symbolic analysis, numeric factorization;
+  // schur: the Schur complement's inverse factor and the stored forward substitution.
   double assemble = 0, factor = 0, schur = 0;
 };
 

@@ -1,0 +1,28 @@
+// trivcon/blas.h: which BLAS kernels the factorization runs on.
+//
+// CHOLMOD's supernodal factorization spends most of its time in BLAS (dgemm, dsyrk, dtrsm). Debian 12's
+// OpenBLAS 0.3.21 picks its kernels for the CPU when it is loaded, and does not recognise recent CPUs
+// (e.g. Intel family 6 model 207, the machine of BENCHMARKS.md): it falls back to its generic "Prescott"
+// (SSE3) kernels, which factor 1.3–1.5× slower there than its AVX-512 ("SkylakeX") ones. OpenBLAS only
+// reads its choice (OPENBLAS_CORETYPE) when it is loaded, so a program that wants the better kernels
+// must be started with it set.
+#pragma once
+#include <string>
+
+namespace trivcon {
+
+// The kernels OpenBLAS uses ("SkylakeX", "Haswell", "Prescott", …), or "" if the BLAS is not OpenBLAS.
+std::string blas_kernels();
+
+// The kernels this CPU supports that OpenBLAS would use if it recognised the CPU: "SkylakeX" with
+// AVX-512 (F, CD, BW, DQ, VL), "Haswell" with AVX2 and FMA, else "".
+std::string native_blas_kernels();
+
+// For a program's main(): if OpenBLAS fell back to its generic kernels although the CPU supports better
+// ones, and OPENBLAS_CORETYPE is not set, re-executes the program (/proc/self/exe, same arguments) with
+// OPENBLAS_CORETYPE set to native_blas_kernels(). Returns when there is nothing to do, or if the
+// re-execution fails (the program then carries on with the generic kernels). Set OPENBLAS_CORETYPE
+// yourself (e.g. to Prescott) to keep your own choice.
+void use_native_blas_kernels(char** argv);
+
+}  // namespace trivcon

@@ -1,0 +1,41 @@
+#include "trivcon/blas.h"
+
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+
+namespace trivcon {
+
+std::string blas_kernels() {
+  // Looked up at run time: the BLAS is whatever libblas.so.3 CHOLMOD was loaded with.
+  using CoreName = char* (*)();
+  const auto corename = reinterpret_cast<CoreName>(dlsym(RTLD_DEFAULT, "openblas_get_corename"));
+  if (!corename) return "";
+  const char* name = corename();
+  return name ? name : "";
+}
+
+std::string native_blas_kernels() {
+#if defined(__x86_64__)
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512bw") &&
+      __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl"))
+    return "SkylakeX";
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return "Haswell";
+#endif
+  return "";
+}
+
+void use_native_blas_kernels(char** argv) {
+  if (std::getenv("OPENBLAS_CORETYPE") != nullptr) return;
+  if (blas_kernels() != "Prescott") return;  // OpenBLAS's generic fallback for a CPU it does not know
+  const std::string native = native_blas_kernels();
+  if (native.empty()) return;
+  if (setenv("OPENBLAS_CORETYPE", native.c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  unsetenv("OPENBLAS_CORETYPE");  // exec failed: carry on as we are
+}
+
+}  // namespace trivcon
