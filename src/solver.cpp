@@ -12,6 +12,7 @@
 #include "trivcon/error.h"
 #include "trivcon/field.h"
 #include <algorithm>
+#include <array>
 #include <map>
 
 namespace trivcon {
@@ -23,6 +24,7 @@ constexpr int kMaxDensePaths = 256;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
 using Clock = std::chrono::steady_clock;
+using EdgeEnds = std::vector<std::array<int, 2>>;  // per active edge, the vertex rows of its ends (−1: none)
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 }  // namespace
 
@@ -63,7 +65,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   cholmod_factor* factor = nullptr;
   Eigen::VectorXd w;
   int m = 0, nD = 0, nC = 0;
-  // The constraint rows touching each active edge a (rows of [Dt Ct]): edge_row_[edge_start_[a] …
+  // The constraint rows touching each active edge a (column a of A): edge_row_[edge_start_[a] …
   // edge_start_[a + 1]) with their coefficients; after the factorization, as positions in factor order.
   std::vector<int> edge_start_, edge_row_;
   std::vector<double> edge_coefficient_;
@@ -80,15 +82,20 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   mutable std::vector<int> super_stamp_;
   mutable int stamp_ = 0;
 
-  CholeskyEngine(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w_, SetupTimings& timings) : w(w_) {
+  // The rows of A: vertex rows given per active edge by its two ends (coefficients −1 for ends[a][0] and
+  // +1 for ends[a][1], −1 where an end has no row), then the extra rows Et (m × nX, fixed-face paths that
+  // are ordered with the vertex rows), then the cycle rows Ct (m × nC, last).
+  CholeskyEngine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et, const SparseMatrix& Ct, const Eigen::VectorXd& w_,
+                 SetupTimings& timings)
+      : w(w_) {
     cholmod_start(&cc);
     cc.print = 0;
     cc.supernodal = CHOLMOD_SUPERNODAL;
     cc.final_ll = 1;
-    m = static_cast<int>(Dt.rows()), nD = static_cast<int>(Dt.cols()), nC = static_cast<int>(Ct.cols());
+    m = static_cast<int>(ends.size()), nD = num_vertex_rows + static_cast<int>(Et.cols()), nC = static_cast<int>(Ct.cols());
     const int n = nD + nC;
     auto t0 = Clock::now();
-    Csc M = normal_matrix(Dt, Ct);
+    Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct);
     timings.assemble += seconds_since(t0);
     if (n == 0) return;
 
@@ -148,27 +155,42 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     return s;
   }
 
-  // Upper triangle of A W Aᵀ, A = [Dt Ct]ᵀ, as a sparse product over the edges (Gustavson's algorithm):
-  // column c gathers, for each edge a in column c of [Dt Ct], the rows r ≤ c that edge a touches.
-  Csc normal_matrix(const SparseMatrix& Dt, const SparseMatrix& Ct) {
+  // Upper triangle of A W Aᵀ as a sparse product over the edges (Gustavson's algorithm): column c
+  // gathers, for each edge a in row c of A, the rows r ≤ c that edge a touches.
+  Csc normal_matrix(const EdgeEnds& ends, int nV, const SparseMatrix& Et, const SparseMatrix& Ct) {
     const int n = nD + nC;
-    // The rows of [Dt Ct] (per edge, the constraint rows touching it, in increasing order) by a
-    // counting-sort transpose.
+    // The rows of A touching each edge (edge_start_/edge_row_/edge_coefficient_), by counting.
     std::vector<int>& start = edge_start_;
     start.assign(static_cast<size_t>(m) + 1, 0);
-    auto for_each_entry = [&](auto&& visit) {
-      for (int c = 0; c < n; ++c) {
-        const SparseMatrix& S = c < nD ? Dt : Ct;
-        for (SparseMatrix::InnerIterator it(S, c < nD ? c : c - nD); it; ++it) visit(c, static_cast<int>(it.row()), it.value());
-      }
+    auto for_each_sparse_entry = [&](auto&& visit) {  // (row of A, edge, coefficient) of Et and Ct
+      for (int c = 0; c < static_cast<int>(Et.cols()); ++c)
+        for (SparseMatrix::InnerIterator it(Et, c); it; ++it) visit(nV + c, static_cast<int>(it.row()), it.value());
+      for (int c = 0; c < nC; ++c)
+        for (SparseMatrix::InnerIterator it(Ct, c); it; ++it) visit(nD + c, static_cast<int>(it.row()), it.value());
     };
-    for_each_entry([&](int, int a, double) { ++start[a + 1]; });
+    for (int a = 0; a < m; ++a) start[a + 1] = (ends[a][0] >= 0) + (ends[a][1] >= 0);
+    for_each_sparse_entry([&](int, int a, double) { ++start[a + 1]; });
     std::partial_sum(start.begin(), start.end(), start.begin());
-    std::vector<int> next(start.begin(), start.end() - 1);
     std::vector<int>& row_of = edge_row_;
     std::vector<double>& coefficient = edge_coefficient_;
     row_of.resize(start[m]), coefficient.resize(start[m]);
-    for_each_entry([&](int c, int a, double v) { row_of[next[a]] = c, coefficient[next[a]++] = v; });
+    std::vector<int> next(start.begin(), start.end() - 1);
+    for (int a = 0; a < m; ++a)
+      for (int end = 0; end < 2; ++end)
+        if (ends[a][end] >= 0) row_of[next[a]] = ends[a][end], coefficient[next[a]++] = end == 0 ? -1.0 : 1.0;
+    for_each_sparse_entry([&](int r, int a, double v) { row_of[next[a]] = r, coefficient[next[a]++] = v; });
+    // Per vertex row, its edges as (the other end's row or −1, weight): a vertex column of M holds only
+    // vertex rows (the others come after it), so it is read from this list in sequence.
+    std::vector<int> incident_start(static_cast<size_t>(nV) + 1, 0);
+    for (int a = 0; a < m; ++a)
+      for (int end = 0; end < 2; ++end)
+        if (ends[a][end] >= 0) ++incident_start[ends[a][end] + 1];
+    std::partial_sum(incident_start.begin(), incident_start.end(), incident_start.begin());
+    std::vector<std::pair<int, double>> incident(incident_start[nV]);
+    next.assign(incident_start.begin(), incident_start.end() - 1);
+    for (int a = 0; a < m; ++a)
+      for (int end = 0; end < 2; ++end)
+        if (ends[a][end] >= 0) incident[next[ends[a][end]]++] = {ends[a][1 - end], w(a)};
 
     Csc M;
     M.outer.assign(static_cast<size_t>(n) + 1, 0);
@@ -176,17 +198,34 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     M.values.reserve(M.inner.capacity());
     std::vector<double> sum(n, 0.0);
     std::vector<int> seen(n, -1), rows;
+    auto add_edge = [&](int c, int a, double scale) {
+      for (int k = start[a]; k < start[a + 1]; ++k) {
+        const int r = row_of[k];
+        if (r > c) continue;
+        if (seen[r] != c) seen[r] = c, sum[r] = 0, rows.push_back(r);
+        sum[r] += scale * coefficient[k];
+      }
+    };
+    std::vector<std::pair<int, double>> column;
     for (int c = 0; c < n; ++c) {
       rows.clear();
-      const SparseMatrix& S = c < nD ? Dt : Ct;
-      for (SparseMatrix::InnerIterator it(S, c < nD ? c : c - nD); it; ++it) {
-        const int a = static_cast<int>(it.row());
-        const double scale = it.value() * w(a);
-        for (int k = start[a]; k < start[a + 1] && row_of[k] <= c; ++k) {
-          const int r = row_of[k];
-          if (seen[r] != c) seen[r] = c, sum[r] = 0, rows.push_back(r);
-          sum[r] += scale * coefficient[k];
+      if (c < nV) {  // −w to each neighbouring row above the diagonal, Σ w on it (one edge per vertex pair)
+        column.clear();
+        double diagonal = 0;
+        for (int k = incident_start[c]; k < incident_start[c + 1]; ++k) {
+          const auto [other, weight] = incident[k];
+          diagonal += weight;
+          if (other >= 0 && other < c) column.emplace_back(other, -weight);
         }
+        std::sort(column.begin(), column.end());
+        for (const auto& [r, v] : column) M.inner.push_back(r), M.values.push_back(v);
+        M.inner.push_back(c), M.values.push_back(diagonal);
+        M.outer[c + 1] = static_cast<int>(M.inner.size());
+        continue;
+      } else {
+        const SparseMatrix& S = c < nD ? Et : Ct;
+        for (SparseMatrix::InnerIterator it(S, c < nD ? c - nV : c - nD); it; ++it)
+          add_edge(c, static_cast<int>(it.row()), it.value() * w(static_cast<int>(it.row())));
       }
       std::sort(rows.begin(), rows.end());
       for (int r : rows) M.inner.push_back(r), M.values.push_back(sum[r]);
@@ -577,6 +616,7 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
   double epsilon = 1e-6;
   {
     std::vector<double> positive;
+    positive.reserve(nE);
     for (int e = 0; e < nE; ++e)
       if (weights_(e) > 0) positive.push_back(weights_(e));
     if (!positive.empty()) {
@@ -629,47 +669,40 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
 
   const int m = static_cast<int>(active_edges_.size());
   const int nC = static_cast<int>(rows_.size());
-  SparseMatrix Dt(m, num_vertex_rows_), Ct(m, nC);
-  {
-    // Dt column by column (a vertex row's edges, in increasing order), straight into compressed storage.
-    std::vector<int> count(num_vertex_rows_, 0);
-    for (int a = 0; a < m; ++a)
-      for (int end = 0; end < 2; ++end)
-        if (const int r = vertex_row_[t.edge_vertices(active_edges_[a], end)]; r >= 0) ++count[r];
-    Dt.reserve(count);
-    for (int a = 0; a < m; ++a)
-      for (int end = 0; end < 2; ++end)
-        if (const int r = vertex_row_[t.edge_vertices(active_edges_[a], end)]; r >= 0) Dt.insert(a, r) = end == 0 ? -1.0 : 1.0;
-    Dt.makeCompressed();
+  // The vertex rows of A as the rows of each edge's ends; the cycle and path rows as sparse columns.
+  EdgeEnds ends(m);
+  for (int a = 0; a < m; ++a)
+    for (int end = 0; end < 2; ++end) ends[a][end] = vertex_row_[t.edge_vertices(active_edges_[a], end)];
+  auto columns_of = [&](int count, const std::function<const DualCycle&(int)>& cycle) {
     std::vector<Triplet> trip;
-    for (int r = 0; r < nC; ++r) {
-      const DualCycle& cycle = cycle_of_row(r);
-      for (size_t k = 0; k < cycle.edges.size(); ++k)
-        if (edge_column_[cycle.edges[k]] >= 0) trip.emplace_back(edge_column_[cycle.edges[k]], r, cycle.signs[k]);
+    for (int r = 0; r < count; ++r) {
+      const DualCycle& c = cycle(r);
+      for (size_t k = 0; k < c.edges.size(); ++k)
+        if (edge_column_[c.edges[k]] >= 0) trip.emplace_back(edge_column_[c.edges[k]], r, c.signs[k]);
     }
-    Ct.setFromTriplets(trip.begin(), trip.end());  // sums repeated edges of a cycle
-  }
+    SparseMatrix S(m, count);
+    S.setFromTriplets(trip.begin(), trip.end());  // sums repeated edges of a cycle
+    return S;
+  };
+  const SparseMatrix Ct = columns_of(nC, [&](int r) -> const DualCycle& { return cycle_of_row(r); });
   Eigen::VectorXd w(m);
   for (int a = 0; a < m; ++a) w(a) = weights_(active_edges_[a]);
   timings_.assemble += seconds_since(t0);
   if (options.solver == SolverKind::QR) {
+    SparseMatrix Dt(m, num_vertex_rows_);
+    std::vector<Triplet> trip;
+    for (int a = 0; a < m; ++a)
+      for (int end = 0; end < 2; ++end)
+        if (ends[a][end] >= 0) trip.emplace_back(a, ends[a][end], end == 0 ? -1.0 : 1.0);
+    Dt.setFromTriplets(trip.begin(), trip.end());
     engine_ = std::make_unique<QREngine>(Dt, Ct, w, timings_);
   } else if (!sparse_paths_) {
-    engine_ = std::make_unique<CholeskyEngine>(Dt, Ct, w, timings_);
+    engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, SparseMatrix(m, 0), Ct, w, timings_);
   } else {
     // The vertex rows alone (for the field without path constraints), and vertex + path rows together.
-    SparseMatrix Et(m, static_cast<Eigen::Index>(paths_.size())), DEt(m, num_vertex_rows_ + static_cast<Eigen::Index>(paths_.size()));
-    std::vector<Triplet> trip;
-    for (size_t k = 0; k < paths_.size(); ++k) {
-      const DualCycle& path = paths_[k].path;
-      for (size_t i = 0; i < path.edges.size(); ++i)
-        if (edge_column_[path.edges[i]] >= 0) trip.emplace_back(edge_column_[path.edges[i]], static_cast<int>(k), path.signs[i]);
-    }
-    Et.setFromTriplets(trip.begin(), trip.end());
-    DEt.leftCols(num_vertex_rows_) = Dt;
-    DEt.rightCols(Et.cols()) = Et;
-    relaxed_engine_ = std::make_unique<CholeskyEngine>(Dt, SparseMatrix(m, 0), w, timings_);
-    engine_ = std::make_unique<CholeskyEngine>(DEt, Ct, w, timings_);
+    const SparseMatrix Et = columns_of(static_cast<int>(paths_.size()), [&](int k) -> const DualCycle& { return paths_[k].path; });
+    relaxed_engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, SparseMatrix(m, 0), SparseMatrix(m, 0), w, timings_);
+    engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, Et, Ct, w, timings_);
   }
   t0 = Clock::now();
   Eigen::VectorXd base(num_vertex_rows_);
@@ -696,36 +729,60 @@ const DualCycle& ConnectionSolver::cycle_of_row(int r) const {
 // recomputed.
 void ConnectionSolver::connect_isolated_vertices(double epsilon) {
   const Topology& t = topology_;
-  bool changed = false;
-  for (int round = 0;; ++round) {
-    std::vector<int> parent(t.num_vertices);
-    std::iota(parent.begin(), parent.end(), 0);
-    auto find = [&](int a) {
-      while (parent[a] != a) a = parent[a] = parent[parent[a]];
-      return a;
-    };
-    for (int e = 0; e < t.num_edges; ++e)
-      if (weights_(e) > 0) parent[find(t.edge_vertices(e, 0))] = find(t.edge_vertices(e, 1));
-    std::vector<char> grounded(t.num_vertices, 0);
-    for (int v = 0; v < t.num_vertices; ++v)
-      if (t.is_boundary_vertex(v)) grounded[find(v)] = 1;
-    for (int v : dropped_vertex_)
-      if (v >= 0) grounded[find(v)] = 1;
-    int added = 0, isolated = -1;
-    for (int v = 0; v < t.num_vertices; ++v) {
-      if (vertex_row_[v] < 0 || grounded[find(v)]) continue;
-      isolated = v;
+  // Through interior edges every vertex reaches the boundary or its component's dropped vertex (an edge
+  // with an interior end is interior), so only zero weights can cut a vertex off.
+  bool any_zero = false;
+  for (int e = 0; e < t.num_edges && !any_zero; ++e) any_zero = !t.is_boundary_edge(e) && weights_(e) == 0;
+  if (!any_zero) return;
+  // Breadth-first search from the grounded vertices through edges of positive weight; each round gives
+  // the zero-weight edges of the vertices it did not reach a small weight and carries the search on.
+  std::vector<char> grounded(t.num_vertices, 0);
+  std::vector<int> queue;
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (t.is_boundary_vertex(v)) grounded[v] = 1, queue.push_back(v);
+  for (int v : dropped_vertex_)
+    if (v >= 0 && !grounded[v]) grounded[v] = 1, queue.push_back(v);
+  size_t searched = 0;
+  auto search = [&] {
+    for (; searched < queue.size(); ++searched) {
+      const int v = queue[searched];
       for (int a = t.vertex_edge_offsets[v]; a < t.vertex_edge_offsets[v + 1]; ++a) {
         const int e = t.vertex_edges[a];
-        if (!t.is_boundary_edge(e) && weights_(e) == 0) weights_(e) = epsilon, ++added;
+        if (!(weights_(e) > 0)) continue;
+        const int u = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+        if (!grounded[u]) grounded[u] = 1, queue.push_back(u);
       }
     }
-    if (isolated < 0) break;
+  };
+  search();
+  std::vector<int> isolated_vertices;
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (vertex_row_[v] >= 0 && !grounded[v]) isolated_vertices.push_back(v);
+  bool changed = false;
+  while (!isolated_vertices.empty()) {
+    int added = 0;
+    for (int v : isolated_vertices) {
+      for (int a = t.vertex_edge_offsets[v]; a < t.vertex_edge_offsets[v + 1]; ++a) {
+        const int e = t.vertex_edges[a];
+        if (t.is_boundary_edge(e) || weights_(e) != 0) continue;
+        weights_(e) = epsilon, ++added;
+        // The search goes on from the grounded end of a newly weighted edge.
+        for (int end = 0; end < 2; ++end) {
+          const int u = t.edge_vertices(e, end), other = t.edge_vertices(e, 1 - end);
+          if (grounded[u] && !grounded[other]) grounded[other] = 1, queue.push_back(other);
+        }
+      }
+    }
     if (added == 0)  // cannot happen on a connected component; kept as a guard against an endless loop
-      throw Error("interior vertex " + std::to_string(isolated) + " cannot be joined to the rest of component " +
-                  std::to_string(t.vertex_component[isolated]) + " through weighted edges; use --weights unit");
+      throw Error("interior vertex " + std::to_string(isolated_vertices[0]) + " cannot be joined to the rest of component " +
+                  std::to_string(t.vertex_component[isolated_vertices[0]]) + " through weighted edges; use --weights unit");
     regularized_edges_ += added;
     changed = true;
+    search();
+    std::vector<int> still;
+    for (int v : isolated_vertices)
+      if (!grounded[v]) still.push_back(v);
+    isolated_vertices.swap(still);
   }
   if (!changed) return;
   active_edges_.clear();

@@ -47,27 +47,34 @@ void check_face_indices(const MatrixX3i& F, int num_vertices) {
 
 // Groups the 3F half-edges (h = 3f + k, from corner k to k+1) into undirected edges. Returns the edge
 // id of every half-edge; edges are numbered in order of first appearance. Linear time whatever the
-// valences: a two-pass counting sort orders half-edges by (smaller vertex, larger vertex, h), so the
-// half-edges of one edge become neighbours.
+// valences: one counting sort buckets the half-edges by their smaller vertex (in increasing h), then
+// each bucket is sorted stably by the larger vertex (insertion sort: buckets hold about six entries; a
+// merge sort for the rare large ones), so the half-edges of one edge become neighbours, smallest h first.
 std::vector<int> match_half_edges(const MatrixX3i& F, int num_vertices, int& num_edges) {
-  const int H = static_cast<int>(F.rows()) * 3;
-  auto lo = [&](int h) { return std::min(F(h / 3, h % 3), F(h / 3, (h % 3 + 1) % 3)); };
-  auto hi = [&](int h) { return std::max(F(h / 3, h % 3), F(h / 3, (h % 3 + 1) % 3)); };
-  auto counting_sort = [&](const std::vector<int>& in, auto key) {  // stable
-    std::vector<int> offset(num_vertices + 1, 0), out(in.size());
-    for (int h : in) ++offset[key(h) + 1];
-    for (int v = 0; v < num_vertices; ++v) offset[v + 1] += offset[v];
-    for (int h : in) out[offset[key(h)]++] = h;
-    return out;
-  };
-  std::vector<int> order(H);
-  std::iota(order.begin(), order.end(), 0);
-  order = counting_sort(counting_sort(order, hi), lo);
+  const int nF = static_cast<int>(F.rows()), H = 3 * nF;
+  std::vector<int> offset(static_cast<size_t>(num_vertices) + 1, 0);
+  for (int k = 0; k < 3; ++k)
+    for (int f = 0; f < nF; ++f) ++offset[std::min(F(f, k), F(f, (k + 1) % 3)) + 1];
+  std::partial_sum(offset.begin(), offset.end(), offset.begin());
+  std::vector<std::pair<int, int>> bucket(H);  // (larger vertex, h), by smaller vertex
+  {
+    std::vector<int> fill(offset.begin(), offset.end() - 1);
+    for (int f = 0; f < nF; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = F(f, k), b = F(f, (k + 1) % 3);
+        bucket[fill[std::min(a, b)]++] = {std::max(a, b), 3 * f + k};
+      }
+  }
   std::vector<int> first_of(H);  // the first half-edge (smallest h) of h's edge
-  for (int a = 0; a < H; ++a) {
-    const int h = order[a];
-    const bool same_edge = a > 0 && lo(order[a - 1]) == lo(h) && hi(order[a - 1]) == hi(h);
-    first_of[h] = same_edge ? first_of[order[a - 1]] : h;
+  for (int v = 0; v < num_vertices; ++v) {
+    const auto begin = bucket.begin() + offset[v], end = bucket.begin() + offset[v + 1];
+    if (end - begin > 32) {
+      std::stable_sort(begin, end, [](const auto& x, const auto& y) { return x.first < y.first; });
+    } else {
+      for (auto i = begin + 1; i < end; ++i)
+        for (auto j = i; j > begin && (j - 1)->first > j->first; --j) std::iter_swap(j - 1, j);
+    }
+    for (auto i = begin; i < end; ++i) first_of[i->second] = i > begin && (i - 1)->first == i->first ? first_of[(i - 1)->second] : i->second;
   }
   std::vector<int> edge_of(H);
   num_edges = 0;
@@ -147,9 +154,15 @@ Topology build_topology(const MatrixX3i& F_in, int num_vertices) {
 
   // Components and orientation: breadth-first over faces; flip[g] says whether g must be reversed to
   // agree with the component's first face.
-  auto same_direction = [&](int h0, int h1) {
-    return F_in(h0 / 3, h0 % 3) == F_in(h1 / 3, h1 % 3);
-  };
+  // twin[h] = 2 h' + s for the other half-edge h' of h's edge, s = 1 when both run the same way (one of
+  // the two faces must flip); −1 on the boundary. Built once so that the search reads it in sequence.
+  std::vector<int> twin(H, -1);
+  for (int e = 0; e < nE; ++e) {
+    if (edge_count[e] != 2) continue;
+    const int h0 = edge_half[e][0], h1 = edge_half[e][1];
+    const int same = F_in(h0 / 3, h0 % 3) == F_in(h1 / 3, h1 % 3);
+    twin[h0] = 2 * h1 + same, twin[h1] = 2 * h0 + same;
+  }
   t.face_component.assign(nF, -1);
   std::vector<char> flip(nF, 0);
   std::vector<int> queue;
@@ -165,11 +178,10 @@ Topology build_topology(const MatrixX3i& F_in, int num_vertices) {
     for (size_t q = begin; q < queue.size(); ++q) {
       const int f = queue[q];
       for (int k = 0; k < 3; ++k) {
-        const int h = 3 * f + k, e = edge_of[h];
-        if (edge_count[e] != 2) continue;
-        const int h2 = edge_half[e][0] == h ? edge_half[e][1] : edge_half[e][0];
-        const int g = h2 / 3;
-        const char want = flip[f] ^ (same_direction(h, h2) ? 1 : 0);
+        const int code = twin[3 * f + k];
+        if (code < 0) continue;
+        const int g = (code >> 1) / 3;
+        const char want = flip[f] ^ static_cast<char>(code & 1);
         if (t.face_component[g] < 0) {
           t.face_component[g] = c;
           flip[g] = want;
