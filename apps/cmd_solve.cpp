@@ -213,6 +213,7 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   report["weights"] = o.weights;
   report["solver"] = o.solver;
   report["blas_kernels"] = blas_kernels();
+  report["ordering"] = designer.solver().ordering();
   nlohmann::ordered_json sing = nlohmann::ordered_json::array();
   for (auto [v, n] : prescription.vertex) sing.push_back({{"vertex", v}, {"index", format_index(n, prescription.N)}});
   report["singularities"] = sing;

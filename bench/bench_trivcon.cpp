@@ -344,6 +344,7 @@ int child_run(const RunOptions& o) {
   result["N"] = o.N;
   result["weights"] = o.weights;
   result["singularities"] = gen.singularities();
+  result["ordering"] = p.solver->ordering();
   result["stages"] = json{{"read_ply", read_ply.to_json()}, {"read_obj", read_obj.to_json()}, {"read_ascii", read_ascii.to_json()},
                           {"topology", topo.to_json()},     {"geometry", geom.to_json()},     {"cycles", cyc.to_json()},
                           {"plan", plan.to_json()},         {"setup", setup.to_json()},       {"assemble", assemble.to_json()}, {"factor", factor.to_json()},
@@ -591,8 +592,8 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
   }
   out << "\n### Mesh facts and checks (last edit, verified outside the timings)\n\n";
   out << "| mesh | vertices | components | loops | generators | singularities (N) | max vertex residual | max cycle residual | "
-         "transport mismatch | index mismatches | edges with \\|x\\| ≥ π/N | verify (not in edit) | load avg before / after |\n";
-  out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+         "transport mismatch | index mismatches | edges with \\|x\\| ≥ π/N | verify (not in edit) | fill-reducing order | load avg before / after |\n";
+  out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|\n";
   for (const json& r : runs) {
     if (r.value("status", "") != "ok") continue;
     const json& m = r["mesh"];
@@ -604,7 +605,8 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
     out << "| " << label(r) << " | " << m["vertices"].get<long>() << " | " << m["components"].get<long>() << " | "
         << m["boundary_loops"].get<long>() << " | " << m["generators"].get<long>() << " | " << r["singularities"].get<int>() << " ("
         << r["N"].get<int>() << ") | " << res[0] << " | " << res[1] << " | " << res[2] << " | " << c["index_mismatch_vertices"].get<int>()
-        << " | " << c.value("large_turn_edges", -1) << " | " << ms(med(r["edits"], "verify")) << " | " << fmt(r.value("loadavg_before", NAN), 2) << " / "
+        << " | " << c.value("large_turn_edges", -1) << " | " << ms(med(r["edits"], "verify")) << " | " << r.value("ordering", std::string("?"))
+        << " | " << fmt(r.value("loadavg_before", NAN), 2) << " / "
         << fmt(r.value("loadavg_after", NAN), 2) << " |\n";
   }
 
