@@ -51,7 +51,6 @@ Eigen::Vector3d Geometry::direction_in_face(int f, double beta) const {
 Geometry compute_geometry(const MatrixX3d& V, const Topology& t) {
   const int nF = t.num_faces, nE = t.num_edges, nV = t.num_vertices;
   Geometry g;
-  g.vertex_position = V;
   g.corner_angles.resize(nF, 3);
   g.half_edge_angle.resize(nF, 3);
   g.face_area.resize(nF);

@@ -1,6 +1,6 @@
-// Internal to the solver: fill-reducing orders for the vertex block of the normal matrix (see solver.cpp).
+// Internal to the solver: the pattern and elimination tree of the normal matrix's vertex block, to
+// postorder a fill-reducing order (see CholeskyEngine::vertex_order in solver.cpp).
 #pragma once
-#include <array>
 #include <vector>
 
 namespace trivcon::ordering {
@@ -12,12 +12,6 @@ struct Pattern {
   std::vector<int> start, neighbour;  // neighbours of row r: neighbour[start[r] … start[r + 1])
 };
 Pattern leading_block_pattern(const std::vector<int>& outer, const std::vector<int>& inner, int n);
-
-// Nested dissection by coordinate bisection: each part is split at the median of its longest extent,
-// the smaller set of vertices with a neighbour across the cut is its separator, down to parts of at
-// most `leaf` rows. Returns a constraint set per row (for CAMD): parts before their separators, so
-// that the sets, in increasing order, are a postorder of the dissection tree. O(n log n).
-std::vector<int> coordinate_dissection(const Pattern& pattern, const std::vector<std::array<float, 3>>& position, int leaf);
 
 // The elimination tree of the block in the order `order` (order[k] = row eliminated k-th), Liu's
 // algorithm: parent[k] (positions), −1 at roots.

@@ -8,7 +8,6 @@
 #include <functional>
 #include <cmath>
 #include <numeric>
-#include <thread>
 
 #include "ordering.h"
 #include "trivcon/error.h"
@@ -23,10 +22,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 // Beyond this many fixed-face paths the Cholesky route keeps them out of the dense block.
 constexpr int kMaxDensePaths = 256;
-// The nested-dissection candidate order (CholeskyEngine::analyse) is tried from this many vertex rows,
-// with parts of at most kDissectionLeaf rows left to minimum degree.
-constexpr int kMinDissectionRows = 20000;
-constexpr int kDissectionLeaf = 3000;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
 using Clock = std::chrono::steady_clock;
@@ -78,7 +73,6 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   std::vector<int> edge_start_, edge_row_;
   std::vector<double> edge_coefficient_;
   Eigen::MatrixXd R_CC, R_inv;  // lower triangular; P = R_invᵀ R_inv
-  bool dissection_chosen = false;  // the nested-dissection order had fewer flops
   // Upper triangle of M, compressed columns.
   struct Csc {
     std::vector<int> outer, inner;
@@ -94,9 +88,8 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   // The rows of A: vertex rows given per active edge by its two ends (coefficients −1 for ends[a][0] and
   // +1 for ends[a][1], −1 where an end has no row), then the extra rows Et (m × nX, fixed-face paths that
   // are ordered with the vertex rows), then the cycle rows Ct (m × nC, last).
-  // `position`: coordinates of the vertex rows, for the nested-dissection candidate order (empty: none).
   CholeskyEngine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et, const SparseMatrix& Ct, const Eigen::VectorXd& w_,
-                 const std::vector<std::array<float, 3>>& position, SetupTimings& timings)
+                 SetupTimings& timings)
       : w(w_) {
     start(cc);
     m = static_cast<int>(ends.size()), nD = num_vertex_rows + static_cast<int>(Et.cols()), nC = static_cast<int>(Ct.cols());
@@ -107,43 +100,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     if (n == 0) return;
 
     t0 = Clock::now();
-    // Two candidate orders, analysed side by side (the second core is idle during analysis): minimum
-    // degree, and, on large meshes, minimum degree within a nested dissection by coordinates. The one
-    // with fewer factorization flops is factored.
-    const ordering::Pattern pattern = ordering::leading_block_pattern(M.outer, M.inner, nD);
-    const bool dissect = static_cast<int>(position.size()) == nD && nD >= kMinDissectionRows;
-    cholmod_common alternative_cc;
-    cholmod_factor* alternative = nullptr;
-    std::exception_ptr alternative_error;
-    std::thread dissection;
-    if (dissect) {
-      start(alternative_cc);
-      dissection = std::thread([&] {
-        try {
-          alternative = analyse(M, pattern, ordering::coordinate_dissection(pattern, position, kDissectionLeaf), alternative_cc);
-        } catch (...) {
-          alternative_error = std::current_exception();
-        }
-      });
-    }
-    try {
-      factor = analyse(M, pattern, {}, cc);
-    } catch (...) {
-      if (dissection.joinable()) dissection.join();
-      if (alternative) cholmod_free_factor(&alternative, &alternative_cc);
-      if (dissect) cholmod_finish(&alternative_cc);
-      throw;
-    }
-    if (dissection.joinable()) dissection.join();
-    if (dissect) {
-      if (alternative && !alternative_error && alternative_cc.fl < cc.fl) {
-        std::swap(cc, alternative_cc);  // plain C structs: the factor goes on with the common that made it
-        std::swap(factor, alternative);
-        dissection_chosen = true;
-      }
-      if (alternative) cholmod_free_factor(&alternative, &alternative_cc);
-      cholmod_finish(&alternative_cc);
-    }
+    factor = symbolic(M, vertex_order(M), cc);
     cholmod_sparse A = view(M, n);
     const int* perm = static_cast<const int*>(factor->Perm);
     cholmod_factorize(&A, factor, &cc);
@@ -179,7 +136,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     cholmod_finish(&cc);
   }
 
-  std::string ordering() const override { return dissection_chosen ? "nested dissection + CAMD" : nC > 0 ? "CAMD" : "AMD"; }
+  std::string ordering() const override { return nC > 0 ? "CAMD" : "AMD"; }
 
   void check(bool ok, const char* what) const {
     if (!ok) throw Error(std::string(what) + " (CHOLMOD status " + std::to_string(cc.status) + ")");
@@ -274,7 +231,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     return M;
   }
 
-  static void start(cholmod_common& c) {
+  static void start(cholmod_common& c) {  // supernodal LLᵀ
     cholmod_start(&c);
     c.print = 0;
     c.supernodal = CHOLMOD_SUPERNODAL;
@@ -284,36 +241,40 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     if (!ok) throw Error(std::string(what) + " (CHOLMOD status " + std::to_string(c.status) + ")");
   }
 
-  // Symbolic analysis of the whole system in a fill-reducing order of the vertex rows, the cycle rows
-  // last. The vertex order is minimum degree (AMD; CAMD when there are cycle rows or constraint `sets`,
-  // so that it sees how the cycle rows couple the vertices: a quarter fewer flops on the dragon), then
+  // A fill-reducing order of the vertex rows (the cycle rows come last). Minimum degree (AMD; CAMD when
+  // there are cycle rows, constrained to order them last, so that it sees how they couple the vertices:
+  // a quarter fewer flops on the dragon), then
   // postordered by the vertex block's elimination tree so that CHOLMOD finds large supernodes without
   // postordering the whole system (which could move the cycle rows). Not CHOLMOD's default choice,
   // which tries METIS on large meshes: its analysis alone takes 3 s (the dragon) to 16 s (the dragon
-  // subdivided) on our 2-core machine, more than the fill it saves.
-  cholmod_factor* analyse(Csc& M, const ordering::Pattern& pattern, const std::vector<int>& sets, cholmod_common& c) const {
-    const int n = nD + nC;
+  // subdivided) on our 2-core machine, more than the fill it saves. (A nested dissection by vertex
+  // coordinates, tried as a second candidate, cut the flops by a third on smooth closed surfaces but not
+  // the time with AVX-512 BLAS kernels, and lost on the dragon; see BENCHMARKS.md.)
+  std::vector<int> vertex_order(Csc& M) const {
     std::vector<int> order(nD);
-    if (nD > 0) {
-      if (nC > 0 || !sets.empty()) {
-        cholmod_sparse A = view(M, n);
-        std::vector<int> member(n, 0), full(n);
-        if (!sets.empty()) std::copy(sets.begin(), sets.end(), member.begin());
-        const int last = sets.empty() ? 1 : *std::max_element(sets.begin(), sets.end()) + 1;
-        std::fill(member.begin() + nD, member.end(), last);
-        require(cholmod_camd(&A, nullptr, 0, member.data(), full.data(), &c) != 0, "CHOLMOD could not order the constraint system", c);
-        std::copy(full.begin(), full.begin() + nD, order.begin());
-        for (int k = 0; k < nD; ++k) require(order[k] < nD, "CHOLMOD did not order the cycle rows last", c);
-      } else {
-        cholmod_sparse A = view(M, nD);
-        require(cholmod_amd(&A, nullptr, 0, order.data(), &c) != 0, "CHOLMOD could not order the vertex Laplacian", c);
-      }
-      std::vector<int> parent = ordering::elimination_tree(pattern, order), post(nD);
-      require(cholmod_postorder(parent.data(), nD, nullptr, post.data(), &c) == nD, "CHOLMOD could not postorder the elimination tree", c);
-      std::vector<int> postordered(nD);
-      for (int k = 0; k < nD; ++k) postordered[k] = order[post[k]];
-      order.swap(postordered);
+    if (nD == 0) return order;
+    if (nC > 0) {
+      cholmod_sparse A = view(M, nD + nC);
+      std::vector<int> last(nD + nC, 0), full(nD + nC);
+      std::fill(last.begin() + nD, last.end(), 1);
+      require(cholmod_camd(&A, nullptr, 0, last.data(), full.data(), &cc) != 0, "CHOLMOD could not order the constraint system", cc);
+      std::copy(full.begin(), full.begin() + nD, order.begin());
+      for (int k = 0; k < nD; ++k) require(order[k] < nD, "CHOLMOD did not order the cycle rows last", cc);
+    } else {
+      cholmod_sparse A = view(M, nD);
+      require(cholmod_amd(&A, nullptr, 0, order.data(), &cc) != 0, "CHOLMOD could not order the vertex Laplacian", cc);
     }
+    const ordering::Pattern pattern = ordering::leading_block_pattern(M.outer, M.inner, nD);
+    std::vector<int> parent = ordering::elimination_tree(pattern, order), post(nD);
+    require(cholmod_postorder(parent.data(), nD, nullptr, post.data(), &cc) == nD, "CHOLMOD could not postorder the elimination tree", cc);
+    std::vector<int> postordered(nD);
+    for (int k = 0; k < nD; ++k) postordered[k] = order[post[k]];
+    return postordered;
+  }
+
+  // Symbolic analysis of the whole system: the vertex rows in `order`, then the cycle rows.
+  cholmod_factor* symbolic(Csc& M, std::vector<int> order, cholmod_common& c) const {
+    const int n = nD + nC;
     for (int r = nD; r < n; ++r) order.push_back(r);
     cholmod_sparse A = view(M, n);
     c.nmethods = 1;
@@ -725,13 +686,6 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
   const SparseMatrix Ct = columns_of(nC, [&](int r) -> const DualCycle& { return cycle_of_row(r); });
   Eigen::VectorXd w(m);
   for (int a = 0; a < m; ++a) w(a) = weights_(active_edges_[a]);
-  std::vector<std::array<float, 3>> position;  // of the vertex rows
-  if (options.solver == SolverKind::Cholesky && geometry.vertex_position.rows() == nV) {
-    position.resize(num_vertex_rows_);
-    for (int v = 0; v < nV; ++v)
-      if (vertex_row_[v] >= 0)
-        for (int d = 0; d < 3; ++d) position[vertex_row_[v]][d] = static_cast<float>(geometry.vertex_position(v, d));
-  }
   timings_.assemble += seconds_since(t0);
   if (options.solver == SolverKind::QR) {
     SparseMatrix Dt(m, num_vertex_rows_);
@@ -742,12 +696,12 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
     Dt.setFromTriplets(trip.begin(), trip.end());
     engine_ = std::make_unique<QREngine>(Dt, Ct, w, timings_);
   } else if (!sparse_paths_) {
-    engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, SparseMatrix(m, 0), Ct, w, position, timings_);
+    engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, SparseMatrix(m, 0), Ct, w, timings_);
   } else {
     // The vertex rows alone (for the field without path constraints), and vertex + path rows together.
     const SparseMatrix Et = columns_of(static_cast<int>(paths_.size()), [&](int k) -> const DualCycle& { return paths_[k].path; });
-    relaxed_engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, SparseMatrix(m, 0), SparseMatrix(m, 0), w, position, timings_);
-    engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, Et, Ct, w, std::vector<std::array<float, 3>>{}, timings_);
+    relaxed_engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, SparseMatrix(m, 0), SparseMatrix(m, 0), w, timings_);
+    engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, Et, Ct, w, timings_);
   }
   t0 = Clock::now();
   Eigen::VectorXd base(num_vertex_rows_);

@@ -228,29 +228,6 @@ TEST(Solver, SparseAndFullForwardSubstitutionsAgreeWithQr) {
   }
 }
 
-// From 20k vertex rows the solver also analyses a nested-dissection order and factors whichever has
-// fewer flops: on smooth closed surfaces that is the dissection (asserted, so that this route is tested),
-// and the connection must be the same as the paper-literal QR one.
-TEST(Solver, NestedDissectionOrderGivesTheSameConnection) {
-  struct Mesh_ {
-    std::string name;
-    Mesh mesh;
-  };
-  const std::vector<Mesh_> meshes = {{"cube_sphere", make_cube_sphere(60, true)}, {"torus", make_torus(250, 100)}};
-  for (const Mesh_& m : meshes) {
-    SCOPED_TRACE(m.name);
-    FieldDesigner chol(m.mesh.V, m.mesh.F);
-    FieldDesigner qr(m.mesh.V, m.mesh.F, SolverOptions{WeightKind::Cotan, SolverKind::QR});
-    const IndexPrescription p = gauss_bonnet_prescription(chol.topology(), 4);
-    const Design a = chol.design(p), b = qr.design(p);
-    EXPECT_EQ(chol.solver().ordering(), "nested dissection + CAMD");
-    expect_exact(chol, a, p);
-    EXPECT_EQ(a.connection.generator_index, b.connection.generator_index);
-    EXPECT_LE(max_abs(a.connection.x - b.connection.x), 1e-8 * std::max(1.0, max_abs(a.connection.x)));
-    EXPECT_NEAR(a.connection.energy, b.connection.energy, 1e-8 * std::max(1.0, a.connection.energy));
-  }
-}
-
 TEST(Solver, UnitWeightsAreExact) {
   for (const Case& c : generated_cases()) {
     SCOPED_TRACE(c.name);

@@ -35,7 +35,6 @@ struct Geometry {
   Eigen::VectorXd face_area;   // extrinsic area, 0 for degenerate faces
   std::vector<char> degenerate_face;
   MatrixX3d frame_x, frame_y, normal;  // unit vectors; for a degenerate face the normal is borrowed from its neighbours
-  MatrixX3d vertex_position;           // V itself (the solver's nested-dissection ordering uses it)
   Eigen::VectorXd angle_defect;        // per vertex
   Eigen::VectorXd rho;                 // per edge
   Eigen::VectorXd cotan_weight;        // per edge

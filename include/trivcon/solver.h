@@ -19,10 +19,8 @@
 // factored once by CHOLMOD (supernodal, OpenBLAS), the vertex rows in a fill-reducing order and the cycle
 // rows last, so that the
 // trailing block of the factor is the Cholesky factor of the Schur complement S = CWCᵀ −
-// CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is the one with fewer flops of two candidates analysed side by
-// side: minimum degree (CAMD with the cycle rows constrained last, AMD without cycle rows) and, from
-// 20k vertex rows on, CAMD within a nested dissection of the vertices by their coordinates (smooth
-// closed surfaces: a third fewer flops; the dragon: minimum degree wins). A new prescription only changes b: nothing is refactored. The forward substitution
+// CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is minimum degree: CAMD with the cycle rows constrained last, or
+// AMD without cycle rows. A new prescription only changes b: nothing is refactored. The forward substitution
 // of the prescription without singularities is stored, so an edit that places a few singularities
 // updates it along their paths in the elimination tree only, then does one full backward substitution.
 // Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
@@ -96,8 +94,8 @@ class ConnectionSolver {
 
   const Eigen::VectorXd& weights() const { return weights_; }  // per edge, 0 on boundary edges
   const SetupTimings& timings() const { return timings_; }
-  // The fill-reducing order of the factorization: "AMD", "CAMD" or "nested dissection + CAMD" (the
-  // candidate with fewer flops; see the route above), or "SuiteSparseQR default".
+  // The fill-reducing order of the factorization: "AMD" or "CAMD" (see the route above), or
+  // "SuiteSparseQR default".
   std::string ordering() const;
   int num_generators() const { return static_cast<int>(cycles_.generators.size()); }
   // Levi-Civita holonomy the constraints use: K_ℓ per loop, z_γ per generator.
