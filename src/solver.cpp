@@ -57,7 +57,7 @@ namespace {
 // One supernodal Cholesky factorization R Rᵀ = Π M Πᵀ of the whole normal matrix
 //   M = A W Aᵀ = [ D W Dᵀ   D W Cᵀ ]
 //                [ C W Dᵀ   C W Cᵀ ],
-// with the vertex rows in AMD's fill-reducing order (postordered) and the cycle rows C forced last. Then
+// with the vertex rows in a minimum-degree order (vertex_order) and the cycle rows C forced last. Then
 // the trailing block R_CC of the factor is the Cholesky factor of the Schur complement S, so
 // P = S⁻¹ = R_CC⁻ᵀ R_CC⁻¹ costs O(|C|³) with no extra solves, and an edit needs one forward and one
 // backward substitution: the forward part of the vertex rows does not depend on b_C. The forward part is
@@ -85,21 +85,40 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   mutable std::vector<int> super_stamp_;
   mutable int stamp_ = 0;
 
-  // The rows of A: vertex rows given per active edge by its two ends (coefficients −1 for ends[a][0] and
-  // +1 for ends[a][1], −1 where an end has no row), then the extra rows Et (m × nX, fixed-face paths that
-  // are ordered with the vertex rows), then the cycle rows Ct (m × nC, last).
+  // The rows of A: vertex rows given per active edge by the rows of its two ends (coefficient −1 for
+  // ends[a][0], +1 for ends[a][1]; an end without a row, a boundary or dropped vertex, is marked −1), then
+  // the extra rows Et (m × nX, fixed-face paths that are ordered with the vertex rows), then the cycle
+  // rows Ct (m × nC, last).
   CholeskyEngine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et, const SparseMatrix& Ct, const Eigen::VectorXd& w_,
                  SetupTimings& timings)
       : w(w_) {
     start(cc);
     m = static_cast<int>(ends.size()), nD = num_vertex_rows + static_cast<int>(Et.cols()), nC = static_cast<int>(Ct.cols());
     const int n = nD + nC;
-    auto t0 = Clock::now();
-    Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct);
-    timings.assemble += seconds_since(t0);
-    if (n == 0) return;
+    try {
+      auto t0 = Clock::now();
+      Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct);
+      timings.assemble += seconds_since(t0);
+      if (n == 0) return;
+      t0 = Clock::now();
+      factorize(M);
+      timings.factor += seconds_since(t0);
+      t0 = Clock::now();
+      prepare_schur();
+      timings.schur += seconds_since(t0);
+    } catch (...) {  // the destructor does not run for an object whose constructor throws
+      release();
+      throw;
+    }
+  }
+  ~CholeskyEngine() override { release(); }
+  void release() {
+    if (factor) cholmod_free_factor(&factor, &cc);
+    cholmod_finish(&cc);
+  }
 
-    t0 = Clock::now();
+  void factorize(Csc& M) {
+    const int n = nD + nC;
     factor = symbolic(M, vertex_order(M), cc);
     cholmod_sparse A = view(M, n);
     const int* perm = static_cast<const int*>(factor->Perm);
@@ -112,14 +131,12 @@ struct CholeskyEngine : ConnectionSolver::Engine {
                       : "CHOLMOD found the constraint system not positive definite; try --weights unit");
     }
     check(cc.status == CHOLMOD_OK && factor->is_super && factor->is_ll, "CHOLMOD factorization failed");
-    {
-      const int* final_perm = static_cast<const int*>(factor->Perm);
-      for (int k = nD; k < n; ++k) check(final_perm[k] == k, "CHOLMOD did not keep the cycle rows last");
-    }
+    for (int k = nD; k < n; ++k) check(perm[k] == k, "CHOLMOD did not keep the cycle rows last");
     prepare_sparse_forward();
-    timings.factor += seconds_since(t0);
+  }
 
-    t0 = Clock::now();
+  // R_CC and its inverse: the Schur complement's factor, for choosing free cycle indices.
+  void prepare_schur() {
     extract_cycle_block();
     if (nC > 0) {
       const double min_diag = R_CC.diagonal().minCoeff(), max_diag = R_CC.diagonal().maxCoeff();
@@ -129,11 +146,6 @@ struct CholeskyEngine : ConnectionSolver::Engine {
       R_inv = R_CC.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(nC, nC));
       P_diagonal = R_inv.colwise().squaredNorm().transpose();
     }
-    timings.schur += seconds_since(t0);
-  }
-  ~CholeskyEngine() override {
-    if (factor) cholmod_free_factor(&factor, &cc);
-    cholmod_finish(&cc);
   }
 
   std::string ordering() const override { return nC > 0 ? "CAMD" : "AMD"; }
@@ -447,9 +459,22 @@ struct QREngine : ConnectionSolver::Engine {
   }
 
   QREngine(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w, SetupTimings& timings) {
-    auto t0 = Clock::now();
     cholmod_l_start(&cc);
     cc.print = 0;
+    try {
+      set_up(Dt, Ct, w, timings);
+    } catch (...) {  // the destructor does not run for an object whose constructor throws
+      release();
+      throw;
+    }
+  }
+  ~QREngine() override { release(); }
+  void release() {
+    if (qr) SuiteSparseQR_free<double>(&qr, &cc);
+    cholmod_l_finish(&cc);
+  }
+  void set_up(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w, SetupTimings& timings) {
+    auto t0 = Clock::now();
     sqrt_w = w.cwiseSqrt();
     nD = static_cast<int>(Dt.cols()), nC = static_cast<int>(Ct.cols()), m = static_cast<int>(Dt.rows());
     Eigen::SparseMatrix<double, Eigen::ColMajor, SuiteSparse_long> At(m, nD + nC);  // (A W^½)ᵀ
@@ -489,10 +514,6 @@ struct QREngine : ConnectionSolver::Engine {
       P_lower = Eigen::MatrixXd(llt.matrixU()).reverse();
     }
     timings.schur += seconds_since(t0);
-  }
-  ~QREngine() override {
-    if (qr) SuiteSparseQR_free<double>(&qr, &cc);
-    cholmod_l_finish(&cc);
   }
   static cholmod_sparse viewAsCholmod(Eigen::SparseMatrix<double, Eigen::ColMajor, SuiteSparse_long>& M) {
     cholmod_sparse s{};
