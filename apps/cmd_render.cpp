@@ -1,5 +1,6 @@
 // trivcon render MESH --field F -o picture.png [options]: a picture of a field (trivcon/render.h).
 #include <iostream>
+#include <tuple>
 
 #include "commands.h"
 #include "trivcon/cycles.h"
@@ -20,32 +21,33 @@ struct RenderCommand {
   bool flat = false, no_legend = false;
 };
 
+// Two numbers separated by `separator` ("1200x900", "30,20"), each parsed whole by `parse` (std::stoi,
+// std::stod); anything else is `error`.
+template <typename T, typename Parse>
+std::pair<T, T> parse_pair(const std::string& text, char separator, Parse parse, const std::string& error) {
+  const size_t at = text.find(separator);
+  try {
+    size_t end_a = 0, end_b = 0;
+    if (at == std::string::npos) throw std::invalid_argument(text);
+    const T a = parse(text.substr(0, at), &end_a), b = parse(text.substr(at + 1), &end_b);
+    if (end_a != at || end_b != text.size() - at - 1) throw std::invalid_argument(text);
+    return {a, b};
+  } catch (const std::logic_error&) {
+    throw Error(error);
+  }
+}
+
 // "WxH" → (W, H).
 void parse_size(const std::string& text, RenderOptions& o) {
-  const size_t x = text.find('x');
-  try {
-    size_t end_w = 0, end_h = 0;
-    if (x == std::string::npos) throw std::invalid_argument(text);
-    o.width = std::stoi(text.substr(0, x), &end_w);
-    o.height = std::stoi(text.substr(x + 1), &end_h);
-    if (end_w != x || end_h != text.size() - x - 1) throw std::invalid_argument(text);
-  } catch (const std::logic_error&) {
-    throw Error("--size " + text + ": expected WIDTHxHEIGHT, e.g. 1200x900");
-  }
+  std::tie(o.width, o.height) = parse_pair<int>(
+      text, 'x', [](const std::string& s, size_t* end) { return std::stoi(s, end); }, "--size " + text + ": expected WIDTHxHEIGHT, e.g. 1200x900");
 }
 
 // "AZ,EL" in degrees.
 void parse_view(const std::string& text, RenderOptions& o) {
-  const size_t comma = text.find(',');
-  try {
-    size_t end_a = 0, end_e = 0;
-    if (comma == std::string::npos) throw std::invalid_argument(text);
-    o.azimuth = std::stod(text.substr(0, comma), &end_a);
-    o.elevation = std::stod(text.substr(comma + 1), &end_e);
-    if (end_a != comma || end_e != text.size() - comma - 1) throw std::invalid_argument(text);
-  } catch (const std::logic_error&) {
-    throw Error("--view " + text + ": expected AZIMUTH,ELEVATION in degrees, e.g. 30,20");
-  }
+  std::tie(o.azimuth, o.elevation) = parse_pair<double>(
+      text, ',', [](const std::string& s, size_t* end) { return std::stod(s, end); },
+      "--view " + text + ": expected AZIMUTH,ELEVATION in degrees, e.g. 30,20");
 }
 
 void run_render(const RenderCommand& c) {

@@ -8,11 +8,11 @@ namespace trivcon {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-// Into [0, 2π). floor rather than fmod: the same result to round-off, several times faster (one per face
-// per edit).
+// Into [0, 2π), through wrap_angle's (−π, π].
 double wrap_positive(double a) {
-  a -= 2 * kPi * std::floor(a * (1 / (2 * kPi)));
-  return a >= 2 * kPi ? a - 2 * kPi : (a < 0 ? a + 2 * kPi : a);
+  a = wrap_angle(a);
+  if (a < 0) a += 2 * kPi;
+  return a < 2 * kPi ? a : 0.0;  // a tiny negative angle plus 2π can round to 2π
 }
 }  // namespace
 

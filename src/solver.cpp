@@ -83,6 +83,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   std::vector<int> super_of_col_, super_parent_;
   Eigen::VectorXd base_b_, base_z_;  // base right-hand side of the vertex rows, and L⁻¹ Π [base_b; 0]
   mutable std::vector<int> super_stamp_;
+  mutable Eigen::VectorXd forward_work_;
   mutable int stamp_ = 0;
 
   // The rows of A: vertex rows given per active edge by the rows of its two ends (coefficient −1 for
@@ -332,7 +333,8 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     for (const auto& [k, value] : entries)
       for (int s = super_of_col_[k]; s != -1 && super_stamp_[s] != stamp_; s = super_parent_[s]) super_stamp_[s] = stamp_, path.push_back(s);
     std::sort(path.begin(), path.end());
-    Eigen::VectorXd d = Eigen::VectorXd::Zero(z.size());
+    Eigen::VectorXd& d = forward_work_;  // zero outside a call
+    if (d.size() != z.size()) d.setZero(z.size());
     for (const auto& [k, value] : entries) d(k) += value;
     Eigen::VectorXd below;
     for (int s : path) {
@@ -344,7 +346,13 @@ struct CholeskyEngine : ConnectionSolver::Engine {
       below.noalias() = Ls.bottomRows(nrow - ncol) * block;
       for (int i = 0; i < nrow - ncol; ++i) d(rows[pi[s] + ncol + i]) -= below(i);
     }
-    for (int s : path) z.segment(super[s], super[s + 1] - super[s]) += d.segment(super[s], super[s + 1] - super[s]);
+    // Every entry touched lies in the columns of the path's supernodes (the rows below a supernode are
+    // columns of its ancestors): add them to z and zero them again.
+    for (int s : path) {
+      auto touched = d.segment(super[s], super[s + 1] - super[s]);
+      z.segment(super[s], super[s + 1] - super[s]) += touched;
+      touched.setZero();
+    }
   }
 
   // R_CC: the factor's entries at rows and columns ≥ nD (in factor order), read from the supernodes.
@@ -628,6 +636,7 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
     std::vector<char> usable(nE, 0);
     for (int e = 0; e < nE; ++e) usable[e] = weights_(e) > 0;
     paths_ = fixed_face_paths(t, fixed_faces_, usable);
+    for (const FixedPath& path : paths_) path_holonomy_.push_back(levi_civita_holonomy(path.path, geometry));
   }
 
   // A cycle or fixed-face path made only of zero-weight edges could not turn the field at all; its edges
@@ -826,7 +835,7 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   const double step = 2 * kPi / N;
   auto path_holonomy = [&](int k) {  // what the x along path k must add up to, before the 2π/N turns
     const FixedPath& path = paths_[k];
-    return levi_civita_holonomy(path.path, geometry_) - (prescription.fixed.at(path.to_face) - prescription.fixed.at(path.from_face));
+    return path_holonomy_[k] - (prescription.fixed.at(path.to_face) - prescription.fixed.at(path.from_face));
   };
   Eigen::VectorXd b_D(num_vertex_rows_);
   for (int v = 0; v < t.num_vertices; ++v)

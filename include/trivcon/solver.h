@@ -114,7 +114,7 @@ class ConnectionSolver {
   const Cycles& cycles_;
   SolverOptions options_;
   Eigen::VectorXd weights_;
-  std::vector<double> loop_curvature_, generator_holonomy_;
+  std::vector<double> loop_curvature_, generator_holonomy_, path_holonomy_;  // Levi-Civita, per loop / generator / fixed-face path
   SetupTimings timings_;
   std::unique_ptr<Engine> engine_;
   std::unique_ptr<Engine> relaxed_engine_;  // vertex rows only, when the path rows are sparse
