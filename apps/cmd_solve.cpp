@@ -249,10 +249,23 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
                        {"large_turn_edges", d.large_turn_edges}};
   const PrepareTimings& pt = designer.timings();
   const SetupTimings& st = designer.solver().timings();
-  report["seconds"] = {{"read", read_seconds},     {"topology", pt.topology},     {"geometry", pt.geometry},
-                       {"cycles", pt.cycles},      {"setup", pt.setup},           {"setup_assemble", st.assemble},
-                       {"setup_factor", st.factor}, {"setup_schur", st.schur},    {"solve", d.solve_seconds},
-                       {"field", d.field_seconds}, {"verify", d.verify_seconds}, {"write", write_seconds}};
+  report["symbolic_analysis"] = st.analysis_adopted ? "concurrent" : "in set-up";
+  report["seconds"] = {{"read", read_seconds},
+                       {"topology", pt.topology},
+                       {"geometry", pt.geometry},
+                       {"cycles", pt.cycles},
+                       {"plan", pt.plan},
+                       {"analysis", pt.analysis},
+                       {"setup", pt.setup},
+                       {"setup_assemble", st.assemble},
+                       {"setup_analysis_wait", st.analysis_wait},
+                       {"setup_factor", st.factor},
+                       {"setup_schur", st.schur},
+                       {"prepare", pt.prepare},
+                       {"solve", d.solve_seconds},
+                       {"field", d.field_seconds},
+                       {"verify", d.verify_seconds},
+                       {"write", write_seconds}};
   report["verified"] = ok;
   if (!o.report.empty())
     write_file_atomically(staged.path(output_path(o.report, name)), [&](std::ostream& out) { out << report.dump(2) << "\n"; });
@@ -313,8 +326,9 @@ void run_solve(const SolveOptions& o) {
     std::cout << "mesh " << o.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
               << " component(s), chi " << t.euler_characteristic() << ", " << designer.cycles().generators.size() << " generator(s), "
               << t.boundary_loops.size() << " boundary loop(s)\n"
-              << "time: read " << fmt(read_seconds) << " s, topology " << fmt(pt.topology) << " s, geometry " << fmt(pt.geometry) << " s, cycles "
-              << fmt(pt.cycles) << " s, setup " << fmt(pt.setup) << " s\n";
+              << "time: read " << fmt(read_seconds) << " s, prepared in " << fmt(pt.prepare) << " s (topology " << fmt(pt.topology)
+              << " s, geometry " << fmt(pt.geometry) << " s, cycles " << fmt(pt.cycles) << " s, plan " << fmt(pt.plan) << " s, setup "
+              << fmt(pt.setup) << " s)\n";
   bool ok = true;
   if (batch.empty()) {
     ok = solve_one(o, mesh, designer, prescription, roots, "", read_seconds);

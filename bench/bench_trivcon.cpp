@@ -46,6 +46,7 @@
 #include "edits.h"
 #include "trivcon/blas.h"
 #include "trivcon/cycles.h"
+#include "trivcon/design.h"
 #include "trivcon/error.h"
 #include "trivcon/field.h"
 #include "trivcon/generate.h"
@@ -187,19 +188,16 @@ SolverOptions solver_options(const RunOptions& o) {
 }
 
 // Everything the pipeline holds, freed between repetitions.
+// A mesh prepared as a user of the library gets it: FieldDesigner (its second thread included).
 struct Pipeline {
   MeshData mesh;
-  Topology topology;
-  Geometry geometry;
-  Cycles cycles;
-  PropagationPlan plan;
-  std::unique_ptr<ConnectionSolver> solver;
+  std::unique_ptr<FieldDesigner> designer;
+  const Topology& topology() const { return designer->topology(); }
+  const Geometry& geometry() const { return designer->geometry(); }
+  const Cycles& cycles() const { return designer->cycles(); }
+  const PropagationPlan& plan() const { return designer->plan(); }
   void clear() {
-    solver.reset();
-    plan = PropagationPlan{};
-    cycles = Cycles{};
-    geometry = Geometry{};
-    topology = Topology{};
+    designer.reset();
     mesh = MeshData{};
   }
 };
@@ -218,7 +216,7 @@ EditResult timed_edit(const ConnectionSolver& solver, const Pipeline& p, const b
   const auto t1 = Clock::now();
   r.connection = solver.solve(prescription);
   const auto t2 = Clock::now();
-  r.field = propagate_field(p.topology, p.geometry, p.plan, r.connection.x, prescription.N);
+  r.field = propagate_field(p.topology(), p.geometry(), p.plan(), r.connection.x, prescription.N);
   const auto t3 = Clock::now();
   r.solve = std::chrono::duration<double>(t2 - t1).count();
   r.field_time = std::chrono::duration<double>(t3 - t2).count();
@@ -227,14 +225,14 @@ EditResult timed_edit(const ConnectionSolver& solver, const Pipeline& p, const b
 }
 
 json mesh_summary(const Pipeline& p) {
-  const Topology& t = p.topology;
+  const Topology& t = p.topology();
   int max_genus = 0;
   for (const auto& c : t.components) max_genus = std::max(max_genus, c.genus);
   return json{{"vertices", t.num_vertices},    {"faces", t.num_faces},
               {"edges", t.num_edges},          {"components", t.components.size()},
-              {"boundary_loops", t.boundary_loops.size()}, {"generators", p.cycles.generators.size()},
+              {"boundary_loops", t.boundary_loops.size()}, {"generators", p.cycles().generators.size()},
               {"max_genus", max_genus},        {"euler_characteristic", t.euler_characteristic()},
-              {"negative_cotan_edges", p.geometry.negative_cotan_edges}, {"degenerate_faces", p.geometry.degenerate_faces}};
+              {"negative_cotan_edges", p.geometry().negative_cotan_edges}, {"degenerate_faces", p.geometry().degenerate_faces}};
 }
 
 // Verification of one edit (outside the timings): the solver's residuals and the indices read back.
@@ -242,17 +240,17 @@ json verify_edit(const Pipeline& p, const bench::EditGenerator& gen, const std::
   std::mt19937_64 rng(bench::edit_seed(name, index));
   const IndexPrescription prescription = gen.next(rng);
   const auto t0 = Clock::now();
-  const FieldIndices idx = field_indices(p.topology, p.geometry, p.cycles, r.field);
-  const double mismatch = max_transport_mismatch(p.topology, p.geometry, r.connection.x, r.field);
+  const FieldIndices idx = field_indices(p.topology(), p.geometry(), p.cycles(), r.field);
+  const double mismatch = max_transport_mismatch(p.topology(), p.geometry(), r.connection.x, r.field);
   int wrong = 0;
-  for (int v = 0; v < p.topology.num_vertices; ++v) {
-    if (!p.topology.is_interior_vertex(v)) continue;
+  for (int v = 0; v < p.topology().num_vertices; ++v) {
+    if (!p.topology().is_interior_vertex(v)) continue;
     auto it = prescription.vertex.find(v);
     wrong += idx.vertex[v] != (it == prescription.vertex.end() ? 0 : it->second);
   }
   if (verify_time) verify_time->add(seconds_since(t0));
   int large_turns = 0;
-  for (int e = 0; e < p.topology.num_edges; ++e) large_turns += std::abs(r.connection.x(e)) >= 3.14159265358979323846 / prescription.N;
+  for (int e = 0; e < p.topology().num_edges; ++e) large_turns += std::abs(r.connection.x(e)) >= 3.14159265358979323846 / prescription.N;
   return json{{"max_vertex_residual", r.connection.max_vertex_residual},
               {"max_cycle_residual", r.connection.max_cycle_residual},
               {"rhs_scale", r.connection.rhs_scale},
@@ -266,7 +264,8 @@ int child_run(const RunOptions& o) {
   json result;
   result["name"] = o.name;
   result["status"] = "running";
-  Samples read_ply, read_obj, read_ascii, topo, geom, cyc, plan, setup, assemble, factor, schur, prepare, to_setup;
+  Samples read_ply, read_obj, read_ascii, topo, geom, cyc, plan, analysis, setup, assemble, wait, factor, schur, prepare, to_setup;
+  bool adopted = true;
   Pipeline p;
   json rss;
   rss["start"] = peak_rss();
@@ -279,36 +278,24 @@ int child_run(const RunOptions& o) {
     const double t_read = seconds_since(t0);
     if (r == 0) rss["after_read"] = peak_rss();
     t0 = Clock::now();
-    check_finite(p.mesh.V);
-    p.topology = build_topology(p.mesh.F, static_cast<int>(p.mesh.V.rows()));
-    const double t_topo = seconds_since(t0);
-    if (r == 0) rss["after_topology"] = peak_rss();
-    t0 = Clock::now();
-    p.geometry = compute_geometry(p.mesh.V, p.topology);
-    const double t_geom = seconds_since(t0);
-    if (r == 0) rss["after_geometry"] = peak_rss();
-    t0 = Clock::now();
-    p.cycles = compute_cycles(p.topology);
-    const double t_cyc = seconds_since(t0);
-    if (r == 0) rss["after_cycles"] = peak_rss();
-    t0 = Clock::now();
-    p.plan = plan_propagation(p.topology);
-    const double t_plan = seconds_since(t0);
-    t0 = Clock::now();
-    p.solver = std::make_unique<ConnectionSolver>(p.topology, p.geometry, p.cycles, solver_options(o));
-    const double t_setup = seconds_since(t0);
+    p.designer = std::make_unique<FieldDesigner>(p.mesh.V, p.mesh.F, solver_options(o));
+    p.designer->set_fixed_faces({});  // sets up (factors) the solver now
+    const double t_prepare = seconds_since(t0);
     if (r == 0) rss["after_setup"] = peak_rss();
+    const PrepareTimings& pt = p.designer->timings();
+    const SetupTimings& st = p.designer->solver().timings();
     // Fewer repetitions on the largest meshes, where one run takes tens of seconds.
-    if (r == 0 && p.topology.num_faces > kFewRepsFaces) reps = std::min(reps, 3), edits = std::min(edits, 10);
-    log("  " + o.name + (keep ? " rep " : " warm-up ") + std::to_string(r) + ": read " + std::to_string(t_read) + " topology " +
-        std::to_string(t_topo) + " geometry " + std::to_string(t_geom) + " cycles " + std::to_string(t_cyc) + " field plan " + std::to_string(t_plan) + " set-up " +
-        std::to_string(t_setup) + " s");
+    if (r == 0 && p.topology().num_faces > kFewRepsFaces) reps = std::min(reps, 3), edits = std::min(edits, 10);
+    log("  " + o.name + (keep ? " rep " : " warm-up ") + std::to_string(r) + ": read " + std::to_string(t_read) + " prepare " +
+        std::to_string(t_prepare) + " s (topology " + std::to_string(pt.topology) + " geometry " + std::to_string(pt.geometry) + " cycles " +
+        std::to_string(pt.cycles) + " field plan " + std::to_string(pt.plan) + " analysis " + std::to_string(pt.analysis) + " set-up " +
+        std::to_string(pt.setup) + (st.analysis_adopted ? "" : ", own analysis") + ")");
     if (!keep) continue;
-    read_ply.add(t_read), topo.add(t_topo), geom.add(t_geom), cyc.add(t_cyc), plan.add(t_plan), setup.add(t_setup);
-    const SetupTimings& st = p.solver->timings();
-    assemble.add(st.assemble), factor.add(st.factor), schur.add(st.schur);
-    prepare.add(t_topo + t_geom + t_cyc + t_plan + t_setup);
-    to_setup.add(t_read + t_topo + t_geom + t_cyc + t_plan + t_setup);
+    read_ply.add(t_read), topo.add(pt.topology), geom.add(pt.geometry), cyc.add(pt.cycles), plan.add(pt.plan), analysis.add(pt.analysis);
+    setup.add(pt.setup), assemble.add(st.assemble), wait.add(st.analysis_wait), factor.add(st.factor), schur.add(st.schur);
+    prepare.add(t_prepare);
+    to_setup.add(t_read + t_prepare);
+    adopted = adopted && st.analysis_adopted;
   }
   result["mesh"] = mesh_summary(p);
   result["format"] = p.mesh.format;
@@ -320,7 +307,7 @@ int child_run(const RunOptions& o) {
       auto t0 = Clock::now();
       MeshData m = read_mesh(path);
       const double t = seconds_since(t0);
-      if (m.F.rows() != p.topology.num_faces) throw std::runtime_error(path + ": face count differs from the binary PLY");
+      if (m.F.rows() != p.topology().num_faces) throw std::runtime_error(path + ": face count differs from the binary PLY");
       if (r >= o.warmup) s.add(t);
     }
   };
@@ -329,11 +316,11 @@ int child_run(const RunOptions& o) {
   rss["after_reads"] = peak_rss();
 
   // Edits.
-  const bench::EditGenerator gen(p.topology, o.N, o.count);
+  const bench::EditGenerator gen(p.topology(), o.N, o.count);
   Samples solve, field, whole, verify_time;
   EditResult last;
   for (int i = 0; i < o.edit_warmup + edits; ++i) {
-    EditResult r = timed_edit(*p.solver, p, gen, o.name, i);
+    EditResult r = timed_edit(p.designer->solver(), p, gen, o.name, i);
     if (i >= o.edit_warmup) solve.add(r.solve), field.add(r.field_time), whole.add(r.whole);
     if (i + 1 == o.edit_warmup + edits) result["check"] = verify_edit(p, gen, o.name, i, r, &verify_time);
   }
@@ -344,10 +331,12 @@ int child_run(const RunOptions& o) {
   result["N"] = o.N;
   result["weights"] = o.weights;
   result["singularities"] = gen.singularities();
-  result["ordering"] = p.solver->ordering();
+  result["ordering"] = p.designer->solver().ordering();
+  result["analysis_concurrent"] = adopted;
   result["stages"] = json{{"read_ply", read_ply.to_json()}, {"read_obj", read_obj.to_json()}, {"read_ascii", read_ascii.to_json()},
                           {"topology", topo.to_json()},     {"geometry", geom.to_json()},     {"cycles", cyc.to_json()},
-                          {"plan", plan.to_json()},         {"setup", setup.to_json()},       {"assemble", assemble.to_json()}, {"factor", factor.to_json()},
+                          {"plan", plan.to_json()},         {"analysis", analysis.to_json()}, {"setup", setup.to_json()},
+                          {"assemble", assemble.to_json()}, {"analysis_wait", wait.to_json()}, {"factor", factor.to_json()},
                           {"schur", schur.to_json()},       {"prepare", prepare.to_json()},   {"read_to_setup", to_setup.to_json()}};
   result["edits"] = json{{"solve", solve.to_json()}, {"field", field.to_json()}, {"whole", whole.to_json()}, {"verify", verify_time.to_json()}};
   result["status"] = "ok";
@@ -411,20 +400,19 @@ class Watchdog {
 int child_qr(const RunOptions& o) {
   Pipeline p;
   p.mesh = read_mesh(o.ply);
-  check_finite(p.mesh.V);
-  p.topology = build_topology(p.mesh.F, static_cast<int>(p.mesh.V.rows()));
-  p.geometry = compute_geometry(p.mesh.V, p.topology);
-  p.cycles = compute_cycles(p.topology);
-  p.plan = plan_propagation(p.topology);
+  // Topology, geometry, cycles and plan only (the QR option keeps the designer from analysing on a
+  // second thread); both solvers below are built in sequence on one thread, like for like.
+  p.designer = std::make_unique<FieldDesigner>(p.mesh.V, p.mesh.F, SolverOptions{solver_options(o).weights, SolverKind::QR});
+  std::unique_ptr<ConnectionSolver> ours;
   json result;
   result["name"] = o.name;
   result["mesh"] = mesh_summary(p);
 
   Samples ours_setup, qr_setup, qr_assemble, qr_factor, qr_schur;
   for (int r = 0; r < o.warmup + o.reps; ++r) {
-    p.solver.reset();
+    ours.reset();
     auto t0 = Clock::now();
-    p.solver = std::make_unique<ConnectionSolver>(p.topology, p.geometry, p.cycles, solver_options(o));
+    ours = std::make_unique<ConnectionSolver>(p.topology(), p.geometry(), p.cycles(), solver_options(o));
     if (r >= o.warmup) ours_setup.add(seconds_since(t0));
   }
   const double rss_before_qr = current_rss();
@@ -441,7 +429,7 @@ int child_qr(const RunOptions& o) {
     qr.reset();
     Watchdog dog(o.qr_time_limit, o.qr_mem_limit_gb * 1e9, "QR set-up");
     auto t0 = Clock::now();
-    qr = std::make_unique<ConnectionSolver>(p.topology, p.geometry, p.cycles, SolverOptions{solver_options(o).weights, SolverKind::QR});
+    qr = std::make_unique<ConnectionSolver>(p.topology(), p.geometry(), p.cycles(), SolverOptions{solver_options(o).weights, SolverKind::QR});
     const double t = seconds_since(t0);
     qr_peak = std::max(qr_peak, dog.peak_seen());
     qr_setup.add(t);
@@ -457,11 +445,11 @@ int child_qr(const RunOptions& o) {
   result["qr"]["rss_before"] = rss_before_qr;
   result["qr"]["rss_peak_during_setup"] = qr_peak;
 
-  const bench::EditGenerator gen(p.topology, o.N, o.count);
+  const bench::EditGenerator gen(p.topology(), o.N, o.count);
   Samples ours_solve, ours_whole, qr_solve, qr_whole;
   double max_dx = 0, max_x = 0, max_denergy = 0;
   for (int i = 0; i < o.edit_warmup + o.edits; ++i) {
-    const EditResult a = timed_edit(*p.solver, p, gen, o.name, i);
+    const EditResult a = timed_edit(*ours, p, gen, o.name, i);
     const EditResult b = timed_edit(*qr, p, gen, o.name, i);
     if (i >= o.edit_warmup) ours_solve.add(a.solve), ours_whole.add(a.whole), qr_solve.add(b.solve), qr_whole.add(b.whole);
     max_dx = std::max(max_dx, (a.connection.x - b.connection.x).cwiseAbs().maxCoeff());
@@ -556,12 +544,12 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
   std::ostream& out = std::cout;
   out << "### Per mesh (medians; " << o.reps << " runs after " << o.warmup << " warm-up for the stages, " << o.edits << " edits after "
       << o.edit_warmup << " warm-up; above 2M faces at most 3 runs and 10 edits)\n\n";
-  out << "| mesh | faces | read (bin. PLY) | read (OBJ) | topology | geometry | cycles | field plan | set-up (assemble / factor / schur) | "
-         "prepare = topology…set-up | edit solve | edit field | whole edit | peak RSS |\n";
-  out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  out << "| mesh | faces | read (bin. PLY) | read (OBJ) | topology | geometry | cycles ² | field plan | analysis ² | set-up (assemble / wait / "
+         "factor / schur) | prepare (wall) | edit solve | edit field | whole edit | peak RSS |\n";
+  out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const json& r : runs) {
     if (r.value("status", "") != "ok") {
-      out << "| " << label(r) << " | failed: " << r.value("status", std::string("?")) << " ||||||||||||\n";
+      out << "| " << label(r) << " | failed: " << r.value("status", std::string("?")) << " |||||||||||||\n";
       continue;
     }
     const json& s = r["stages"];
@@ -570,24 +558,35 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
     if (s["read_ascii"].is_object()) obj += " (ASCII PLY " + sec(med(s, "read_ascii")) + ")";
     out << "| " << label(r) << " | " << r["mesh"]["faces"].get<long>() << " | " << sec(med(s, "read_ply")) << " | " << obj
         << " | " << sec(med(s, "topology")) << " | " << sec(med(s, "geometry")) << " | " << sec(med(s, "cycles")) << " | "
-        << sec(med(s, "plan")) << " | " << sec(med(s, "setup")) << " (" << fmt(med(s, "assemble")) << " / " << fmt(med(s, "factor")) << " / " << fmt(med(s, "schur")) << ")"
+        << sec(med(s, "plan")) << " | " << sec(med(s, "analysis")) << " | " << sec(med(s, "setup")) << " (" << fmt(med(s, "assemble")) << " / "
+        << fmt(med(s, "analysis_wait")) << " / " << fmt(med(s, "factor")) << " / " << fmt(med(s, "schur")) << ")"
         << " | " << sec(med(s, "prepare")) << " | " << ms(med(e, "solve")) << " | " << ms(med(e, "field")) << " | " << ms(med(e, "whole"))
         << " | " << gb(r["rss"]["peak"].get<double>()) << " |\n";
   }
+  out << "\n² On the second thread, while the first computes the geometry and the field plan (trivcon/design.h); *wait* is the "
+         "time the set-up waited for that thread's analysis (ordering and symbolic factorization), and *factor* is the numeric "
+         "factorization (with the ordering and symbolic factorization where the analysis was not adopted: "
+      << [&] {
+           std::string own;
+           for (const json& r : runs)
+             if (r.value("status", "") == "ok" && !r.value("analysis_concurrent", true)) own += (own.empty() ? "" : ", ") + r["name"].get<std::string>();
+           return own.empty() ? std::string("none") : own;
+         }()
+      << "). *prepare* is the wall time of the whole (less than the sum of the stages).\n";
   for (const json& r : runs)
     if (r.contains("cotan_error"))
       out << "\n† " << r["name"].get<std::string>() << ": with cotangent weights (the default) the set-up fails: \""
           << r["cotan_error"].get<std::string>().substr(7) << "\". Measured with unit weights instead (the same matrix structure, "
           << "except that no edge is dropped for a zero weight).\n";
   out << "\n### Spread (min–max over the same runs; seconds for stages, milliseconds for edits)\n\n";
-  out << "| mesh | read | topology | geometry | cycles | field plan | set-up | prepare | edit solve (ms) | edit field (ms) | whole edit (ms) |\n";
-  out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  out << "| mesh | read | topology | geometry | cycles | field plan | analysis | set-up | prepare | edit solve (ms) | edit field (ms) | whole edit (ms) |\n";
+  out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const json& r : runs) {
     if (r.value("status", "") != "ok") continue;
     const json& s = r["stages"];
     const json& e = r["edits"];
     out << "| " << label(r) << " | " << range_s(s, "read_ply") << " | " << range_s(s, "topology") << " | "
-        << range_s(s, "geometry") << " | " << range_s(s, "cycles") << " | " << range_s(s, "plan") << " | " << range_s(s, "setup") << " | " << range_s(s, "prepare") << " | "
+        << range_s(s, "geometry") << " | " << range_s(s, "cycles") << " | " << range_s(s, "plan") << " | " << range_s(s, "analysis") << " | " << range_s(s, "setup") << " | " << range_s(s, "prepare") << " | "
         << range_ms(e, "solve") << " | " << range_ms(e, "field") << " | " << range_ms(e, "whole") << " |\n";
   }
   out << "\n### Mesh facts and checks (last edit, verified outside the timings)\n\n";
@@ -681,7 +680,7 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
     const json& s = r["stages"];
     const json& e = r["edits"];
     if (r.value("target_class", "") == "400k") {
-      row("set-up after reading (topology + geometry + cycles + field plan + solver)", name, med(s, "prepare"), 1.0, false);
+      row("set-up after reading (FieldDesigner: topology, geometry, cycles, field plan, solver)", name, med(s, "prepare"), 1.0, false);
       row("one edit", name, med(e, "whole"), 0.060, true);
       row("read OBJ", name, med(s, "read_obj"), 0.6, false);
     } else if (r.value("target_class", "") == "dragon") {

@@ -14,17 +14,48 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 }  // namespace
 
 FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptions options) : V_(V), options_(options) {
-  auto t0 = Clock::now();
+  const auto start = Clock::now();
+  auto t0 = start;
   check_finite(V_);
   topology_ = build_topology(F, static_cast<int>(V_.rows()));
   timings_.topology = seconds_since(t0);
-  t0 = Clock::now();
-  geometry_ = compute_geometry(V_, topology_);
-  timings_.geometry = seconds_since(t0);
-  t0 = Clock::now();
-  cycles_ = compute_cycles(topology_);
-  plan_ = plan_propagation(topology_);
-  timings_.cycles = seconds_since(t0);
+  if (options_.solver == SolverKind::Cholesky) {
+    // The cycles and the solver's symbolic analysis depend on the connectivity only: a second thread
+    // computes them while this one computes the geometry and the plan (see design.h).
+    std::promise<void> cycles_done;
+    std::future<void> cycles_ready = cycles_done.get_future();
+    analysis_ = std::async(std::launch::async, [this, done = std::move(cycles_done)]() mutable {
+      const auto t1 = Clock::now();
+      try {
+        cycles_ = compute_cycles(topology_);
+      } catch (...) {
+        done.set_exception(std::current_exception());
+        throw;
+      }
+      timings_.cycles = seconds_since(t1);
+      done.set_value();
+      return SolverAnalysis(topology_, cycles_);
+    });
+    t0 = Clock::now();
+    geometry_ = compute_geometry(V_, topology_);
+    timings_.geometry = seconds_since(t0);
+    t0 = Clock::now();
+    plan_ = plan_propagation(topology_);
+    timings_.plan = seconds_since(t0);
+    cycles_ready.get();  // rethrows the thread's error
+  } else {
+    t0 = Clock::now();
+    geometry_ = compute_geometry(V_, topology_);
+    timings_.geometry = seconds_since(t0);
+    t0 = Clock::now();
+    cycles_ = compute_cycles(topology_);
+    timings_.cycles = seconds_since(t0);
+    t0 = Clock::now();
+    plan_ = plan_propagation(topology_);
+    timings_.plan = seconds_since(t0);
+  }
+  construct_seconds_ = seconds_since(start);
+  timings_.prepare = construct_seconds_;
 }
 
 void FieldDesigner::set_fixed_faces(const std::vector<int>& faces) {
@@ -36,8 +67,16 @@ void FieldDesigner::set_fixed_faces(const std::vector<int>& faces) {
 const ConnectionSolver& FieldDesigner::solver() const {
   if (!solver_) {
     const auto t0 = Clock::now();
-    solver_ = std::make_unique<ConnectionSolver>(topology_, geometry_, cycles_, options_, fixed_faces_);
+    std::function<SolverAnalysis()> analysis;
+    if (analysis_.valid() && fixed_faces_.empty())
+      analysis = [this] {
+        SolverAnalysis a = analysis_.get();
+        timings_.analysis = a.seconds();
+        return a;
+      };
+    solver_ = std::make_unique<ConnectionSolver>(topology_, geometry_, cycles_, options_, fixed_faces_, analysis);
     timings_.setup = seconds_since(t0);
+    timings_.prepare = construct_seconds_ + timings_.setup;
   }
   return *solver_;
 }

@@ -29,11 +29,12 @@ using EdgeEnds = std::vector<std::array<int, 2>>;  // per active edge, the verte
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 }  // namespace
 
-// The constraint system in "active edge" space (interior edges with w_e > 0): Dt (m × nD) and
-// Ct (m × nC) are the transposed constraint rows, so x_active = W (Dt λ + Ct μ).
+// The constraint system in the space of the system edges (system_edges: every interior edge on the
+// Cholesky route, those with w_e > 0 on the QR route): Dt (m × nD) and Ct (m × nC) are the transposed
+// constraint rows, so x_active = W (Dt λ + Ct μ).
 struct ConnectionSolver::Engine {
   virtual ~Engine() = default;
-  // Returns x on the active edges for vertex right-hand sides b_D; the cycle right-hand sides b_C are
+  // Returns x on the system edges for vertex right-hand sides b_D; the cycle right-hand sides b_C are
   // asked from `choose`, given r₀: the real b_C that minimises the energy for this b_D.
   using CycleRhsChooser = std::function<Eigen::VectorXd(const Eigen::VectorXd& r0)>;
   virtual Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const = 0;
@@ -54,6 +55,187 @@ struct ConnectionSolver::Engine {
 
 namespace {
 
+// Upper triangle of the normal matrix M = A W Aᵀ, compressed columns.
+struct Csc {
+  std::vector<int> outer, inner;
+  std::vector<double> values;
+};
+
+// The rows of A touching each system edge a (column a of A): row[start[a] … start[a + 1]) with their
+// coefficients.
+struct EdgeRows {
+  std::vector<int> start, row;
+  std::vector<double> coefficient;
+};
+
+// The leading n × n block of the upper triangle M (the vertex block for n = nD: its columns hold no
+// cycle rows).
+cholmod_sparse view(Csc& M, int n) {
+  cholmod_sparse s{};
+  s.nrow = s.ncol = static_cast<size_t>(n), s.nzmax = static_cast<size_t>(M.outer[n]);
+  s.p = M.outer.data(), s.i = M.inner.data(), s.x = M.values.data();
+  s.stype = 1, s.itype = CHOLMOD_INT, s.xtype = CHOLMOD_REAL, s.dtype = CHOLMOD_DOUBLE, s.sorted = 1, s.packed = 1;
+  return s;
+}
+
+// Upper triangle of A W Aᵀ as a sparse product over the edges (Gustavson's algorithm): column c
+// gathers, for each edge a in row c of A, the rows r ≤ c that edge a touches. The rows of A: nV vertex
+// rows given per edge by the rows of its two ends (coefficient −1 for ends[a][0], +1 for ends[a][1]; an
+// end without a row is −1), then the extra rows Et (m × (nD − nV)), then the cycle rows Ct (m × nC).
+// Every product of two rows sharing an edge is an entry, also where w is 0 or the sum cancels: the
+// pattern depends on ends, Et and Ct only (SolverAnalysis relies on it).
+Csc normal_matrix(const EdgeEnds& ends, int nV, const SparseMatrix& Et, const SparseMatrix& Ct, const Eigen::VectorXd& w, EdgeRows& edges) {
+  const int m = static_cast<int>(ends.size()), nD = nV + static_cast<int>(Et.cols()), nC = static_cast<int>(Ct.cols());
+  const int n = nD + nC;
+  // The rows of A touching each edge, by counting.
+  std::vector<int>& start = edges.start;
+  start.assign(static_cast<size_t>(m) + 1, 0);
+  auto for_each_sparse_entry = [&](auto&& visit) {  // (row of A, edge, coefficient) of Et and Ct
+    for (int c = 0; c < static_cast<int>(Et.cols()); ++c)
+      for (SparseMatrix::InnerIterator it(Et, c); it; ++it) visit(nV + c, static_cast<int>(it.row()), it.value());
+    for (int c = 0; c < nC; ++c)
+      for (SparseMatrix::InnerIterator it(Ct, c); it; ++it) visit(nD + c, static_cast<int>(it.row()), it.value());
+  };
+  for (int a = 0; a < m; ++a) start[a + 1] = (ends[a][0] >= 0) + (ends[a][1] >= 0);
+  for_each_sparse_entry([&](int, int a, double) { ++start[a + 1]; });
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<int>& row_of = edges.row;
+  std::vector<double>& coefficient = edges.coefficient;
+  row_of.resize(start[m]), coefficient.resize(start[m]);
+  std::vector<int> next(start.begin(), start.end() - 1);
+  for (int a = 0; a < m; ++a)
+    for (int end = 0; end < 2; ++end)
+      if (ends[a][end] >= 0) row_of[next[a]] = ends[a][end], coefficient[next[a]++] = end == 0 ? -1.0 : 1.0;
+  for_each_sparse_entry([&](int r, int a, double v) { row_of[next[a]] = r, coefficient[next[a]++] = v; });
+  // Per vertex row, its edges as (the other end's row or −1, weight): a vertex column of M holds only
+  // vertex rows (the others come after it), so it is read from this list in sequence.
+  std::vector<int> incident_start(static_cast<size_t>(nV) + 1, 0);
+  for (int a = 0; a < m; ++a)
+    for (int end = 0; end < 2; ++end)
+      if (ends[a][end] >= 0) ++incident_start[ends[a][end] + 1];
+  std::partial_sum(incident_start.begin(), incident_start.end(), incident_start.begin());
+  std::vector<std::pair<int, double>> incident(incident_start[nV]);
+  next.assign(incident_start.begin(), incident_start.end() - 1);
+  for (int a = 0; a < m; ++a)
+    for (int end = 0; end < 2; ++end)
+      if (ends[a][end] >= 0) incident[next[ends[a][end]]++] = {ends[a][1 - end], w(a)};
+
+  Csc M;
+  M.outer.assign(static_cast<size_t>(n) + 1, 0);
+  M.inner.reserve(static_cast<size_t>(start[m]) * 2 + n);
+  M.values.reserve(M.inner.capacity());
+  std::vector<double> sum(n, 0.0);
+  std::vector<int> seen(n, -1), rows;
+  auto add_edge = [&](int c, int a, double scale) {
+    for (int k = start[a]; k < start[a + 1]; ++k) {
+      const int r = row_of[k];
+      if (r > c) continue;
+      if (seen[r] != c) seen[r] = c, sum[r] = 0, rows.push_back(r);
+      sum[r] += scale * coefficient[k];
+    }
+  };
+  std::vector<std::pair<int, double>> column;
+  for (int c = 0; c < n; ++c) {
+    rows.clear();
+    if (c < nV) {  // −w to each neighbouring row above the diagonal, Σ w on it (one edge per vertex pair)
+      column.clear();
+      double diagonal = 0;
+      for (int k = incident_start[c]; k < incident_start[c + 1]; ++k) {
+        const auto [other, weight] = incident[k];
+        diagonal += weight;
+        if (other >= 0 && other < c) column.emplace_back(other, -weight);
+      }
+      std::sort(column.begin(), column.end());
+      for (const auto& [r, v] : column) M.inner.push_back(r), M.values.push_back(v);
+      M.inner.push_back(c), M.values.push_back(diagonal);
+      M.outer[c + 1] = static_cast<int>(M.inner.size());
+      continue;
+    }
+    const SparseMatrix& S = c < nD ? Et : Ct;
+    for (SparseMatrix::InnerIterator it(S, c < nD ? c - nV : c - nD); it; ++it)
+      add_edge(c, static_cast<int>(it.row()), it.value() * w(static_cast<int>(it.row())));
+    std::sort(rows.begin(), rows.end());
+    for (int r : rows) M.inner.push_back(r), M.values.push_back(sum[r]);
+    M.outer[c + 1] = static_cast<int>(M.inner.size());
+  }
+  return M;
+}
+
+void start_supernodal(cholmod_common& c) {  // supernodal LLᵀ
+  cholmod_start(&c);
+  c.print = 0;
+  c.supernodal = CHOLMOD_SUPERNODAL;
+  c.final_ll = 1;
+}
+void require(bool ok, const char* what, const cholmod_common& c) {
+  if (!ok) throw Error(std::string(what) + " (CHOLMOD status " + std::to_string(c.status) + ")");
+}
+
+// A fill-reducing order of the nD vertex rows of M (the nC cycle rows come last). Minimum degree (AMD;
+// CAMD when there are cycle rows, constrained to order them last, so that it sees how they couple the
+// vertices: a quarter fewer flops on the dragon), then postordered by the vertex block's elimination
+// tree so that CHOLMOD finds large supernodes without postordering the whole system (which could move
+// the cycle rows). Not CHOLMOD's default choice, which tries METIS on large meshes: its analysis alone
+// takes 3 s (the dragon) to 16 s (the dragon subdivided) on our 2-core machine, more than the fill it
+// saves. (A nested dissection by vertex coordinates, tried as a second candidate, cut the flops by a
+// third on smooth closed surfaces but not the time with AVX-512 BLAS kernels, and lost on the dragon;
+// see BENCHMARKS.md.)
+std::vector<int> vertex_order(Csc& M, int nD, int nC, cholmod_common& cc) {
+  std::vector<int> order(nD);
+  if (nD == 0) return order;
+  if (nC > 0) {
+    cholmod_sparse A = view(M, nD + nC);
+    std::vector<int> last(nD + nC, 0), full(nD + nC);
+    std::fill(last.begin() + nD, last.end(), 1);
+    require(cholmod_camd(&A, nullptr, 0, last.data(), full.data(), &cc) != 0, "CHOLMOD could not order the constraint system", cc);
+    std::copy(full.begin(), full.begin() + nD, order.begin());
+    for (int k = 0; k < nD; ++k) require(order[k] < nD, "CHOLMOD did not order the cycle rows last", cc);
+  } else {
+    cholmod_sparse A = view(M, nD);
+    require(cholmod_amd(&A, nullptr, 0, order.data(), &cc) != 0, "CHOLMOD could not order the vertex Laplacian", cc);
+  }
+  const ordering::Pattern pattern = ordering::leading_block_pattern(M.outer, M.inner, nD);
+  std::vector<int> parent = ordering::elimination_tree(pattern, order), post(nD);
+  require(cholmod_postorder(parent.data(), nD, nullptr, post.data(), &cc) == nD, "CHOLMOD could not postorder the elimination tree", cc);
+  std::vector<int> postordered(nD);
+  for (int k = 0; k < nD; ++k) postordered[k] = order[post[k]];
+  return postordered;
+}
+
+// Symbolic analysis of the whole system: the vertex rows in `order`, then the cycle rows.
+cholmod_factor* symbolic(Csc& M, std::vector<int> order, int nD, int nC, cholmod_common& c) {
+  const int n = nD + nC;
+  for (int r = nD; r < n; ++r) order.push_back(r);
+  cholmod_sparse A = view(M, n);
+  c.nmethods = 1;
+  c.method[0].ordering = CHOLMOD_GIVEN;
+  c.postorder = 0;  // keep the cycle rows last (the vertex order is postordered already)
+  cholmod_factor* L = cholmod_analyze_p(&A, order.data(), nullptr, 0, &c);
+  require(L != nullptr, "CHOLMOD could not analyse the constraint system", c);
+  return L;
+}
+
+}  // namespace
+
+// A symbolic factorization and the pattern it was computed for (SolverAnalysis), or just the CHOLMOD
+// workspace of an engine that analyses its own.
+struct SolverAnalysis::Impl {
+  cholmod_common cc;
+  cholmod_factor* factor = nullptr;
+  int nD = 0, nC = 0;
+  std::vector<int> outer, inner;
+  double seconds = 0;
+  Impl() { start_supernodal(cc); }
+  ~Impl() {
+    if (factor) cholmod_free_factor(&factor, &cc);
+    cholmod_finish(&cc);
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+};
+
+namespace {
+
 // One supernodal Cholesky factorization R Rᵀ = Π M Πᵀ of the whole normal matrix
 //   M = A W Aᵀ = [ D W Dᵀ   D W Cᵀ ]
 //                [ C W Dᵀ   C W Cᵀ ],
@@ -64,20 +246,18 @@ namespace {
 // sparse too: with a base right-hand side set (set_base_rhs), a new b_D that differs from it in a few
 // rows (a new set of singular vertices) only updates the supernodes on their paths to the root.
 struct CholeskyEngine : ConnectionSolver::Engine {
-  mutable cholmod_common cc;
+  // CHOLMOD's workspace, and the symbolic factorization when one was given (see factorize). Mutable:
+  // CHOLMOD's solves write to their workspace.
+  mutable std::unique_ptr<SolverAnalysis::Impl> cholmod_ = std::make_unique<SolverAnalysis::Impl>();
+  cholmod_common& cc() const { return cholmod_->cc; }
   cholmod_factor* factor = nullptr;
+  bool analysis_adopted = false;
   Eigen::VectorXd w;
   int m = 0, nD = 0, nC = 0;
-  // The constraint rows touching each active edge a (column a of A): edge_row_[edge_start_[a] …
-  // edge_start_[a + 1]) with their coefficients; after the factorization, as positions in factor order.
-  std::vector<int> edge_start_, edge_row_;
-  std::vector<double> edge_coefficient_;
+  // The constraint rows touching each system edge (column a of A); after the factorization, as
+  // positions in factor order.
+  EdgeRows edge_rows_;
   Eigen::MatrixXd R_CC, R_inv;  // lower triangular; P = R_invᵀ R_inv
-  // Upper triangle of M, compressed columns.
-  struct Csc {
-    std::vector<int> outer, inner;
-    std::vector<double> values;
-  };
   // Sparse forward substitution (see forward_update).
   std::vector<int> position_;     // factor position of each row of M (the inverse of factor->Perm)
   std::vector<int> super_of_col_, super_parent_;
@@ -86,21 +266,26 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   mutable Eigen::VectorXd forward_work_;
   mutable int stamp_ = 0;
 
-  // The rows of A: vertex rows given per active edge by the rows of its two ends (coefficient −1 for
-  // ends[a][0], +1 for ends[a][1]; an end without a row, a boundary or dropped vertex, is marked −1), then
-  // the extra rows Et (m × nX, fixed-face paths that are ordered with the vertex rows), then the cycle
-  // rows Ct (m × nC, last).
+  // The rows of A (see normal_matrix): vertex rows given per system edge by the rows of its two ends (a
+  // boundary or dropped vertex has none), then the extra rows Et (fixed-face paths that are ordered with
+  // the vertex rows), then the cycle rows Ct (last). `analysis`, if given, is asked for a symbolic
+  // factorization once A W Aᵀ is assembled; it is used if it was made for this pattern.
   CholeskyEngine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et, const SparseMatrix& Ct, const Eigen::VectorXd& w_,
-                 SetupTimings& timings)
+                 SetupTimings& timings, const std::function<std::unique_ptr<SolverAnalysis::Impl>()>& analysis = {})
       : w(w_) {
-    start(cc);
     m = static_cast<int>(ends.size()), nD = num_vertex_rows + static_cast<int>(Et.cols()), nC = static_cast<int>(Ct.cols());
     const int n = nD + nC;
     try {
       auto t0 = Clock::now();
-      Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct);
+      Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct, w, edge_rows_);
       timings.assemble += seconds_since(t0);
       if (n == 0) return;
+      if (analysis) {
+        t0 = Clock::now();
+        adopt(M, analysis());
+        timings.analysis_wait += seconds_since(t0);
+        timings.analysis_adopted = analysis_adopted;
+      }
       t0 = Clock::now();
       factorize(M);
       timings.factor += seconds_since(t0);
@@ -114,24 +299,32 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   }
   ~CholeskyEngine() override { release(); }
   void release() {
-    if (factor) cholmod_free_factor(&factor, &cc);
-    cholmod_finish(&cc);
+    if (factor) cholmod_free_factor(&factor, &cc());
+  }
+
+  // Takes a symbolic factorization made for exactly this pattern (compared entry by entry; a different
+  // one is dropped and the factorization analyses its own).
+  void adopt(const Csc& M, std::unique_ptr<SolverAnalysis::Impl> given) {
+    if (!given || !given->factor || given->nD != nD || given->nC != nC || given->outer != M.outer || given->inner != M.inner) return;
+    factor = given->factor, given->factor = nullptr;
+    cholmod_ = std::move(given);
+    analysis_adopted = true;
   }
 
   void factorize(Csc& M) {
     const int n = nD + nC;
-    factor = symbolic(M, vertex_order(M), cc);
+    if (!factor) factor = symbolic(M, vertex_order(M, nD, nC, cc()), nD, nC, cc());
     cholmod_sparse A = view(M, n);
     const int* perm = static_cast<const int*>(factor->Perm);
-    cholmod_factorize(&A, factor, &cc);
-    if (cc.status == CHOLMOD_NOT_POSDEF || factor->minor < factor->n) {
+    cholmod_factorize(&A, factor, &cc());
+    if (cc().status == CHOLMOD_NOT_POSDEF || factor->minor < factor->n) {
       const int row = static_cast<int>(factor->minor);
       throw Error(row < n && perm[row] >= nD
                       ? "the holonomy of the generators, boundary loops or fixed-direction paths cannot be controlled independently "
                         "with these weights (the constraint system is singular); try --weights unit"
                       : "CHOLMOD found the constraint system not positive definite; try --weights unit");
     }
-    check(cc.status == CHOLMOD_OK && factor->is_super && factor->is_ll, "CHOLMOD factorization failed");
+    check(cc().status == CHOLMOD_OK && factor->is_super && factor->is_ll, "CHOLMOD factorization failed");
     for (int k = nD; k < n; ++k) check(perm[k] == k, "CHOLMOD did not keep the cycle rows last");
     prepare_sparse_forward();
   }
@@ -152,150 +345,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   std::string ordering() const override { return nC > 0 ? "CAMD" : "AMD"; }
 
   void check(bool ok, const char* what) const {
-    if (!ok) throw Error(std::string(what) + " (CHOLMOD status " + std::to_string(cc.status) + ")");
-  }
-
-  // The leading n × n block of the upper triangle M (the vertex block for n = nD: its columns hold no
-  // cycle rows).
-  static cholmod_sparse view(Csc& M, int n) {
-    cholmod_sparse s{};
-    s.nrow = s.ncol = static_cast<size_t>(n), s.nzmax = static_cast<size_t>(M.outer[n]);
-    s.p = M.outer.data(), s.i = M.inner.data(), s.x = M.values.data();
-    s.stype = 1, s.itype = CHOLMOD_INT, s.xtype = CHOLMOD_REAL, s.dtype = CHOLMOD_DOUBLE, s.sorted = 1, s.packed = 1;
-    return s;
-  }
-
-  // Upper triangle of A W Aᵀ as a sparse product over the edges (Gustavson's algorithm): column c
-  // gathers, for each edge a in row c of A, the rows r ≤ c that edge a touches.
-  Csc normal_matrix(const EdgeEnds& ends, int nV, const SparseMatrix& Et, const SparseMatrix& Ct) {
-    const int n = nD + nC;
-    // The rows of A touching each edge (edge_start_/edge_row_/edge_coefficient_), by counting.
-    std::vector<int>& start = edge_start_;
-    start.assign(static_cast<size_t>(m) + 1, 0);
-    auto for_each_sparse_entry = [&](auto&& visit) {  // (row of A, edge, coefficient) of Et and Ct
-      for (int c = 0; c < static_cast<int>(Et.cols()); ++c)
-        for (SparseMatrix::InnerIterator it(Et, c); it; ++it) visit(nV + c, static_cast<int>(it.row()), it.value());
-      for (int c = 0; c < nC; ++c)
-        for (SparseMatrix::InnerIterator it(Ct, c); it; ++it) visit(nD + c, static_cast<int>(it.row()), it.value());
-    };
-    for (int a = 0; a < m; ++a) start[a + 1] = (ends[a][0] >= 0) + (ends[a][1] >= 0);
-    for_each_sparse_entry([&](int, int a, double) { ++start[a + 1]; });
-    std::partial_sum(start.begin(), start.end(), start.begin());
-    std::vector<int>& row_of = edge_row_;
-    std::vector<double>& coefficient = edge_coefficient_;
-    row_of.resize(start[m]), coefficient.resize(start[m]);
-    std::vector<int> next(start.begin(), start.end() - 1);
-    for (int a = 0; a < m; ++a)
-      for (int end = 0; end < 2; ++end)
-        if (ends[a][end] >= 0) row_of[next[a]] = ends[a][end], coefficient[next[a]++] = end == 0 ? -1.0 : 1.0;
-    for_each_sparse_entry([&](int r, int a, double v) { row_of[next[a]] = r, coefficient[next[a]++] = v; });
-    // Per vertex row, its edges as (the other end's row or −1, weight): a vertex column of M holds only
-    // vertex rows (the others come after it), so it is read from this list in sequence.
-    std::vector<int> incident_start(static_cast<size_t>(nV) + 1, 0);
-    for (int a = 0; a < m; ++a)
-      for (int end = 0; end < 2; ++end)
-        if (ends[a][end] >= 0) ++incident_start[ends[a][end] + 1];
-    std::partial_sum(incident_start.begin(), incident_start.end(), incident_start.begin());
-    std::vector<std::pair<int, double>> incident(incident_start[nV]);
-    next.assign(incident_start.begin(), incident_start.end() - 1);
-    for (int a = 0; a < m; ++a)
-      for (int end = 0; end < 2; ++end)
-        if (ends[a][end] >= 0) incident[next[ends[a][end]]++] = {ends[a][1 - end], w(a)};
-
-    Csc M;
-    M.outer.assign(static_cast<size_t>(n) + 1, 0);
-    M.inner.reserve(static_cast<size_t>(start[m]) * 2 + n);
-    M.values.reserve(M.inner.capacity());
-    std::vector<double> sum(n, 0.0);
-    std::vector<int> seen(n, -1), rows;
-    auto add_edge = [&](int c, int a, double scale) {
-      for (int k = start[a]; k < start[a + 1]; ++k) {
-        const int r = row_of[k];
-        if (r > c) continue;
-        if (seen[r] != c) seen[r] = c, sum[r] = 0, rows.push_back(r);
-        sum[r] += scale * coefficient[k];
-      }
-    };
-    std::vector<std::pair<int, double>> column;
-    for (int c = 0; c < n; ++c) {
-      rows.clear();
-      if (c < nV) {  // −w to each neighbouring row above the diagonal, Σ w on it (one edge per vertex pair)
-        column.clear();
-        double diagonal = 0;
-        for (int k = incident_start[c]; k < incident_start[c + 1]; ++k) {
-          const auto [other, weight] = incident[k];
-          diagonal += weight;
-          if (other >= 0 && other < c) column.emplace_back(other, -weight);
-        }
-        std::sort(column.begin(), column.end());
-        for (const auto& [r, v] : column) M.inner.push_back(r), M.values.push_back(v);
-        M.inner.push_back(c), M.values.push_back(diagonal);
-        M.outer[c + 1] = static_cast<int>(M.inner.size());
-        continue;
-      } else {
-        const SparseMatrix& S = c < nD ? Et : Ct;
-        for (SparseMatrix::InnerIterator it(S, c < nD ? c - nV : c - nD); it; ++it)
-          add_edge(c, static_cast<int>(it.row()), it.value() * w(static_cast<int>(it.row())));
-      }
-      std::sort(rows.begin(), rows.end());
-      for (int r : rows) M.inner.push_back(r), M.values.push_back(sum[r]);
-      M.outer[c + 1] = static_cast<int>(M.inner.size());
-    }
-    return M;
-  }
-
-  static void start(cholmod_common& c) {  // supernodal LLᵀ
-    cholmod_start(&c);
-    c.print = 0;
-    c.supernodal = CHOLMOD_SUPERNODAL;
-    c.final_ll = 1;
-  }
-  static void require(bool ok, const char* what, const cholmod_common& c) {
-    if (!ok) throw Error(std::string(what) + " (CHOLMOD status " + std::to_string(c.status) + ")");
-  }
-
-  // A fill-reducing order of the vertex rows (the cycle rows come last). Minimum degree (AMD; CAMD when
-  // there are cycle rows, constrained to order them last, so that it sees how they couple the vertices:
-  // a quarter fewer flops on the dragon), then
-  // postordered by the vertex block's elimination tree so that CHOLMOD finds large supernodes without
-  // postordering the whole system (which could move the cycle rows). Not CHOLMOD's default choice,
-  // which tries METIS on large meshes: its analysis alone takes 3 s (the dragon) to 16 s (the dragon
-  // subdivided) on our 2-core machine, more than the fill it saves. (A nested dissection by vertex
-  // coordinates, tried as a second candidate, cut the flops by a third on smooth closed surfaces but not
-  // the time with AVX-512 BLAS kernels, and lost on the dragon; see BENCHMARKS.md.)
-  std::vector<int> vertex_order(Csc& M) const {
-    std::vector<int> order(nD);
-    if (nD == 0) return order;
-    if (nC > 0) {
-      cholmod_sparse A = view(M, nD + nC);
-      std::vector<int> last(nD + nC, 0), full(nD + nC);
-      std::fill(last.begin() + nD, last.end(), 1);
-      require(cholmod_camd(&A, nullptr, 0, last.data(), full.data(), &cc) != 0, "CHOLMOD could not order the constraint system", cc);
-      std::copy(full.begin(), full.begin() + nD, order.begin());
-      for (int k = 0; k < nD; ++k) require(order[k] < nD, "CHOLMOD did not order the cycle rows last", cc);
-    } else {
-      cholmod_sparse A = view(M, nD);
-      require(cholmod_amd(&A, nullptr, 0, order.data(), &cc) != 0, "CHOLMOD could not order the vertex Laplacian", cc);
-    }
-    const ordering::Pattern pattern = ordering::leading_block_pattern(M.outer, M.inner, nD);
-    std::vector<int> parent = ordering::elimination_tree(pattern, order), post(nD);
-    require(cholmod_postorder(parent.data(), nD, nullptr, post.data(), &cc) == nD, "CHOLMOD could not postorder the elimination tree", cc);
-    std::vector<int> postordered(nD);
-    for (int k = 0; k < nD; ++k) postordered[k] = order[post[k]];
-    return postordered;
-  }
-
-  // Symbolic analysis of the whole system: the vertex rows in `order`, then the cycle rows.
-  cholmod_factor* symbolic(Csc& M, std::vector<int> order, cholmod_common& c) const {
-    const int n = nD + nC;
-    for (int r = nD; r < n; ++r) order.push_back(r);
-    cholmod_sparse A = view(M, n);
-    c.nmethods = 1;
-    c.method[0].ordering = CHOLMOD_GIVEN;
-    c.postorder = 0;  // keep the cycle rows last (the vertex order is postordered already)
-    cholmod_factor* L = cholmod_analyze_p(&A, order.data(), nullptr, 0, &c);
-    require(L != nullptr, "CHOLMOD could not analyse the constraint system", c);
-    return L;
+    if (!ok) throw Error(std::string(what) + " (CHOLMOD status " + std::to_string(cc().status) + ")");
   }
 
   // Supernodal elimination tree and the factor position of each row, for forward_update.
@@ -317,7 +367,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
       if (nrow > ncol) super_parent_[s] = super_of_col_[rows[pi[s] + ncol]];
     }
     super_stamp_.assign(nsuper, -1);
-    for (int& r : edge_row_) r = position_[r];
+    for (int& r : edge_rows_.row) r = position_[r];
   }
 
   // z += L⁻¹ d for d with the few nonzeros `entries` (factor positions, values): only the supernodes on
@@ -380,10 +430,10 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     B.nrow = b.size(), B.ncol = 1, B.nzmax = b.size(), B.d = b.size();
     B.x = const_cast<double*>(b.data());
     B.xtype = CHOLMOD_REAL, B.dtype = CHOLMOD_DOUBLE;
-    cholmod_dense* X = cholmod_solve(sys, factor, &B, &cc);
-    check(X != nullptr && cc.status == CHOLMOD_OK, "CHOLMOD solve failed");
+    cholmod_dense* X = cholmod_solve(sys, factor, &B, &cc());
+    check(X != nullptr && cc().status == CHOLMOD_OK, "CHOLMOD solve failed");
     Eigen::VectorXd out = Eigen::Map<Eigen::VectorXd>(static_cast<double*>(X->x), b.size());
-    cholmod_free_dense(&X, &cc);
+    cholmod_free_dense(&X, &cc());
     return out;
   }
   // L⁻¹ Π [b_D; 0]: the forward substitution with the cycle right-hand sides zero.
@@ -441,7 +491,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     Eigen::VectorXd x(m);
     for (int a = 0; a < m; ++a) {
       double sum = 0;
-      for (int k = edge_start_[a]; k < edge_start_[a + 1]; ++k) sum += edge_coefficient_[k] * y(edge_row_[k]);
+      for (int k = edge_rows_.start[a]; k < edge_rows_.start[a + 1]; ++k) sum += edge_rows_.coefficient[k] * y(edge_rows_.row[k]);
       x(a) = w(a) * sum;
     }
     return x;
@@ -613,10 +663,94 @@ Eigen::VectorXi nearest_lattice_point(const ConnectionSolver::Engine& engine, co
   return t;
 }
 
+
+// Which rows the reduced system has (see trivcon/solver.h): per component the dropped vertex (closed
+// component: its largest interior vertex) or loop (with boundary: the longest loop, ties to the smallest
+// id), and the row of each other interior vertex.
+struct RowLayout {
+  std::vector<int> vertex_row, dropped_vertex, dropped_loop;
+  int num_vertex_rows = 0;
+};
+RowLayout row_layout(const Topology& t) {
+  RowLayout r;
+  r.vertex_row.assign(t.num_vertices, -1);
+  r.dropped_vertex.assign(t.components.size(), -1);
+  r.dropped_loop.assign(t.components.size(), -1);
+  for (size_t c = 0; c < t.components.size(); ++c)
+    for (int l : t.components[c].boundary_loops)
+      if (r.dropped_loop[c] < 0 || t.boundary_loops[l].size() > t.boundary_loops[r.dropped_loop[c]].size()) r.dropped_loop[c] = l;
+  for (int v = t.num_vertices - 1; v >= 0; --v) {
+    if (!t.is_interior_vertex(v)) continue;
+    const int c = t.vertex_component[v];
+    if (t.components[c].boundary_loops.empty() && r.dropped_vertex[c] < 0) r.dropped_vertex[c] = v;
+  }
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (t.is_interior_vertex(v) && r.dropped_vertex[t.vertex_component[v]] != v) r.vertex_row[v] = r.num_vertex_rows++;
+  return r;
+}
+// The boundary loops that have a row, in id order.
+std::vector<int> loop_rows(const Topology& t, const std::vector<int>& dropped_loop) {
+  std::vector<int> loops;
+  for (size_t l = 0; l < t.boundary_loops.size(); ++l)
+    if (dropped_loop[t.vertex_component[t.boundary_loops[l][0]]] != static_cast<int>(l)) loops.push_back(static_cast<int>(l));
+  return loops;
+}
+// The edges that are columns of A, and each edge's column (−1: none). The Cholesky route takes every
+// interior edge: a zero weight gives an entry of zero, which keeps A W Aᵀ's pattern that of the mesh
+// whatever the geometry (SolverAnalysis relies on it); the QR route takes the edges of positive weight.
+void system_edges(const Topology& t, const Eigen::VectorXd* positive_only, std::vector<int>& edges, std::vector<int>& column) {
+  edges.clear();
+  column.assign(t.num_edges, -1);
+  for (int e = 0; e < t.num_edges; ++e)
+    if (positive_only ? (*positive_only)(e) > 0 : !t.is_boundary_edge(e)) column[e] = static_cast<int>(edges.size()), edges.push_back(e);
+}
+EdgeEnds edge_ends(const Topology& t, const std::vector<int>& edges, const std::vector<int>& vertex_row) {
+  EdgeEnds ends(edges.size());
+  for (size_t a = 0; a < edges.size(); ++a)
+    for (int end = 0; end < 2; ++end) ends[a][end] = vertex_row[t.edge_vertices(edges[a], end)];
+  return ends;
+}
+// Cycles (or paths) as the sparse columns of Aᵀ (m × count); repeated edges of a cycle are summed.
+SparseMatrix cycle_columns(int m, const std::vector<int>& column, int count, const std::function<const DualCycle&(int)>& cycle) {
+  std::vector<Triplet> trip;
+  for (int r = 0; r < count; ++r) {
+    const DualCycle& c = cycle(r);
+    for (size_t k = 0; k < c.edges.size(); ++k)
+      if (column[c.edges[k]] >= 0) trip.emplace_back(column[c.edges[k]], r, c.signs[k]);
+  }
+  SparseMatrix S(m, count);
+  S.setFromTriplets(trip.begin(), trip.end());
+  return S;
+}
+
 }  // namespace
 
+SolverAnalysis::SolverAnalysis(const Topology& t, const Cycles& cycles) : impl_(std::make_unique<Impl>()) {
+  const auto t0 = Clock::now();
+  const RowLayout layout = row_layout(t);
+  std::vector<int> edges, column;
+  system_edges(t, nullptr, edges, column);
+  std::vector<const DualCycle*> rows;
+  for (int l : loop_rows(t, layout.dropped_loop)) rows.push_back(&cycles.loops[l]);
+  for (const DualCycle& g : cycles.generators) rows.push_back(&g);
+  const int m = static_cast<int>(edges.size());
+  const SparseMatrix Ct = cycle_columns(m, column, static_cast<int>(rows.size()), [&](int r) -> const DualCycle& { return *rows[r]; });
+  EdgeRows edge_rows;
+  Csc M = normal_matrix(edge_ends(t, edges, layout.vertex_row), layout.num_vertex_rows, SparseMatrix(m, 0), Ct, Eigen::VectorXd::Ones(m),
+                        edge_rows);
+  Impl& a = *impl_;
+  a.nD = layout.num_vertex_rows, a.nC = static_cast<int>(rows.size());
+  if (a.nD + a.nC > 0) a.factor = symbolic(M, vertex_order(M, a.nD, a.nC, a.cc), a.nD, a.nC, a.cc);
+  a.outer = std::move(M.outer), a.inner = std::move(M.inner);
+  a.seconds = seconds_since(t0);
+}
+SolverAnalysis::~SolverAnalysis() = default;
+SolverAnalysis::SolverAnalysis(SolverAnalysis&&) noexcept = default;
+SolverAnalysis& SolverAnalysis::operator=(SolverAnalysis&&) noexcept = default;
+double SolverAnalysis::seconds() const { return impl_ ? impl_->seconds : 0; }
+
 ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geometry, const Cycles& cycles, SolverOptions options,
-                                   const std::vector<int>& fixed_faces)
+                                   const std::vector<int>& fixed_faces, const std::function<SolverAnalysis()>& analysis)
     : topology_(topology), geometry_(geometry), cycles_(cycles), options_(options) {
   const Topology& t = topology;
   const int nV = t.num_vertices, nE = t.num_edges;
@@ -661,26 +795,11 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
     for (const FixedPath& p : paths_) regularize(p.path);
   }
 
-  // Active edges, vertex rows (one dropped per closed component), loop rows (one dropped per component
-  // with boundary: the longest loop, ties to the smallest id), generator rows.
-  active_edges_.clear();
-  edge_column_.assign(nE, -1);
-  for (int e = 0; e < nE; ++e)
-    if (weights_(e) > 0) edge_column_[e] = static_cast<int>(active_edges_.size()), active_edges_.push_back(e);
-  vertex_row_.assign(nV, -1);
-  dropped_vertex_.assign(t.components.size(), -1);
-  dropped_loop_.assign(t.components.size(), -1);
-  for (size_t c = 0; c < t.components.size(); ++c) {
-    for (int l : t.components[c].boundary_loops)
-      if (dropped_loop_[c] < 0 || t.boundary_loops[l].size() > t.boundary_loops[dropped_loop_[c]].size()) dropped_loop_[c] = l;
-  }
-  for (int v = nV - 1; v >= 0; --v) {
-    if (!t.is_interior_vertex(v)) continue;
-    const int c = t.vertex_component[v];
-    if (t.components[c].boundary_loops.empty() && dropped_vertex_[c] < 0) dropped_vertex_[c] = v;
-  }
-  for (int v = 0; v < nV; ++v)
-    if (t.is_interior_vertex(v) && dropped_vertex_[t.vertex_component[v]] != v) vertex_row_[v] = num_vertex_rows_++;
+  // Vertex rows (one dropped per closed component), loop rows (one dropped per component with
+  // boundary), generator rows.
+  RowLayout layout = row_layout(t);
+  vertex_row_ = std::move(layout.vertex_row), dropped_vertex_ = std::move(layout.dropped_vertex);
+  dropped_loop_ = std::move(layout.dropped_loop), num_vertex_rows_ = layout.num_vertex_rows;
   // Cycle rows, fixed-face paths first: free indices are rounded in this order (see nearest_lattice_point),
   // and a path between nearby fixed faces is well determined, while a loop or generator index is only
   // determined once the paths around it are.
@@ -690,30 +809,17 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
   sparse_paths_ = options.solver == SolverKind::Cholesky && static_cast<int>(paths_.size()) > kMaxDensePaths;
   if (!sparse_paths_)
     for (int k = 0; k < static_cast<int>(paths_.size()); ++k) rows_.push_back({RowKind::Path, k});
-  for (size_t l = 0; l < t.boundary_loops.size(); ++l)
-    if (dropped_loop_[t.vertex_component[t.boundary_loops[l][0]]] != static_cast<int>(l)) rows_.push_back({RowKind::Loop, static_cast<int>(l)});
+  for (int l : loop_rows(t, dropped_loop_)) rows_.push_back({RowKind::Loop, l});
   for (int g = 0; g < num_generators(); ++g) rows_.push_back({RowKind::Generator, g});
 
   connect_isolated_vertices(epsilon);
+  system_edges(t, options.solver == SolverKind::QR ? &weights_ : nullptr, active_edges_, edge_column_);
 
   const int m = static_cast<int>(active_edges_.size());
   const int nC = static_cast<int>(rows_.size());
   // The vertex rows of A as the rows of each edge's ends; the cycle and path rows as sparse columns.
-  EdgeEnds ends(m);
-  for (int a = 0; a < m; ++a)
-    for (int end = 0; end < 2; ++end) ends[a][end] = vertex_row_[t.edge_vertices(active_edges_[a], end)];
-  auto columns_of = [&](int count, const std::function<const DualCycle&(int)>& cycle) {
-    std::vector<Triplet> trip;
-    for (int r = 0; r < count; ++r) {
-      const DualCycle& c = cycle(r);
-      for (size_t k = 0; k < c.edges.size(); ++k)
-        if (edge_column_[c.edges[k]] >= 0) trip.emplace_back(edge_column_[c.edges[k]], r, c.signs[k]);
-    }
-    SparseMatrix S(m, count);
-    S.setFromTriplets(trip.begin(), trip.end());  // sums repeated edges of a cycle
-    return S;
-  };
-  const SparseMatrix Ct = columns_of(nC, [&](int r) -> const DualCycle& { return cycle_of_row(r); });
+  const EdgeEnds ends = edge_ends(t, active_edges_, vertex_row_);
+  const SparseMatrix Ct = cycle_columns(m, edge_column_, nC, [&](int r) -> const DualCycle& { return cycle_of_row(r); });
   Eigen::VectorXd w(m);
   for (int a = 0; a < m; ++a) w(a) = weights_(active_edges_[a]);
   timings_.assemble += seconds_since(t0);
@@ -726,10 +832,14 @@ ConnectionSolver::ConnectionSolver(const Topology& topology, const Geometry& geo
     Dt.setFromTriplets(trip.begin(), trip.end());
     engine_ = std::make_unique<QREngine>(Dt, Ct, w, timings_);
   } else if (!sparse_paths_) {
-    engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, SparseMatrix(m, 0), Ct, w, timings_);
+    // A symbolic factorization made beforehand fits the system without fixed faces only.
+    std::function<std::unique_ptr<SolverAnalysis::Impl>()> given;
+    if (analysis && paths_.empty()) given = [&analysis] { return std::move(analysis().impl_); };
+    engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, SparseMatrix(m, 0), Ct, w, timings_, given);
   } else {
     // The vertex rows alone (for the field without path constraints), and vertex + path rows together.
-    const SparseMatrix Et = columns_of(static_cast<int>(paths_.size()), [&](int k) -> const DualCycle& { return paths_[k].path; });
+    const SparseMatrix Et =
+        cycle_columns(m, edge_column_, static_cast<int>(paths_.size()), [&](int k) -> const DualCycle& { return paths_[k].path; });
     relaxed_engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, SparseMatrix(m, 0), SparseMatrix(m, 0), w, timings_);
     engine_ = std::make_unique<CholeskyEngine>(ends, num_vertex_rows_, Et, Ct, w, timings_);
   }
@@ -756,8 +866,7 @@ const DualCycle& ConnectionSolver::cycle_of_row(int r) const {
 // Every vertex row must reach a boundary vertex or the dropped vertex of its component through edges of
 // positive weight; otherwise the Laplacian is singular and the vertex's curvature has nowhere to go
 // (e.g. a vertex surrounded by zero-area faces only). The zero-weight edges at such vertices get the
-// small weight `epsilon`, repeatedly, until every vertex row is reached; then the active edges are
-// recomputed.
+// small weight `epsilon`, repeatedly, until every vertex row is reached.
 void ConnectionSolver::connect_isolated_vertices(double epsilon) {
   const Topology& t = topology_;
   // Through interior edges every vertex reaches the boundary or its component's dropped vertex (an edge
@@ -789,7 +898,6 @@ void ConnectionSolver::connect_isolated_vertices(double epsilon) {
   std::vector<int> isolated_vertices;
   for (int v = 0; v < t.num_vertices; ++v)
     if (vertex_row_[v] >= 0 && !grounded[v]) isolated_vertices.push_back(v);
-  bool changed = false;
   while (!isolated_vertices.empty()) {
     int added = 0;
     for (int v : isolated_vertices) {
@@ -808,18 +916,12 @@ void ConnectionSolver::connect_isolated_vertices(double epsilon) {
       throw Error("interior vertex " + std::to_string(isolated_vertices[0]) + " cannot be joined to the rest of component " +
                   std::to_string(t.vertex_component[isolated_vertices[0]]) + " through weighted edges; use --weights unit");
     regularized_edges_ += added;
-    changed = true;
     search();
     std::vector<int> still;
     for (int v : isolated_vertices)
       if (!grounded[v]) still.push_back(v);
     isolated_vertices.swap(still);
   }
-  if (!changed) return;
-  active_edges_.clear();
-  edge_column_.assign(t.num_edges, -1);
-  for (int e = 0; e < t.num_edges; ++e)
-    if (weights_(e) > 0) edge_column_[e] = static_cast<int>(active_edges_.size()), active_edges_.push_back(e);
 }
 
 Connection ConnectionSolver::solve(const IndexPrescription& prescription) const {
@@ -961,7 +1063,8 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
     result.loop_index[dl] = rest;
     result.loop_chosen[dl] = !prescription.loop.count(dl);
   }
-  for (int e : active_edges_) result.energy += result.x(e) * result.x(e) / weights_(e);
+  for (int e : active_edges_)
+    if (weights_(e) > 0) result.energy += result.x(e) * result.x(e) / weights_(e);
 
   IndexPrescription used = prescription;
   for (int g = 0; g < nG; ++g) used.generator[g] = result.generator_index[g];

@@ -559,6 +559,16 @@ TEST(CliSolve, SphereWithTwoPoles) {
   EXPECT_EQ(rep["singularities"], json::parse(R"([{"vertex": 0, "index": "1"}, {"vertex": 85, "index": "1"}])"));
   EXPECT_TRUE(rep["generators"].empty());
   EXPECT_TRUE(rep["boundary_loops"].empty());
+  // The ordering and symbolic factorization ran on the second thread (trivcon/design.h) and were used;
+  // the wall time of the preparation is no more than the sum of its stages.
+  EXPECT_EQ(rep["symbolic_analysis"], "concurrent");
+  EXPECT_EQ(rep["ordering"], "AMD");
+  const json& sec = rep["seconds"];
+  for (const char* k : {"topology", "geometry", "cycles", "plan", "analysis", "setup", "setup_analysis_wait", "prepare"})
+    EXPECT_GE(sec[k].get<double>(), 0.0) << k;
+  EXPECT_LE(sec["prepare"].get<double>(),
+            sec["topology"].get<double>() + sec["geometry"].get<double>() + sec["cycles"].get<double>() + sec["plan"].get<double>() +
+                sec["analysis"].get<double>() + sec["setup"].get<double>() + 1e-3);
   // The BLAS kernels (trivcon/blas.h): the program re-executes itself rather than run OpenBLAS's generic
   // kernels on a CPU that supports better ones, unless OPENBLAS_CORETYPE chooses for it.
   ASSERT_TRUE(rep["blas_kernels"].is_string());
@@ -684,6 +694,15 @@ TEST(CliSolve, TorusWithoutSingularities) {
   EXPECT_LE(rep["residuals"]["max_vertex"].get<double>(), 1e-9);
   EXPECT_LE(rep["residuals"]["max_cycle"].get<double>(), 1e-9);
   EXPECT_TRUE(rep["singularities"].empty());
+  EXPECT_EQ(rep["ordering"], "CAMD");
+  EXPECT_EQ(rep["symbolic_analysis"], "concurrent");
+  // With a fixed face the system has a path row: the set-up analyses its own.
+  const CommandResult f = run_cli("solve " + q(mesh) + " -q --fix 0:angle=0 --fix 100:angle=0.5 --report " + q(report));
+  ASSERT_EQ(f.status, 0) << f.err;
+  const json fixed = json::parse(slurp(report));
+  EXPECT_EQ(fixed["symbolic_analysis"], "in set-up");
+  EXPECT_EQ(fixed["fixed"]["faces"], 2);
+  EXPECT_LE(fixed["residuals"]["max_cycle"].get<double>(), 1e-9);
 }
 
 // Runs a solve that must fail with exactly `message` and leave none of its outputs behind.

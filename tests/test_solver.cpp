@@ -228,6 +228,69 @@ TEST(Solver, SparseAndFullForwardSubstitutionsAgreeWithQr) {
   }
 }
 
+// FieldDesigner orders and analyses A W Aᵀ on a second thread, from the connectivity and cycles alone
+// (SolverAnalysis); the solver adopts that analysis only for the pattern it was made for, and the result
+// is the one of a solver that analysed its own system.
+TEST(Solver, ConcurrentAnalysisIsAdoptedAndChangesNothing) {
+  std::vector<Case> cases = generated_cases();
+  {
+    // Zero weights (a zero-area face): those edges are explicit zeros of the analysed pattern.
+    Mesh m = make_disk(8, 6);
+    m.V.row(m.F(5, 2)) = 0.5 * (m.V.row(m.F(5, 0)) + m.V.row(m.F(5, 1)));  // corner 2 of face 5 onto its opposite edge
+    IndexPrescription p;
+    p.N = 4;
+    cases.push_back({"flattened_face", m, p});
+  }
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    FieldDesigner d(c.mesh.V, c.mesh.F);
+    const Design a = d.design(c.prescription);
+    EXPECT_TRUE(d.solver().timings().analysis_adopted);
+    EXPECT_GT(d.timings().analysis, 0.0);
+    EXPECT_GT(d.timings().prepare, 0.0);
+    const ConnectionSolver own(d.topology(), d.geometry(), d.cycles());
+    EXPECT_FALSE(own.timings().analysis_adopted);
+    if (c.name == "flattened_face") {
+      int zero = 0;
+      for (int e = 0; e < d.topology().num_edges; ++e) zero += !d.topology().is_boundary_edge(e) && own.weights()(e) == 0;
+      EXPECT_GT(zero, 0);
+    }
+    const Connection b = own.solve(c.prescription);
+    EXPECT_EQ(a.connection.generator_index, b.generator_index);
+    EXPECT_EQ(a.connection.loop_index, b.loop_index);
+    EXPECT_LE(max_abs(a.connection.x - b.x), 1e-10 * std::max(1.0, max_abs(b.x)));
+    EXPECT_NEAR(a.connection.energy, b.energy, 1e-10 * std::max(1.0, b.energy));
+    expect_exact(d, a, c.prescription, c.name != "flattened_face");
+  }
+}
+
+TEST(Solver, AnalysisOfAnotherPatternIsNotAdopted) {
+  const Mesh m = make_torus(30, 14), other = make_torus(30, 15);
+  FieldDesigner d(m.V, m.F, SolverOptions{WeightKind::Cotan, SolverKind::QR});  // topology, geometry, cycles only
+  FieldDesigner o(other.V, other.F, SolverOptions{WeightKind::Cotan, SolverKind::QR});
+  int calls = 0;
+  const ConnectionSolver s(d.topology(), d.geometry(), d.cycles(), {}, {}, [&] {
+    ++calls;
+    return SolverAnalysis(o.topology(), o.cycles());
+  });
+  EXPECT_EQ(calls, 1);
+  EXPECT_FALSE(s.timings().analysis_adopted);
+  IndexPrescription p;
+  p.N = 4;
+  p.vertex[10] = 1, p.vertex[200] = -1;
+  const Connection a = s.solve(p), b = ConnectionSolver(d.topology(), d.geometry(), d.cycles()).solve(p);
+  EXPECT_LE(max_abs(a.x - b.x), 1e-12 * std::max(1.0, max_abs(b.x)));
+  EXPECT_LE(a.max_vertex_residual, 1e-9);
+  // With fixed faces the system has path rows: the analysis is not asked for.
+  calls = 0;
+  const ConnectionSolver f(d.topology(), d.geometry(), d.cycles(), {}, {3, 300}, [&] {
+    ++calls;
+    return SolverAnalysis(d.topology(), d.cycles());
+  });
+  EXPECT_EQ(calls, 0);
+  EXPECT_FALSE(f.timings().analysis_adopted);
+}
+
 TEST(Solver, UnitWeightsAreExact) {
   for (const Case& c : generated_cases()) {
     SCOPED_TRACE(c.name);

@@ -1,6 +1,7 @@
 // trivcon/design.h: the whole pipeline on plain (V, F) — validate, prepare once, then design fields.
 //
 //   trivcon::FieldDesigner designer(V, F);          // topology, geometry, cycles (factorization on first use)
+//   designer.set_fixed_faces({});                    // optional: factor now rather than on the first design
 //   trivcon::IndexPrescription p;  p.N = 4;  p.vertex[12] = 1;  ...
 //   trivcon::Design d = designer.design(p);          // a re-solve: milliseconds
 //   d.field.angle, d.connection.x, d.indices ...
@@ -9,10 +10,17 @@
 // give their angles in each prescription's `fixed` map; each component with fixed faces starts its field
 // at its smallest fixed face, with that face's angle.
 //
+// Set-up on two threads: after the topology, a second thread computes the cycles and the solver's
+// symbolic analysis (they depend on the connectivity only, trivcon/solver.h SolverAnalysis) while this
+// one computes the geometry and the field's propagation plan; the factorization (on first use) waits
+// for the analysis if it is not done yet. With fixed faces, or SolverKind::QR, the solver analyses its
+// own system and the early analysis is not used.
+//
 // Every design is verified: the largest holonomy residual over all vertex, loop and generator cycles,
 // the field's mismatch with the connection across every dual edge, and the indices read back from the
 // field itself are compared with the prescription (see trivcon/field.h for when they can differ).
 #pragma once
+#include <future>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -41,13 +49,18 @@ struct Design {
 };
 
 struct PrepareTimings {
-  double topology = 0, geometry = 0, cycles = 0, setup = 0;
+  // Seconds of each stage; cycles and analysis ran on the second thread, concurrently with geometry and
+  // plan. prepare: wall time of the constructor plus the solver's set-up (what a user waits for).
+  double topology = 0, geometry = 0, cycles = 0, plan = 0, analysis = 0, setup = 0, prepare = 0;
 };
 
 class FieldDesigner {
  public:
   // Validates (finite coordinates, manifold, orientable) and prepares; throws trivcon::Error.
   FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptions options = {});
+  // The solver and the second thread refer to the members: a designer stays where it was built.
+  FieldDesigner(const FieldDesigner&) = delete;
+  FieldDesigner& operator=(const FieldDesigner&) = delete;
   // Sets the faces whose direction prescriptions fix, and sets up (factors) the solver for them.
   void set_fixed_faces(const std::vector<int>& faces);
 
@@ -57,6 +70,7 @@ class FieldDesigner {
   const Topology& topology() const { return topology_; }
   const Geometry& geometry() const { return geometry_; }
   const Cycles& cycles() const { return cycles_; }
+  const PropagationPlan& plan() const { return plan_; }  // the field's spanning trees (trivcon/field.h)
   const ConnectionSolver& solver() const;  // set up on first use
   const PrepareTimings& timings() const { return timings_; }
 
@@ -70,6 +84,9 @@ class FieldDesigner {
   mutable std::unique_ptr<ConnectionSolver> solver_;
   mutable PrepareTimings timings_;
   std::vector<int> fixed_faces_;
+  double construct_seconds_ = 0;
+  // Declared last: destroyed (joined) first, while the members its thread reads still exist.
+  mutable std::future<SolverAnalysis> analysis_;
 };
 
 }  // namespace trivcon

@@ -37,6 +37,7 @@
 // steps while the energy decreases.
 #pragma once
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -72,9 +73,32 @@ struct Connection {
 };
 
 struct SetupTimings {
-  // assemble: weights, constraint rows, A W Aᵀ; factor: ordering, symbolic analysis, numeric factorization;
-  // schur: the Schur complement's inverse factor and the stored forward substitution.
-  double assemble = 0, factor = 0, schur = 0;
+  // assemble: weights, constraint rows, A W Aᵀ; factor: ordering, symbolic analysis (unless a
+  // SolverAnalysis was adopted), numeric factorization; schur: the Schur complement's inverse factor and
+  // the stored forward substitution; analysis_wait: time spent waiting for a given SolverAnalysis.
+  double assemble = 0, factor = 0, schur = 0, analysis_wait = 0;
+  bool analysis_adopted = false;  // the factorization used the given SolverAnalysis
+};
+
+// The fill-reducing order and CHOLMOD's symbolic factorization of the Cholesky route's A W Aᵀ for a mesh
+// without fixed faces. The pattern of A W Aᵀ is that of the mesh's vertices, interior edges and cycles
+// (an edge of zero weight is an explicit zero): it does not depend on the geometry or the weights, so
+// this part of the set-up can run on another thread while the geometry is computed (FieldDesigner does).
+// A ConnectionSolver given one adopts it when the pattern it assembles is exactly the one analysed
+// (compared entry by entry), and analyses its own otherwise.
+class SolverAnalysis {
+ public:
+  SolverAnalysis(const Topology& topology, const Cycles& cycles);
+  ~SolverAnalysis();
+  SolverAnalysis(SolverAnalysis&&) noexcept;
+  SolverAnalysis& operator=(SolverAnalysis&&) noexcept;
+  double seconds() const;  // how long the analysis took (on whichever thread ran it)
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+  friend class ConnectionSolver;
 };
 
 class ConnectionSolver {
@@ -82,9 +106,11 @@ class ConnectionSolver {
   // Builds and factors everything that does not depend on the prescription. Throws trivcon::Error if a
   // factorization fails (e.g. cycle rows made dependent by the weights).
   // `fixed_faces`: faces whose direction each prescription fixes (trivcon/constraints.h); they change the
-  // matrix, their angles only the right-hand side.
+  // matrix, their angles only the right-hand side. `analysis`, if given, is called once A W Aᵀ is
+  // assembled, for a SolverAnalysis of this topology and these cycles (e.g. one computed concurrently);
+  // only the Cholesky route without fixed faces calls it.
   ConnectionSolver(const Topology& topology, const Geometry& geometry, const Cycles& cycles, SolverOptions options = {},
-                   const std::vector<int>& fixed_faces = {});
+                   const std::vector<int>& fixed_faces = {}, const std::function<SolverAnalysis()>& analysis = {});
   ~ConnectionSolver();
   ConnectionSolver(const ConnectionSolver&) = delete;
   ConnectionSolver& operator=(const ConnectionSolver&) = delete;
@@ -122,7 +148,7 @@ class ConnectionSolver {
 
   // Rows of the reduced system: interior vertices (minus one per closed component), then the cycle
   // rows C: boundary loops (minus one per component with boundary), then generators.
-  std::vector<int> active_edges_, edge_column_;  // interior edges with w_e > 0, and their column
+  std::vector<int> active_edges_, edge_column_;  // the system edges (see solver.cpp), and their column
   std::vector<int> vertex_row_;                  // row of each vertex, −1 if none
   int num_vertex_rows_ = 0;
   std::vector<int> dropped_vertex_, dropped_loop_;  // per component, −1 if none
