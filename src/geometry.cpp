@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <omp.h>
 
 namespace trivcon {
 
@@ -48,8 +49,9 @@ Eigen::Vector3d Geometry::direction_in_face(int f, double beta) const {
   return std::cos(beta) * frame_x.row(f).transpose() + std::sin(beta) * frame_y.row(f).transpose();
 }
 
-Geometry compute_geometry(const MatrixX3d& V, const Topology& t) {
+Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   const int nF = t.num_faces, nE = t.num_edges, nV = t.num_vertices;
+  const int team = threads > 0 ? threads : omp_get_max_threads();
   Geometry g;
   g.corner_angles.resize(nF, 3);
   g.half_edge_angle.resize(nF, 3);
@@ -62,7 +64,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t) {
   std::vector<Eigen::Vector3d> raw_normal(nF);
   int degenerate_faces = 0, zero_area_faces = 0;
   // Faces, then edges, are independent of one another: both loops run on all cores (OpenMP).
-#pragma omp parallel for schedule(static) reduction(+ : degenerate_faces, zero_area_faces) if (nF > kParallelMin)
+#pragma omp parallel for schedule(static) reduction(+ : degenerate_faces, zero_area_faces) num_threads(team) if (nF > kParallelMin)
   for (int f = 0; f < nF; ++f) {
     const Eigen::Vector3d p[3] = {V.row(t.F(f, 0)), V.row(t.F(f, 1)), V.row(t.F(f, 2))};
     const Eigen::Vector3d a = corner_angles_of(p);
@@ -90,7 +92,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t) {
   g.degenerate_faces = degenerate_faces, g.zero_area_faces = zero_area_faces;
   // Frames. A degenerate face borrows the summed normal of its edge neighbours (any unit vector
   // perpendicular to its first edge as a last resort), so every output stays finite.
-#pragma omp parallel for schedule(static) if (nF > kParallelMin)
+#pragma omp parallel for schedule(static) num_threads(team) if (nF > kParallelMin)
   for (int f = 0; f < nF; ++f) {
     Eigen::Vector3d n = raw_normal[f];
     if (g.degenerate_face[f]) {
@@ -134,7 +136,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t) {
   g.rho.setZero(nE);
   g.cotan_weight.setZero(nE);
   int negative_cotan_edges = 0;
-#pragma omp parallel for schedule(static) reduction(+ : negative_cotan_edges) if (nE > kParallelMin)
+#pragma omp parallel for schedule(static) reduction(+ : negative_cotan_edges) num_threads(team) if (nE > kParallelMin)
   for (int e = 0; e < nE; ++e) {
     if (t.is_boundary_edge(e)) continue;
     const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);

@@ -12,7 +12,8 @@
 //
 // Set-up on two threads: after the topology, a second thread computes the cycles and the solver's
 // symbolic analysis (they depend on the connectivity only, trivcon/solver.h SolverAnalysis) while this
-// one computes the geometry and the field's propagation plan; the factorization (on first use) waits
+// one computes the geometry (on one OpenMP thread fewer than the default) and the field's propagation
+// plan; the factorization (on first use) waits
 // for the analysis if it is not done yet. With fixed faces, or SolverKind::QR, the solver analyses its
 // own system and the early analysis is not used.
 //

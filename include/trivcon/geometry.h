@@ -48,7 +48,9 @@ struct Geometry {
   Eigen::Vector3d direction_in_face(int f, double beta) const;
 };
 
-Geometry compute_geometry(const MatrixX3d& V, const Topology& topology);
+// The per-face and per-edge loops run on `threads` OpenMP threads (0: OpenMP's default) on meshes of
+// more than 50k faces.
+Geometry compute_geometry(const MatrixX3d& V, const Topology& topology, int threads = 0);
 
 // Wraps an angle into (−π, π].
 double wrap_angle(double a);
