@@ -8,6 +8,7 @@ namespace trivcon {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
+constexpr int kParallelFaces = 100000;  // propagate_field's per-face loops run on all cores (OpenMP) above this
 // Into [0, 2π), through wrap_angle's (−π, π].
 double wrap_positive(double a) {
   a = wrap_angle(a);
@@ -63,11 +64,15 @@ Field propagate_field(const Topology& t, const Geometry& g, const PropagationPla
     throw Error("the propagation plan was made for another mesh");
   // Angles are summed unwrapped along the tree in plan order (exact up to round-off), then each
   // component is shifted to its root angle and every face's angle wrapped once.
+  // The turn into each face is read first on all cores (scattered reads), then summed in order.
   std::vector<double> along(nF);
+#pragma omp parallel for schedule(static) if (nF > kParallelFaces)
   for (int q = 0; q < nF; ++q) {
     const int e = plan.edge[q];
-    along[q] = e < 0 ? 0.0 : along[plan.parent[q]] + plan.sign[q] * (g.rho(e) - x(e));
+    along[q] = e < 0 ? 0.0 : plan.sign[q] * (g.rho(e) - x(e));
   }
+  for (int q = 0; q < nF; ++q)
+    if (plan.edge[q] >= 0) along[q] += along[plan.parent[q]];
   std::vector<double> shift(t.components.size(), 0.0);
   std::vector<char> rooted(t.components.size(), 0);
   std::vector<int> position;
@@ -84,8 +89,12 @@ Field propagate_field(const Topology& t, const Geometry& g, const PropagationPla
     shift[c] = angle - along[position[f]];
   }
   field.angle.resize(nF);
-  for (size_t c = 0; c < t.components.size(); ++c)
-    for (int q = plan.component_begin[c]; q < plan.component_begin[c + 1]; ++q) field.angle(plan.order[q]) = wrap_positive(along[q] + shift[c]);
+  const int nC = static_cast<int>(t.components.size());
+  for (int c = 0; c < nC; ++c) {
+    const int begin = plan.component_begin[c], end = plan.component_begin[c + 1];
+#pragma omp parallel for schedule(static) if (end - begin > kParallelFaces)
+    for (int q = begin; q < end; ++q) field.angle(plan.order[q]) = wrap_positive(along[q] + shift[c]);
+  }
   return field;
 }
 

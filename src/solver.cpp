@@ -8,6 +8,7 @@
 #include <functional>
 #include <cmath>
 #include <numeric>
+#include <omp.h>
 
 #include "ordering.h"
 #include "trivcon/error.h"
@@ -22,6 +23,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 // Beyond this many fixed-face paths the Cholesky route keeps them out of the dense block.
 constexpr int kMaxDensePaths = 256;
+// Per-edit loops over edges or vertices run on all cores (OpenMP) above this size.
+constexpr int kParallelEdits = 100000;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
 using Clock = std::chrono::steady_clock;
@@ -265,6 +268,10 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   mutable std::vector<int> super_stamp_;
   mutable Eigen::VectorXd forward_work_;
   mutable int stamp_ = 0;
+  // Backward substitution on two threads (see plan_backward): the supernodes of the top of the tree,
+  // then two sets of disjoint subtrees, all in decreasing order.
+  std::vector<int> backward_top_;
+  std::array<std::vector<int>, 2> backward_part_;
 
   // The rows of A (see normal_matrix): vertex rows given per system edge by the rows of its two ends (a
   // boundary or dropped vertex has none), then the extra rows Et (fixed-face paths that are ordered with
@@ -368,6 +375,84 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     }
     super_stamp_.assign(nsuper, -1);
     for (int& r : edge_rows_.row) r = position_[r];
+    plan_backward();
+  }
+
+  // Splits the supernodal elimination tree for a backward substitution on two threads: subtrees whose
+  // roots are done are independent. The top supernodes go first (one thread); below them, the largest
+  // remaining subtree is split further (its root joins the top) until the subtrees can be shared out
+  // evenly by size (entries of the factor), largest first to the lighter part.
+  void plan_backward() {
+    const int* pi = static_cast<const int*>(factor->pi);
+    const int* super = static_cast<const int*>(factor->super);
+    const int nsuper = static_cast<int>(factor->nsuper);
+    std::vector<double> work(nsuper);  // entries of the factor in each supernode's subtree
+    std::vector<std::vector<int>> children(nsuper);
+    std::vector<int> roots;
+    for (int s = 0; s < nsuper; ++s) {
+      work[s] += static_cast<double>(pi[s + 1] - pi[s]) * (super[s + 1] - super[s]);
+      if (super_parent_[s] >= 0) work[super_parent_[s]] += work[s], children[super_parent_[s]].push_back(s);
+      else roots.push_back(s);
+    }
+    backward_top_.clear();
+    for (auto& part : backward_part_) part.clear();
+    auto larger = [&](int a, int b) { return work[a] < work[b]; };
+    std::vector<int> open = roots;  // a max-heap of subtree roots by work
+    std::make_heap(open.begin(), open.end(), larger);
+    double open_work = 0;
+    for (int r : roots) open_work += work[r];
+    // Split while the largest subtree is more than half of the rest (and worth splitting at all).
+    while (!open.empty() && work[open.front()] > 0.5 * open_work && work[open.front()] > 1e4) {
+      std::pop_heap(open.begin(), open.end(), larger);
+      const int s = open.back();
+      open.pop_back();
+      backward_top_.push_back(s);
+      open_work -= work[s];
+      for (int c : children[s]) open.push_back(c), std::push_heap(open.begin(), open.end(), larger), open_work += work[c];
+    }
+    std::sort(open.begin(), open.end(), [&](int a, int b) { return work[a] > work[b]; });
+    std::array<double, 2> load{0, 0};
+    std::vector<int> stack;
+    for (int r : open) {
+      const int k = load[0] <= load[1] ? 0 : 1;
+      load[k] += work[r];
+      for (stack.assign(1, r); !stack.empty();) {
+        const int s = stack.back();
+        stack.pop_back();
+        backward_part_[k].push_back(s);
+        stack.insert(stack.end(), children[s].begin(), children[s].end());
+      }
+    }
+    std::sort(backward_top_.begin(), backward_top_.end(), std::greater<int>());
+    for (auto& part : backward_part_) std::sort(part.begin(), part.end(), std::greater<int>());
+  }
+
+  // z ← L⁻ᵀ z (in factor order): the top supernodes, then the two parts of the tree concurrently.
+  // Each supernode s solves its columns given its rows below, which belong to its ancestors: done
+  // before it (the top) or earlier in its own part (decreasing order).
+  void backward(Eigen::VectorXd& z) const {
+    const int* super = static_cast<const int*>(factor->super);
+    const int* pi = static_cast<const int*>(factor->pi);
+    const int* px = static_cast<const int*>(factor->px);
+    const int* rows = static_cast<const int*>(factor->s);
+    const double* x = static_cast<const double*>(factor->x);
+    auto solve_supernodes = [&](const std::vector<int>& list) {
+      Eigen::VectorXd below;
+      for (int s : list) {
+        const int first = super[s], ncol = super[s + 1] - first, nrow = pi[s + 1] - pi[s];
+        const Eigen::Map<const Eigen::MatrixXd> Ls(x + px[s], nrow, ncol);
+        auto block = z.segment(first, ncol);
+        if (nrow > ncol) {
+          below.resize(nrow - ncol);
+          for (int i = 0; i < nrow - ncol; ++i) below(i) = z(rows[pi[s] + ncol + i]);
+          block.noalias() -= Ls.bottomRows(nrow - ncol).transpose() * below;
+        }
+        Ls.topRows(ncol).triangularView<Eigen::Lower>().transpose().solveInPlace(block);
+      }
+    };
+    solve_supernodes(backward_top_);
+#pragma omp parallel for schedule(static, 1) num_threads(std::min(2, omp_get_max_threads())) if (!backward_part_[1].empty())
+    for (int k = 0; k < 2; ++k) solve_supernodes(backward_part_[k]);
   }
 
   // z += L⁻¹ d for d with the few nonzeros `entries` (factor positions, values): only the supernodes on
@@ -487,8 +572,10 @@ struct CholeskyEngine : ConnectionSolver::Engine {
       const Eigen::VectorXd b_C = choose(-(R_CC * z_C0));  // the energy ‖z‖² is least at b_C = −R_CC z_C0
       z.tail(nC) = z_C0 + R_CC.triangularView<Eigen::Lower>().solve(b_C);
     }
-    const Eigen::VectorXd y = apply(CHOLMOD_Lt, z);  // [λ; μ] in factor order
+    Eigen::VectorXd& y = z;  // [λ; μ] in factor order
+    backward(y);
     Eigen::VectorXd x(m);
+#pragma omp parallel for schedule(static) if (m > kParallelEdits)
     for (int a = 0; a < m; ++a) {
       double sum = 0;
       for (int k = edge_rows_.start[a]; k < edge_rows_.start[a + 1]; ++k) sum += edge_rows_.coefficient[k] * y(edge_rows_.row[k]);
@@ -1022,7 +1109,9 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   Connection result;
   result.N = N;
   result.x.setZero(t.num_edges);
-  for (size_t a = 0; a < active_edges_.size(); ++a) result.x(active_edges_[a]) = x_active(a);
+  const int num_active = static_cast<int>(active_edges_.size());
+#pragma omp parallel for schedule(static) if (num_active > kParallelEdits)
+  for (int a = 0; a < num_active; ++a) result.x(active_edges_[a]) = x_active(a);
   const int nG = num_generators();
   result.generator_index.assign(nG, 0);
   result.generator_chosen.assign(nG, 0);
@@ -1063,8 +1152,13 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
     result.loop_index[dl] = rest;
     result.loop_chosen[dl] = !prescription.loop.count(dl);
   }
-  for (int e : active_edges_)
-    if (weights_(e) > 0) result.energy += result.x(e) * result.x(e) / weights_(e);
+  double energy = 0;
+#pragma omp parallel for schedule(static) reduction(+ : energy) if (num_active > kParallelEdits)
+  for (int a = 0; a < num_active; ++a) {
+    const int e = active_edges_[a];
+    if (weights_(e) > 0) energy += result.x(e) * result.x(e) / weights_(e);
+  }
+  result.energy = energy;
 
   IndexPrescription used = prescription;
   for (int g = 0; g < nG; ++g) used.generator[g] = result.generator_index[g];
@@ -1086,21 +1180,24 @@ void verify_connection(const Topology& t, const Geometry& geometry, const Cycles
   const Eigen::VectorXd& x = connection.x;
   connection.max_vertex_residual = connection.max_cycle_residual = 0;
   connection.rhs_scale = 0;
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(t.num_vertices);
-  for (int e = 0; e < t.num_edges; ++e) {
-    if (t.is_boundary_edge(e)) continue;
-    sum(t.edge_vertices(e, 1)) += x(e);
-    sum(t.edge_vertices(e, 0)) -= x(e);
-  }
   Eigen::VectorXd rhs_of = geometry.angle_defect;
   for (auto [v, n] : prescription.vertex)
     if (v >= 0 && v < t.num_vertices) rhs_of(v) -= step * n;
+  // Per interior vertex (all of its edges are interior), Σ_e s_ve x_e against its right-hand side.
+  double rhs_scale = 0, max_residual = 0;
+#pragma omp parallel for schedule(static) reduction(max : rhs_scale, max_residual) if (t.num_vertices > kParallelEdits)
   for (int v = 0; v < t.num_vertices; ++v) {
     if (!t.is_interior_vertex(v)) continue;
+    double sum = 0;
+    for (int k = t.vertex_edge_offsets[v]; k < t.vertex_edge_offsets[v + 1]; ++k) {
+      const int e = t.vertex_edges[k];
+      sum += t.edge_vertices(e, 1) == v ? x(e) : -x(e);
+    }
     const double rhs = rhs_of(v);
-    connection.rhs_scale = std::max(connection.rhs_scale, std::abs(rhs));
-    connection.max_vertex_residual = std::max(connection.max_vertex_residual, std::abs(sum(v) - rhs));
+    rhs_scale = std::max(rhs_scale, std::abs(rhs));
+    max_residual = std::max(max_residual, std::abs(sum - rhs));
   }
+  connection.rhs_scale = rhs_scale, connection.max_vertex_residual = max_residual;
   auto check_cycle = [&](const DualCycle& cycle, double holonomy, int n) {
     double s = 0;
     for (size_t k = 0; k < cycle.edges.size(); ++k) s += cycle.signs[k] * x(cycle.edges[k]);

@@ -22,7 +22,8 @@
 // CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is minimum degree: CAMD with the cycle rows constrained last, or
 // AMD without cycle rows. A new prescription only changes b: nothing is refactored. The forward substitution
 // of the prescription without singularities is stored, so an edit that places a few singularities
-// updates it along their paths in the elimination tree only, then does one full backward substitution.
+// updates it along their paths in the elimination tree only, then does one full backward substitution,
+// on two threads (OpenMP; the top of the elimination tree first, then two sets of independent subtrees).
 // Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
 // system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
 //
