@@ -16,47 +16,38 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 
 FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptions options) : V_(V), options_(options) {
   const auto start = Clock::now();
-  auto t0 = start;
-  check_finite(V_);
-  topology_ = build_topology(F, static_cast<int>(V_.rows()));
-  timings_.topology = seconds_since(t0);
-  if (options_.solver == SolverKind::Cholesky) {
-    // The cycles and the solver's symbolic analysis depend on the connectivity only: a second thread
-    // computes them while this one computes the geometry and the plan (see design.h).
-    std::promise<void> cycles_done;
-    std::future<void> cycles_ready = cycles_done.get_future();
-    analysis_ = std::async(std::launch::async, [this, done = std::move(cycles_done)]() mutable {
-      const auto t1 = Clock::now();
+  auto timed = [](double& seconds, auto&& step) {
+    const auto t0 = Clock::now();
+    step();
+    seconds = seconds_since(t0);
+  };
+  timed(timings_.topology, [&] {
+    check_finite(V_);
+    topology_ = build_topology(F, static_cast<int>(V_.rows()));
+  });
+  // The cycles and the solver's symbolic analysis depend on the connectivity only: on the Cholesky
+  // route a second thread computes them while this one computes the geometry and the plan (design.h).
+  const bool concurrent = options_.solver == SolverKind::Cholesky;
+  std::promise<void> cycles_done;
+  std::future<void> cycles_ready = cycles_done.get_future();
+  if (concurrent)
+    analysis_ = std::async(std::launch::async, [this, timed, done = std::move(cycles_done)]() mutable {
       try {
-        cycles_ = compute_cycles(topology_);
+        timed(timings_.cycles, [&] { cycles_ = compute_cycles(topology_); });
       } catch (...) {
         done.set_exception(std::current_exception());
         throw;
       }
-      timings_.cycles = seconds_since(t1);
       done.set_value();
       return SolverAnalysis(topology_, cycles_);
     });
-    // The geometry leaves a core to the analysis: on two cores, OpenMP's two threads and the analysis
-    // would share them, and the analysis, the longer of the two, would finish later (dragon: 0.15 s).
-    t0 = Clock::now();
-    geometry_ = compute_geometry(V_, topology_, std::max(1, omp_get_max_threads() - 1));
-    timings_.geometry = seconds_since(t0);
-    t0 = Clock::now();
-    plan_ = plan_propagation(topology_);
-    timings_.plan = seconds_since(t0);
-    cycles_ready.get();  // rethrows the thread's error
-  } else {
-    t0 = Clock::now();
-    geometry_ = compute_geometry(V_, topology_);
-    timings_.geometry = seconds_since(t0);
-    t0 = Clock::now();
-    cycles_ = compute_cycles(topology_);
-    timings_.cycles = seconds_since(t0);
-    t0 = Clock::now();
-    plan_ = plan_propagation(topology_);
-    timings_.plan = seconds_since(t0);
-  }
+  // With the analysis running, the geometry leaves it a core: on two cores, OpenMP's two threads and the
+  // analysis would share them, and the analysis, the longer of the two, would finish later (dragon: 0.15 s).
+  const int threads = concurrent ? std::max(1, omp_get_max_threads() - 1) : 0;
+  timed(timings_.geometry, [&] { geometry_ = compute_geometry(V_, topology_, threads); });
+  if (!concurrent) timed(timings_.cycles, [&] { cycles_ = compute_cycles(topology_); });
+  timed(timings_.plan, [&] { plan_ = plan_propagation(topology_); });
+  if (concurrent) cycles_ready.get();  // rethrows the thread's error
   construct_seconds_ = seconds_since(start);
   timings_.prepare = construct_seconds_;
 }
