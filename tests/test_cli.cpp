@@ -559,16 +559,17 @@ TEST(CliSolve, SphereWithTwoPoles) {
   EXPECT_EQ(rep["singularities"], json::parse(R"([{"vertex": 0, "index": "1"}, {"vertex": 85, "index": "1"}])"));
   EXPECT_TRUE(rep["generators"].empty());
   EXPECT_TRUE(rep["boundary_loops"].empty());
-  // The ordering and symbolic factorization ran on the second thread (trivcon/design.h) and were used;
-  // the wall time of the preparation is no more than the sum of its stages.
+  // The ordering and symbolic factorization ran on the second thread (trivcon/design.h) and were used.
+  // The wall time of the preparation covers the first thread's stages one after the other, and the
+  // cycles of the second (the constructor waits for them).
   EXPECT_EQ(rep["symbolic_analysis"], "concurrent");
   EXPECT_EQ(rep["ordering"], "AMD");
   const json& sec = rep["seconds"];
   for (const char* k : {"topology", "geometry", "cycles", "plan", "analysis", "setup", "setup_analysis_wait", "prepare"})
     EXPECT_GE(sec[k].get<double>(), 0.0) << k;
-  EXPECT_LE(sec["prepare"].get<double>(),
-            sec["topology"].get<double>() + sec["geometry"].get<double>() + sec["cycles"].get<double>() + sec["plan"].get<double>() +
-                sec["analysis"].get<double>() + sec["setup"].get<double>() + 1e-3);
+  auto seconds = [&](const char* k) { return sec[k].get<double>(); };
+  EXPECT_GE(seconds("prepare"), seconds("topology") + seconds("geometry") + seconds("plan") + seconds("setup") - 1e-6);
+  EXPECT_GE(seconds("prepare"), seconds("topology") + seconds("cycles") + seconds("setup") - 1e-6);
   // The BLAS kernels (trivcon/blas.h): the program re-executes itself rather than run OpenBLAS's generic
   // kernels on a CPU that supports better ones, unless OPENBLAS_CORETYPE chooses for it.
   ASSERT_TRUE(rep["blas_kernels"].is_string());
