@@ -315,6 +315,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     if (!given || !given->factor || given->nD != nD || given->nC != nC || given->outer != M.outer || given->inner != M.inner) return;
     factor = given->factor, given->factor = nullptr;
     cholmod_ = std::move(given);
+    std::vector<int>().swap(cholmod_->outer), std::vector<int>().swap(cholmod_->inner);  // compared: not needed any more
     analysis_adopted = true;
   }
 
