@@ -14,8 +14,9 @@
 // symbolic analysis (they depend on the connectivity only, trivcon/solver.h SolverAnalysis) while this
 // one computes the geometry (on one OpenMP thread fewer than the default) and the field's propagation
 // plan; the factorization (on first use) waits for the analysis if it is not done yet. With fixed
-// faces the solver analyses its own system and the early analysis is not used; with SolverKind::QR
-// there is no second thread.
+// faces the solver analyses its own system and the early analysis is not used (it still runs to its
+// end, on the core the first thread's single-threaded stages leave idle; the destructor waits for it);
+// with SolverKind::QR there is no second thread.
 //
 // Every design is verified: the largest holonomy residual over all vertex, loop and generator cycles,
 // the field's mismatch with the connection across every dual edge, and the indices read back from the
