@@ -14,7 +14,8 @@ struct Pattern {
 Pattern leading_block_pattern(const std::vector<int>& outer, const std::vector<int>& inner, int n);
 
 // The elimination tree of the block in the order `order` (order[k] = row eliminated k-th), Liu's
-// algorithm: parent[k] (positions), −1 at roots.
+// algorithm: parent[k] (positions), −1 at roots. (cholmod_etree would need the permuted matrix, a copy of
+// the whole block; this works on the unpermuted pattern through the positions.)
 std::vector<int> elimination_tree(const Pattern& pattern, const std::vector<int>& order);
 
 }  // namespace trivcon::ordering

@@ -239,6 +239,23 @@ struct SolverAnalysis::Impl {
 
 namespace {
 
+// CHOLMOD's supernodal factor, read in place: supernode s holds the columns first(s) … first(s) + cols(s)
+// − 1; its rows (its own columns first, then rows of its ancestors) are row(s, 0 … height(s) − 1), its
+// entries the height(s) × cols(s) column-major block values(s).
+struct Supernodes {
+  const int *super, *pi, *px, *rows;
+  const double* x;
+  int count;
+  explicit Supernodes(const cholmod_factor* L)
+      : super(static_cast<const int*>(L->super)), pi(static_cast<const int*>(L->pi)), px(static_cast<const int*>(L->px)),
+        rows(static_cast<const int*>(L->s)), x(static_cast<const double*>(L->x)), count(static_cast<int>(L->nsuper)) {}
+  int first(int s) const { return super[s]; }
+  int cols(int s) const { return super[s + 1] - super[s]; }
+  int height(int s) const { return pi[s + 1] - pi[s]; }
+  int row(int s, int i) const { return rows[pi[s] + i]; }
+  Eigen::Map<const Eigen::MatrixXd> values(int s) const { return {x + px[s], height(s), cols(s)}; }
+};
+
 // One supernodal Cholesky factorization R Rᵀ = Π M Πᵀ of the whole normal matrix
 //   M = A W Aᵀ = [ D W Dᵀ   D W Cᵀ ]
 //                [ C W Dᵀ   C W Cᵀ ],
@@ -362,19 +379,14 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     const int* perm = static_cast<const int*>(factor->Perm);
     position_.resize(n);
     for (int k = 0; k < n; ++k) position_[perm[k]] = k;
-    const int* super = static_cast<const int*>(factor->super);
-    const int* pi = static_cast<const int*>(factor->pi);
-    const int* rows = static_cast<const int*>(factor->s);
-    const int nsuper = static_cast<int>(factor->nsuper);
+    const Supernodes L(factor);
     super_of_col_.resize(n);
-    for (int s = 0; s < nsuper; ++s)
-      for (int k = super[s]; k < super[s + 1]; ++k) super_of_col_[k] = s;
-    super_parent_.assign(nsuper, -1);
-    for (int s = 0; s < nsuper; ++s) {
-      const int ncol = super[s + 1] - super[s], nrow = pi[s + 1] - pi[s];
-      if (nrow > ncol) super_parent_[s] = super_of_col_[rows[pi[s] + ncol]];
-    }
-    super_stamp_.assign(nsuper, -1);
+    for (int s = 0; s < L.count; ++s)
+      for (int k = L.first(s); k < L.first(s) + L.cols(s); ++k) super_of_col_[k] = s;
+    super_parent_.assign(L.count, -1);
+    for (int s = 0; s < L.count; ++s)
+      if (L.height(s) > L.cols(s)) super_parent_[s] = super_of_col_[L.row(s, L.cols(s))];
+    super_stamp_.assign(L.count, -1);
     for (int& r : edge_rows_.row) r = position_[r];
     plan_backward();
   }
@@ -384,14 +396,12 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   // remaining subtree is split further (its root joins the top) until the subtrees can be shared out
   // evenly by size (entries of the factor), largest first to the lighter part.
   void plan_backward() {
-    const int* pi = static_cast<const int*>(factor->pi);
-    const int* super = static_cast<const int*>(factor->super);
-    const int nsuper = static_cast<int>(factor->nsuper);
-    std::vector<double> work(nsuper);  // entries of the factor in each supernode's subtree
-    std::vector<std::vector<int>> children(nsuper);
+    const Supernodes L(factor);
+    std::vector<double> work(L.count);  // entries of the factor in each supernode's subtree
+    std::vector<std::vector<int>> children(L.count);
     std::vector<int> roots;
-    for (int s = 0; s < nsuper; ++s) {
-      work[s] += static_cast<double>(pi[s + 1] - pi[s]) * (super[s + 1] - super[s]);
+    for (int s = 0; s < L.count; ++s) {
+      work[s] += static_cast<double>(L.height(s)) * L.cols(s);
       if (super_parent_[s] >= 0) work[super_parent_[s]] += work[s], children[super_parent_[s]].push_back(s);
       else roots.push_back(s);
     }
@@ -432,20 +442,16 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   // Each supernode s solves its columns given its rows below, which belong to its ancestors: done
   // before it (the top) or earlier in its own part (decreasing order).
   void backward(Eigen::VectorXd& z) const {
-    const int* super = static_cast<const int*>(factor->super);
-    const int* pi = static_cast<const int*>(factor->pi);
-    const int* px = static_cast<const int*>(factor->px);
-    const int* rows = static_cast<const int*>(factor->s);
-    const double* x = static_cast<const double*>(factor->x);
+    const Supernodes L(factor);
     auto solve_supernodes = [&](const std::vector<int>& list) {
       Eigen::VectorXd below;
       for (int s : list) {
-        const int first = super[s], ncol = super[s + 1] - first, nrow = pi[s + 1] - pi[s];
-        const Eigen::Map<const Eigen::MatrixXd> Ls(x + px[s], nrow, ncol);
-        auto block = z.segment(first, ncol);
+        const int ncol = L.cols(s), nrow = L.height(s);
+        const auto Ls = L.values(s);
+        auto block = z.segment(L.first(s), ncol);
         if (nrow > ncol) {
           below.resize(nrow - ncol);
-          for (int i = 0; i < nrow - ncol; ++i) below(i) = z(rows[pi[s] + ncol + i]);
+          for (int i = 0; i < nrow - ncol; ++i) below(i) = z(L.row(s, ncol + i));
           block.noalias() -= Ls.bottomRows(nrow - ncol).transpose() * below;
         }
         Ls.topRows(ncol).triangularView<Eigen::Lower>().transpose().solveInPlace(block);
@@ -459,11 +465,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   // z += L⁻¹ d for d with the few nonzeros `entries` (factor positions, values): only the supernodes on
   // the paths from those entries to the root of the elimination tree are touched, in increasing order.
   void forward_update(const std::vector<std::pair<int, double>>& entries, Eigen::VectorXd& z) const {
-    const int* super = static_cast<const int*>(factor->super);
-    const int* pi = static_cast<const int*>(factor->pi);
-    const int* px = static_cast<const int*>(factor->px);
-    const int* rows = static_cast<const int*>(factor->s);
-    const double* x = static_cast<const double*>(factor->x);
+    const Supernodes L(factor);
     ++stamp_;
     std::vector<int> path;
     for (const auto& [k, value] : entries)
@@ -474,19 +476,19 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     for (const auto& [k, value] : entries) d(k) += value;
     Eigen::VectorXd below;
     for (int s : path) {
-      const int first = super[s], ncol = super[s + 1] - first, nrow = pi[s + 1] - pi[s];
-      const Eigen::Map<const Eigen::MatrixXd> Ls(x + px[s], nrow, ncol);
-      auto block = d.segment(first, ncol);
+      const int ncol = L.cols(s), nrow = L.height(s);
+      const auto Ls = L.values(s);
+      auto block = d.segment(L.first(s), ncol);
       Ls.topRows(ncol).triangularView<Eigen::Lower>().solveInPlace(block);
       if (nrow == ncol) continue;
       below.noalias() = Ls.bottomRows(nrow - ncol) * block;
-      for (int i = 0; i < nrow - ncol; ++i) d(rows[pi[s] + ncol + i]) -= below(i);
+      for (int i = 0; i < nrow - ncol; ++i) d(L.row(s, ncol + i)) -= below(i);
     }
     // Every entry touched lies in the columns of the path's supernodes (the rows below a supernode are
     // columns of its ancestors): add them to z and zero them again.
     for (int s : path) {
-      auto touched = d.segment(super[s], super[s + 1] - super[s]);
-      z.segment(super[s], super[s + 1] - super[s]) += touched;
+      auto touched = d.segment(L.first(s), L.cols(s));
+      z.segment(L.first(s), L.cols(s)) += touched;
       touched.setZero();
     }
   }
@@ -495,28 +497,24 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   void extract_cycle_block() {
     R_CC = Eigen::MatrixXd::Zero(nC, nC);
     if (nC == 0) return;
-    const int* super = static_cast<const int*>(factor->super);
-    const int* pi = static_cast<const int*>(factor->pi);
-    const int* px = static_cast<const int*>(factor->px);
-    const int* rows = static_cast<const int*>(factor->s);
-    const double* x = static_cast<const double*>(factor->x);
-    for (size_t s = 0; s < factor->nsuper; ++s) {
-      const int first = super[s], ncol = super[s + 1] - super[s], nrow = pi[s + 1] - pi[s];
-      for (int c = 0; c < ncol; ++c) {
-        const int col = first + c;
+    const Supernodes L(factor);
+    for (int s = 0; s < L.count; ++s) {
+      const auto Ls = L.values(s);
+      for (int c = 0; c < L.cols(s); ++c) {
+        const int col = L.first(s) + c;
         if (col < nD) continue;
-        for (int r = c; r < nrow; ++r) R_CC(rows[pi[s] + r] - nD, col - nD) = x[px[s] + r + static_cast<size_t>(c) * nrow];
+        for (int r = c; r < L.height(s); ++r) R_CC(L.row(s, r) - nD, col - nD) = Ls(r, c);
       }
     }
   }
 
-  // Solves with the factor pieces: sys is CHOLMOD_L or CHOLMOD_Lt (in factor order).
-  Eigen::VectorXd apply(int sys, const Eigen::VectorXd& b) const {
+  // L⁻¹ b by CHOLMOD (in factor order), for a right-hand side that is not an update of the base one.
+  Eigen::VectorXd lower_solve(const Eigen::VectorXd& b) const {
     cholmod_dense B{};
     B.nrow = b.size(), B.ncol = 1, B.nzmax = b.size(), B.d = b.size();
     B.x = const_cast<double*>(b.data());
     B.xtype = CHOLMOD_REAL, B.dtype = CHOLMOD_DOUBLE;
-    cholmod_dense* X = cholmod_solve(sys, factor, &B, &cc());
+    cholmod_dense* X = cholmod_solve(CHOLMOD_L, factor, &B, &cc());
     check(X != nullptr && cc().status == CHOLMOD_OK, "CHOLMOD solve failed");
     Eigen::VectorXd out = Eigen::Map<Eigen::VectorXd>(static_cast<double*>(X->x), b.size());
     cholmod_free_dense(&X, &cc());
@@ -526,7 +524,7 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   Eigen::VectorXd forward(const Eigen::VectorXd& b_D) const {
     Eigen::VectorXd permuted = Eigen::VectorXd::Zero(nD + nC);
     for (int r = 0; r < nD; ++r) permuted(position_[r]) = b_D(r);
-    return apply(CHOLMOD_L, permuted);
+    return lower_solve(permuted);
   }
 
   void set_base_rhs(const Eigen::VectorXd& b_D) override {
@@ -1164,7 +1162,7 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   IndexPrescription used = prescription;
   for (int g = 0; g < nG; ++g) used.generator[g] = result.generator_index[g];
   for (size_t l = 0; l < t.boundary_loops.size(); ++l) used.loop[static_cast<int>(l)] = result.loop_index[l];
-  verify_connection(t, geometry_, cycles_, used, result);
+  verify_connection(t, geometry_, cycles_, used, result, &loop_curvature_, &generator_holonomy_);
   result.max_cycle_residual = std::max(result.max_cycle_residual, path_residual);
   return result;
 }
@@ -1176,7 +1174,7 @@ int ConnectionSolver::component_of_row(int r) const {
 }
 
 void verify_connection(const Topology& t, const Geometry& geometry, const Cycles& cycles, const IndexPrescription& prescription,
-                       Connection& connection) {
+                       Connection& connection, const std::vector<double>* loop_curvatures, const std::vector<double>* generator_holonomies) {
   const double step = 2 * kPi / prescription.N;
   const Eigen::VectorXd& x = connection.x;
   connection.max_vertex_residual = connection.max_cycle_residual = 0;
@@ -1207,9 +1205,11 @@ void verify_connection(const Topology& t, const Geometry& geometry, const Cycles
     connection.max_cycle_residual = std::max(connection.max_cycle_residual, std::abs(s - rhs));
   };
   for (size_t l = 0; l < cycles.loops.size(); ++l)
-    check_cycle(cycles.loops[l], loop_curvature(t, geometry, static_cast<int>(l)), prescription.loop.at(static_cast<int>(l)));
+    check_cycle(cycles.loops[l], loop_curvatures ? (*loop_curvatures)[l] : loop_curvature(t, geometry, static_cast<int>(l)),
+                prescription.loop.at(static_cast<int>(l)));
   for (size_t g = 0; g < cycles.generators.size(); ++g)
-    check_cycle(cycles.generators[g], levi_civita_holonomy(cycles.generators[g], geometry), prescription.generator.at(static_cast<int>(g)));
+    check_cycle(cycles.generators[g], generator_holonomies ? (*generator_holonomies)[g] : levi_civita_holonomy(cycles.generators[g], geometry),
+                prescription.generator.at(static_cast<int>(g)));
 }
 
 }  // namespace trivcon

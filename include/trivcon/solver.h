@@ -168,7 +168,10 @@ class ConnectionSolver {
 };
 
 // Residuals of `x` against every constraint for the given indices (n/N): fills the verification fields.
+// The loops' curvatures and the generators' Levi-Civita holonomies are computed from the geometry unless
+// given (a ConnectionSolver gives the ones it computed at set-up, so that an edit does not redo them).
 void verify_connection(const Topology& topology, const Geometry& geometry, const Cycles& cycles, const IndexPrescription& prescription,
-                       Connection& connection);
+                       Connection& connection, const std::vector<double>* loop_curvatures = nullptr,
+                       const std::vector<double>* generator_holonomies = nullptr);
 
 }  // namespace trivcon
