@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 
 namespace trivcon {
 
@@ -36,6 +37,32 @@ void use_native_blas_kernels(char** argv) {
   if (setenv("OPENBLAS_CORETYPE", native.c_str(), 1) != 0) return;
   execv("/proc/self/exe", argv);
   unsetenv("OPENBLAS_CORETYPE");  // exec failed: carry on as we are
+}
+
+namespace {
+std::mutex blas_threads_mutex;
+int single_threaded_users = 0;  // live SingleThreadedBlas objects
+int saved_blas_threads = 0;     // OpenBLAS's thread count before the first of them
+using SetThreads = void (*)(int);
+using GetThreads = int (*)();
+}  // namespace
+
+SingleThreadedBlas::SingleThreadedBlas() {
+  const auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  const auto get = reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  if (!set || !get) return;
+  std::lock_guard<std::mutex> lock(blas_threads_mutex);
+  if (single_threaded_users++ == 0) {
+    saved_blas_threads = get();
+    if (saved_blas_threads > 1) set(1);
+  }
+}
+
+SingleThreadedBlas::~SingleThreadedBlas() {
+  const auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  if (!set || !dlsym(RTLD_DEFAULT, "openblas_get_num_threads")) return;
+  std::lock_guard<std::mutex> lock(blas_threads_mutex);
+  if (--single_threaded_users == 0 && saved_blas_threads > 1) set(saved_blas_threads);
 }
 
 }  // namespace trivcon

@@ -11,6 +11,7 @@
 #include <omp.h>
 
 #include "ordering.h"
+#include "supernodal.h"
 #include "trivcon/error.h"
 #include "trivcon/field.h"
 #include <algorithm>
@@ -339,15 +340,13 @@ struct CholeskyEngine : ConnectionSolver::Engine {
   void factorize(Csc& M) {
     const int n = nD + nC;
     if (!factor) factor = symbolic(M, vertex_order(M, nD, nC, cc()), nD, nC, cc());
-    cholmod_sparse A = view(M, n);
     const int* perm = static_cast<const int*>(factor->Perm);
-    cholmod_factorize(&A, factor, &cc());
-    if (cc().status == CHOLMOD_NOT_POSDEF || factor->minor < factor->n) {
+    if (supernodal::factorize(*factor, M.outer, M.inner, M.values, cc()) < n) {
       const int row = static_cast<int>(factor->minor);
       throw Error(row < n && perm[row] >= nD
                       ? "the holonomy of the generators, boundary loops or fixed-direction paths cannot be controlled independently "
                         "with these weights (the constraint system is singular); try --weights unit"
-                      : "CHOLMOD found the constraint system not positive definite; try --weights unit");
+                      : "the constraint system is not positive definite with these weights; try --weights unit");
     }
     check(cc().status == CHOLMOD_OK && factor->is_super && factor->is_ll, "CHOLMOD factorization failed");
     for (int k = nD; k < n; ++k) check(perm[k] == k, "CHOLMOD did not keep the cycle rows last");
@@ -383,59 +382,21 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     super_of_col_.resize(n);
     for (int s = 0; s < L.count; ++s)
       for (int k = L.first(s); k < L.first(s) + L.cols(s); ++k) super_of_col_[k] = s;
-    super_parent_.assign(L.count, -1);
-    for (int s = 0; s < L.count; ++s)
-      if (L.height(s) > L.cols(s)) super_parent_[s] = super_of_col_[L.row(s, L.cols(s))];
+    super_parent_ = supernodal::supernode_parents(*factor);
     super_stamp_.assign(L.count, -1);
     for (int& r : edge_rows_.row) r = position_[r];
     plan_backward();
   }
 
-  // Splits the supernodal elimination tree for a backward substitution on two threads: subtrees whose
-  // roots are done are independent. The top supernodes go first (one thread); below them, the largest
-  // remaining subtree is split further (its root joins the top) until the subtrees can be shared out
-  // evenly by size (entries of the factor), largest first to the lighter part.
+  // Splits the supernodal elimination tree for a backward substitution on two threads, balanced by
+  // the factor's entries (see supernodal::split_tree), each list in decreasing order.
   void plan_backward() {
     const Supernodes L(factor);
-    std::vector<double> work(L.count);  // entries of the factor in each supernode's subtree
-    std::vector<std::vector<int>> children(L.count);
-    std::vector<int> roots;
-    for (int s = 0; s < L.count; ++s) {
-      work[s] += static_cast<double>(L.height(s)) * L.cols(s);
-      if (super_parent_[s] >= 0) work[super_parent_[s]] += work[s], children[super_parent_[s]].push_back(s);
-      else roots.push_back(s);
-    }
-    backward_top_.clear();
-    for (auto& part : backward_part_) part.clear();
-    auto larger = [&](int a, int b) { return work[a] < work[b]; };
-    std::vector<int> open = roots;  // a max-heap of subtree roots by work
-    std::make_heap(open.begin(), open.end(), larger);
-    double open_work = 0;
-    for (int r : roots) open_work += work[r];
-    // Split while the largest subtree is more than half of the rest (and worth splitting at all).
-    while (!open.empty() && work[open.front()] > 0.5 * open_work && work[open.front()] > 1e4) {
-      std::pop_heap(open.begin(), open.end(), larger);
-      const int s = open.back();
-      open.pop_back();
-      backward_top_.push_back(s);
-      open_work -= work[s];
-      for (int c : children[s]) open.push_back(c), std::push_heap(open.begin(), open.end(), larger), open_work += work[c];
-    }
-    std::sort(open.begin(), open.end(), [&](int a, int b) { return work[a] > work[b]; });
-    std::array<double, 2> load{0, 0};
-    std::vector<int> stack;
-    for (int r : open) {
-      const int k = load[0] <= load[1] ? 0 : 1;
-      load[k] += work[r];
-      for (stack.assign(1, r); !stack.empty();) {
-        const int s = stack.back();
-        stack.pop_back();
-        backward_part_[k].push_back(s);
-        stack.insert(stack.end(), children[s].begin(), children[s].end());
-      }
-    }
-    std::sort(backward_top_.begin(), backward_top_.end(), std::greater<int>());
-    for (auto& part : backward_part_) std::sort(part.begin(), part.end(), std::greater<int>());
+    std::vector<double> entries(L.count);
+    for (int s = 0; s < L.count; ++s) entries[s] = static_cast<double>(L.height(s)) * L.cols(s);
+    supernodal::TreeSplit split = supernodal::split_tree(super_parent_, entries, 1e4);
+    backward_top_.assign(split.top.rbegin(), split.top.rend());
+    for (int k = 0; k < 2; ++k) backward_part_[k].assign(split.part[k].rbegin(), split.part[k].rend());
   }
 
   // z ← L⁻ᵀ z (in factor order): the top supernodes, then the two parts of the tree concurrently.

@@ -1,6 +1,6 @@
-// trivcon/blas.h: which BLAS kernels the factorization runs on.
+// trivcon/blas.h: which BLAS kernels the factorization runs on, and how many threads each BLAS call uses.
 //
-// CHOLMOD's supernodal factorization spends most of its time in BLAS (dgemm, dsyrk, dtrsm). Debian 12's
+// The supernodal factorization (src/supernodal.h) spends most of its time in BLAS (dgemm, dsyrk, dtrsm). Debian 12's
 // OpenBLAS 0.3.21 picks its kernels for the CPU when it is loaded, and does not recognise recent CPUs
 // (e.g. Intel family 6 model 207, the machine of BENCHMARKS.md): it falls back to its generic "Prescott"
 // (SSE3) kernels, which factor 1.3–1.5× slower there than its AVX-512 ("SkylakeX") ones. OpenBLAS only
@@ -24,5 +24,18 @@ std::string native_blas_kernels();
 // re-execution fails (the program then carries on with the generic kernels). Set OPENBLAS_CORETYPE
 // yourself (e.g. to Prescott) to keep your own choice.
 void use_native_blas_kernels(char** argv);
+
+// While an object of this class lives, OpenBLAS runs every call on the calling thread alone (its own
+// thread count is set to 1, and restored when the last such object in the process is destroyed). For
+// code that calls BLAS from several threads at once: OpenBLAS 0.3.21's pthread build would give each call
+// its thread pool, and concurrent calls then wait for each other (the factorization's two threads took
+// 2–3× longer). Does nothing if the BLAS is not OpenBLAS.
+class SingleThreadedBlas {
+ public:
+  SingleThreadedBlas();
+  ~SingleThreadedBlas();
+  SingleThreadedBlas(const SingleThreadedBlas&) = delete;
+  SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
+};
 
 }  // namespace trivcon

@@ -16,9 +16,9 @@
 // interior-vertex rows D and the cycle rows C (loops, generators). D W Dᵀ is the cotan Laplacian on
 // interior vertices; on a closed component one vertex row is dropped (Gauss–Bonnet makes it redundant),
 // and on a component with boundary one loop row is (its index follows from the others). A W Aᵀ is
-// factored once by CHOLMOD (supernodal, OpenBLAS), the vertex rows in a fill-reducing order and the cycle
-// rows last, so that the
-// trailing block of the factor is the Cholesky factor of the Schur complement S = CWCᵀ −
+// factored once (supernodal LLᵀ: CHOLMOD's symbolic analysis, our numeric factorization into CHOLMOD's
+// factor on two threads, src/supernodal.h; OpenBLAS), the vertex rows in a fill-reducing order and the
+// cycle rows last, so that the trailing block of the factor is the Cholesky factor of the Schur complement S = CWCᵀ −
 // CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is minimum degree: CAMD with the cycle rows constrained last, or
 // AMD without cycle rows. A new prescription only changes b: nothing is refactored. The forward substitution
 // of the prescription without singularities is stored, so an edit that places a few singularities

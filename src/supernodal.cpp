@@ -1,0 +1,333 @@
+#include "supernodal.h"
+
+#include <omp.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <optional>
+#include <string>
+
+#include "trivcon/blas.h"
+#include "trivcon/error.h"
+
+// Fortran BLAS and LAPACK, the same OpenBLAS CHOLMOD calls (libblas.so.3 / liblapack.so.3).
+extern "C" {
+void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k, const double* alpha, const double* a, const int* lda,
+            const double* beta, double* c, const int* ldc);
+void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const double* alpha, const double* a,
+            const int* lda, const double* b, const int* ldb, const double* beta, double* c, const int* ldc);
+void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n, const double* alpha,
+            const double* a, const int* lda, double* b, const int* ldb);
+void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+}
+
+namespace trivcon::supernodal {
+
+namespace {
+
+// Below these sizes a block is computed by inlined loops (Eigen; our own panel factorization) instead of
+// a BLAS call. Most supernodes near the leaves are a few columns wide; on the 400k-face meshes the
+// thresholds (from all-BLAS to none below 10⁹ flops) moved the time by less than the machine's noise, except
+// that without BLAS at all the top of the tree takes 4× longer.
+constexpr double kBlasUpdateFlops = 8192;  // ndrow2 · ndrow1 · ndcol of one descendant's update
+constexpr int kBlasColumns = 24;           // columns of a supernode's own factorization
+
+using Block = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+using ConstBlock = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+
+// The matrix permuted to factor order, lower triangle, by columns: column k holds its rows ≥ k.
+struct PermutedLower {
+  std::vector<int> start, row;
+  std::vector<double> value;
+};
+
+PermutedLower permuted_lower(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
+                             const std::vector<int>& position) {
+  const int n = static_cast<int>(position.size());
+  PermutedLower A;
+  A.start.assign(static_cast<size_t>(n) + 1, 0);
+  for (int c = 0; c < n; ++c)
+    for (int k = outer[c]; k < outer[c + 1]; ++k) ++A.start[std::min(position[inner[k]], position[c]) + 1];
+  for (int c = 0; c < n; ++c) A.start[c + 1] += A.start[c];
+  std::vector<int> fill(A.start.begin(), A.start.end() - 1);
+  A.row.resize(A.start[n]), A.value.resize(A.start[n]);
+  for (int c = 0; c < n; ++c)
+    for (int k = outer[c]; k < outer[c + 1]; ++k) {
+      const int i = position[inner[k]], j = position[c];
+      const int q = fill[std::min(i, j)]++;
+      A.row[q] = std::max(i, j), A.value[q] = values[k];
+    }
+  return A;
+}
+
+// Per thread: where each factor row sits in the supernode being computed, and the update buffer.
+struct Workspace {
+  std::vector<int> map, relative;
+  std::vector<double> update;
+};
+
+class Numeric {
+ public:
+  Numeric(cholmod_factor& L, const PermutedLower& A)
+      : A_(A),
+        super_(static_cast<const int*>(L.super)),
+        pi_(static_cast<const int*>(L.pi)),
+        px_(static_cast<const int*>(L.px)),
+        rows_(static_cast<const int*>(L.s)),
+        x_(static_cast<double*>(L.x)),
+        head_(L.nsuper, -1),
+        next_(L.nsuper, -1),
+        lpos_(L.nsuper, 0),
+        super_of_col_(L.n) {
+    for (size_t s = 0; s < L.nsuper; ++s)
+      for (int k = super_[s]; k < super_[s + 1]; ++k) super_of_col_[k] = static_cast<int>(s);
+  }
+
+  Workspace workspace(const cholmod_factor& L) const {
+    Workspace w;
+    w.map.assign(L.n, -1);
+    int height = 0;
+    for (size_t s = 0; s < L.nsuper; ++s) height = std::max(height, pi_[s + 1] - pi_[s]);
+    w.relative.resize(height);
+    w.update.resize(L.maxcsize);  // the largest update, from the symbolic analysis (update_from checks)
+    return w;
+  }
+
+  // Computes supernode s: its entries of A, minus the updates of the descendants linked to it, then the
+  // Cholesky factor of its diagonal block and the triangular solve of the rows below. Then links s to
+  // the supernode of its first row below (its next update); `defer` (if given) receives the links into
+  // supernodes that another thread may be linking into at the same time. Returns the factor column where
+  // the matrix was found not positive definite, or −1.
+  int compute(int s, Workspace& w, const std::vector<char>* shared, std::vector<std::array<int, 2>>* defer) {
+    const int k1 = super_[s], k2 = super_[s + 1], ncol = k2 - k1;
+    const int p0 = pi_[s], nrow = pi_[s + 1] - p0;
+    double* Ls = x_ + px_[s];
+    for (int i = 0; i < nrow; ++i) w.map[rows_[p0 + i]] = i;
+    std::fill(Ls, Ls + static_cast<size_t>(nrow) * ncol, 0.0);
+    for (int k = k1; k < k2; ++k) {
+      double* column = Ls + static_cast<size_t>(k - k1) * nrow;
+      for (int q = A_.start[k]; q < A_.start[k + 1]; ++q) column[w.map[A_.row[q]]] += A_.value[q];
+    }
+    for (int d = head_[s]; d != -1;) {
+      const int next = next_[d];
+      update_from(d, k2, Ls, nrow, w);
+      link(d, shared, defer);
+      d = next;
+    }
+    head_[s] = -1;
+    const int failed = factor_panel(Ls, nrow, ncol);
+    if (failed >= 0) return k1 + failed;
+    lpos_[s] = ncol;
+    link(s, shared, defer);
+    return -1;
+  }
+
+  void link(int d, int target) {
+    next_[d] = head_[target];
+    head_[target] = d;
+  }
+
+ private:
+  // Ls −= the part of descendant d's columns that falls in supernode s (columns up to k2 − 1, from the
+  // row where d's last update stopped).
+  void update_from(int d, int k2, double* Ls, int nrow, Workspace& w) {
+    const int ndcol = super_[d + 1] - super_[d];
+    const int pd = pi_[d], ndrow = pi_[d + 1] - pd;
+    const int first = lpos_[d];
+    int last = first;
+    while (last < ndrow && rows_[pd + last] < k2) ++last;
+    const int ndrow1 = last - first, ndrow2 = ndrow - first;
+    lpos_[d] = last;
+    if (static_cast<size_t>(ndrow2) * ndrow1 > w.update.size()) w.update.resize(static_cast<size_t>(ndrow2) * ndrow1);
+    const double* Ld = x_ + px_[d] + first;  // rows first … ndrow − 1 of d, leading dimension ndrow
+    double* C = w.update.data();             // ndrow2 × ndrow1, leading dimension ndrow2
+    if (static_cast<double>(ndrow2) * ndrow1 * ndcol < kBlasUpdateFlops) {
+      const ConstBlock below(Ld, ndrow2, ndcol, Eigen::OuterStride<>(ndrow));
+      Block(C, ndrow2, ndrow1, Eigen::OuterStride<>(ndrow2)).noalias() = below * below.topRows(ndrow1).transpose();
+    } else {
+      const double one = 1, zero = 0;
+      dsyrk_("L", "N", &ndrow1, &ndcol, &one, Ld, &ndrow, &zero, C, &ndrow2);
+      const int ndrow3 = ndrow2 - ndrow1;
+      if (ndrow3 > 0) dgemm_("N", "T", &ndrow3, &ndrow1, &ndcol, &one, Ld + ndrow1, &ndrow, Ld, &ndrow, &zero, C + ndrow1, &ndrow2);
+    }
+    int* relative = w.relative.data();
+    for (int i = 0; i < ndrow2; ++i) relative[i] = w.map[rows_[pd + first + i]];
+    for (int j = 0; j < ndrow1; ++j) {
+      double* column = Ls + static_cast<size_t>(relative[j]) * nrow;  // rows k1 … k2 − 1 are s's own columns
+      const double* c = C + static_cast<size_t>(j) * ndrow2;
+      for (int i = j; i < ndrow2; ++i) column[relative[i]] -= c[i];
+    }
+  }
+
+  // Links d (computed, its next rows starting at lpos_[d]) to the supernode of that row, if any.
+  void link(int d, const std::vector<char>* shared, std::vector<std::array<int, 2>>* defer) {
+    const int pd = pi_[d], ndrow = pi_[d + 1] - pd;
+    if (lpos_[d] >= ndrow) return;
+    const int target = super_of_col_[rows_[pd + lpos_[d]]];
+    if (shared && (*shared)[target]) defer->push_back({target, d});
+    else link(d, target);
+  }
+
+  // Cholesky factor of the ncol × ncol diagonal block of the nrow × ncol panel, and the rows below
+  // divided by it. Returns the panel column that is not positive, or −1.
+  static int factor_panel(double* panel, int nrow, int ncol) {
+    if (ncol < kBlasColumns) {
+      for (int j = 0; j < ncol; ++j) {
+        double* cj = panel + static_cast<size_t>(j) * nrow;
+        if (!(cj[j] > 0) || !std::isfinite(cj[j])) return j;
+        const double d = std::sqrt(cj[j]);
+        cj[j] = d;
+        const double inv = 1 / d;
+        for (int i = j + 1; i < nrow; ++i) cj[i] *= inv;
+        for (int k = j + 1; k < ncol; ++k) {
+          double* ck = panel + static_cast<size_t>(k) * nrow;
+          const double f = cj[k];
+          for (int i = k; i < nrow; ++i) ck[i] -= cj[i] * f;
+        }
+      }
+      return -1;
+    }
+    int info = 0;
+    dpotrf_("L", &ncol, panel, &nrow, &info);
+    if (info > 0) return info - 1;
+    for (int j = 0; j < ncol; ++j) {
+      const double d = panel[static_cast<size_t>(j) * nrow + j];
+      if (!(d > 0) || !std::isfinite(d)) return j;
+    }
+    const int below = nrow - ncol;
+    const double one = 1;
+    if (below > 0) dtrsm_("R", "L", "T", "N", &below, &ncol, &one, panel, &nrow, panel + ncol, &nrow);
+    return -1;
+  }
+
+  const PermutedLower& A_;
+  const int *super_, *pi_, *px_, *rows_;
+  double* x_;
+  std::vector<int> head_, next_, lpos_, super_of_col_;
+};
+
+}  // namespace
+
+TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& own_work, double min_split) {
+  const int count = static_cast<int>(parent.size());
+  std::vector<double> work = own_work;  // of each subtree (a parent comes after its children)
+  std::vector<std::vector<int>> children(count);
+  std::vector<int> roots;
+  for (int s = 0; s < count; ++s) {
+    if (parent[s] >= 0) work[parent[s]] += work[s], children[parent[s]].push_back(s);
+    else roots.push_back(s);
+  }
+  TreeSplit split;
+  auto lighter = [&](int a, int b) { return work[a] < work[b]; };
+  std::vector<int> open = roots;  // a max-heap of subtree roots by work
+  std::make_heap(open.begin(), open.end(), lighter);
+  double open_work = 0;
+  for (int r : roots) open_work += work[r];
+  while (!open.empty() && work[open.front()] > 0.5 * open_work && work[open.front()] > min_split) {
+    std::pop_heap(open.begin(), open.end(), lighter);
+    const int s = open.back();
+    open.pop_back();
+    split.top.push_back(s);
+    open_work -= work[s];
+    for (int c : children[s]) open.push_back(c), std::push_heap(open.begin(), open.end(), lighter), open_work += work[c];
+  }
+  std::sort(open.begin(), open.end(), [&](int a, int b) { return work[a] > work[b]; });
+  std::array<double, 2> load{0, 0};
+  std::vector<int> stack;
+  for (int r : open) {
+    const int k = load[0] <= load[1] ? 0 : 1;
+    load[k] += work[r];
+    for (stack.assign(1, r); !stack.empty();) {
+      const int s = stack.back();
+      stack.pop_back();
+      split.part[k].push_back(s);
+      stack.insert(stack.end(), children[s].begin(), children[s].end());
+    }
+  }
+  std::sort(split.top.begin(), split.top.end());
+  for (auto& part : split.part) std::sort(part.begin(), part.end());
+  return split;
+}
+
+std::vector<int> supernode_parents(const cholmod_factor& L) {
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* rows = static_cast<const int*>(L.s);
+  std::vector<int> super_of_col(L.n), parent(L.nsuper, -1);
+  for (size_t s = 0; s < L.nsuper; ++s)
+    for (int k = super[s]; k < super[s + 1]; ++k) super_of_col[k] = static_cast<int>(s);
+  for (size_t s = 0; s < L.nsuper; ++s) {
+    const int ncol = super[s + 1] - super[s];
+    if (pi[s + 1] - pi[s] > ncol) parent[s] = super_of_col[rows[pi[s] + ncol]];
+  }
+  return parent;
+}
+
+int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
+              cholmod_common& c) {
+  const int n = static_cast<int>(L.n);
+  if (!L.is_super) throw Error("internal: the numeric factorization needs a supernodal symbolic factor");
+  // Allocates the values (L.xsize) and marks L numeric LLᵀ, as cholmod_super_numeric does.
+  if (!cholmod_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, &L, &c) || L.x == nullptr)
+    throw Error("CHOLMOD could not allocate the factor (status " + std::to_string(c.status) + ")");
+  const int* perm = static_cast<const int*>(L.Perm);
+  std::vector<int> position(n);
+  for (int k = 0; k < n; ++k) position[perm[k]] = k;
+  const PermutedLower A = permuted_lower(outer, inner, values, position);
+
+  const std::vector<int> parent = supernode_parents(L);
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  std::vector<double> work(L.nsuper);  // flops of its own factorization and of the updates it sends, and a fixed cost
+  for (size_t s = 0; s < L.nsuper; ++s) {
+    const double ncol = super[s + 1] - super[s], nrow = pi[s + 1] - pi[s];
+    work[s] = ncol * nrow * nrow + 64 * nrow;
+  }
+  const TreeSplit split = split_tree(parent, work, 1e5);
+  std::vector<char> in_top(L.nsuper, 0);
+  for (int s : split.top) in_top[s] = 1;
+
+  Numeric numeric(L, A);
+  std::array<std::vector<std::array<int, 2>>, 2> deferred;  // (target, descendant) per thread
+  // Below the top, two threads (each subtree needs only its own descendants); each update from a
+  // descendant into a top supernode is linked after both are done. Then the top, one supernode at a
+  // time, with OpenBLAS's threads inside the large dense blocks there.
+  const bool two = !split.part[1].empty() && omp_get_max_threads() > 1;
+  std::array<int, 2> failed{-1, -1};
+  std::array<std::exception_ptr, 2> error;
+  {
+    std::optional<SingleThreadedBlas> one_thread_per_call;
+    if (two) one_thread_per_call.emplace();
+#pragma omp parallel for schedule(static, 1) num_threads(2) if (two)
+    for (int k = 0; k < 2; ++k) {
+      try {
+        Workspace w = numeric.workspace(L);
+        for (int s : split.part[k])
+          if ((failed[k] = numeric.compute(s, w, &in_top, &deferred[k])) >= 0) break;
+      } catch (...) {  // an exception must not leave an OpenMP region
+        error[k] = std::current_exception();
+      }
+    }
+  }
+  for (const auto& e : error)
+    if (e) std::rethrow_exception(e);
+  int minor = n;
+  for (int f : failed)
+    if (f >= 0) minor = std::min(minor, f);
+  if (minor == n) {
+    for (const auto& links : deferred)
+      for (const auto& [target, d] : links) numeric.link(d, target);
+    Workspace w = numeric.workspace(L);
+    for (int s : split.top)
+      if (const int f = numeric.compute(s, w, nullptr, nullptr); f >= 0) {
+        minor = f;
+        break;
+      }
+  }
+  L.minor = static_cast<size_t>(minor);
+  return minor;
+}
+
+}  // namespace trivcon::supernodal

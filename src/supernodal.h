@@ -1,0 +1,42 @@
+// Internal: the numeric supernodal Cholesky factorization behind ConnectionSolver, on two threads.
+//
+// CHOLMOD does the ordering and the symbolic factorization (trivcon/solver.h); this computes the values of
+// CHOLMOD's own supernodal factor object, so that everything else (CHOLMOD's solves, the solver's sparse
+// forward update and backward substitution) reads it unchanged. Why not cholmod_factorize: CHOLMOD 3
+// (Debian 12) visits the supernodes one after another and uses the second core only inside BLAS calls on
+// large supernodes, while on a mesh most of the time goes to the many small supernodes near the leaves of
+// the elimination tree. Here independent subtrees are factored on two threads, then the top of the tree
+// with multithreaded BLAS. Same algorithm as CHOLMOD's (left-looking supernodal: each supernode gathers
+// the updates of its descendants, then a dense Cholesky of its diagonal block and a triangular solve of
+// the rows below), same storage.
+#pragma once
+#include <cholmod.h>
+
+#include <array>
+#include <vector>
+
+namespace trivcon::supernodal {
+
+// The supernodal elimination tree of a factor, split for two threads: `top` (the supernodes above the
+// split, done one at a time) and two sets of whole subtrees below it that do not depend on each other,
+// balanced by `work` (per supernode; a subtree's work is the sum over it). The largest remaining subtree
+// is split at its root while it holds more than half of the work below the top and more than `min_split`.
+// Each list is in increasing supernode order (descendants first).
+struct TreeSplit {
+  std::vector<int> top;
+  std::array<std::vector<int>, 2> part;
+};
+TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& work, double min_split);
+
+// Parent of each supernode of L in the supernodal elimination tree (−1 at a root).
+std::vector<int> supernode_parents(const cholmod_factor& L);
+
+// Computes the numeric LLᵀ factor in L (a supernodal symbolic factor from cholmod_analyze_p, with its
+// permutation L.Perm) of the symmetric n × n matrix whose upper triangle is given in compressed columns
+// (outer, inner, values; rows ≤ column, in the matrix's own numbering). Returns n on success, or the
+// first factor column found not positive definite (as CHOLMOD's L->minor); throws trivcon::Error if
+// CHOLMOD cannot allocate the factor.
+int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
+              cholmod_common& c);
+
+}  // namespace trivcon::supernodal

@@ -1,0 +1,188 @@
+// The numeric supernodal factorization (src/supernodal.h, internal) against CHOLMOD's own, on the same
+// symbolic factorization; and the split of the elimination tree it and the backward substitution use.
+#include <cholmod.h>
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+#include <set>
+
+#include "supernodal.h"
+#include "trivcon/generate.h"
+
+using namespace trivcon;
+
+namespace {
+
+// Upper triangle (compressed columns) of the graph Laplacian of a mesh's edges plus `shift` on the
+// diagonal, with random positive edge weights.
+struct Upper {
+  int n = 0;
+  std::vector<int> outer, inner;
+  std::vector<double> values;
+};
+
+Upper shifted_laplacian(const Mesh& mesh, double shift, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> weight(0.1, 2.0);
+  const int n = static_cast<int>(mesh.V.rows());
+  std::vector<std::map<int, double>> columns(n);
+  for (int v = 0; v < n; ++v) columns[v][v] = shift;
+  for (int f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = std::min(mesh.F(f, k), mesh.F(f, (k + 1) % 3)), b = std::max(mesh.F(f, k), mesh.F(f, (k + 1) % 3));
+      if (columns[b].count(a)) continue;  // each edge once (the second face sees it again)
+      const double w = weight(rng);
+      columns[b][a] = -w, columns[a][a] += w, columns[b][b] += w;
+    }
+  Upper M;
+  M.n = n;
+  M.outer.push_back(0);
+  for (int c = 0; c < n; ++c) {
+    for (const auto& [r, value] : columns[c]) M.inner.push_back(r), M.values.push_back(value);
+    M.outer.push_back(static_cast<int>(M.inner.size()));
+  }
+  return M;
+}
+
+cholmod_sparse view(Upper& M) {
+  cholmod_sparse s{};
+  s.nrow = s.ncol = static_cast<size_t>(M.n), s.nzmax = M.inner.size();
+  s.p = M.outer.data(), s.i = M.inner.data(), s.x = M.values.data();
+  s.stype = 1, s.itype = CHOLMOD_INT, s.xtype = CHOLMOD_REAL, s.dtype = CHOLMOD_DOUBLE, s.sorted = 1, s.packed = 1;
+  return s;
+}
+
+struct Cholmod {
+  cholmod_common c;
+  Cholmod() {
+    cholmod_start(&c);
+    c.print = 0;
+    c.supernodal = CHOLMOD_SUPERNODAL;
+    c.final_ll = 1;
+  }
+  ~Cholmod() { cholmod_finish(&c); }
+};
+
+// Factors M with CHOLMOD and with supernodal::factorize from one symbolic analysis; returns the largest
+// difference of the factors' values relative to the largest value, and each one's `minor`.
+struct Comparison {
+  double difference = 0;
+  size_t ours_minor = 0, cholmod_minor = 0;
+  size_t supernodes = 0;
+};
+Comparison compare(Upper& M) {
+  Cholmod cm;
+  cholmod_sparse A = view(M);
+  cholmod_factor* theirs = cholmod_analyze(&A, &cm.c);
+  EXPECT_NE(theirs, nullptr);
+  cholmod_factor* ours = cholmod_copy_factor(theirs, &cm.c);
+  cholmod_factorize(&A, theirs, &cm.c);
+  Comparison r;
+  r.ours_minor = static_cast<size_t>(supernodal::factorize(*ours, M.outer, M.inner, M.values, cm.c));
+  EXPECT_EQ(r.ours_minor, ours->minor);
+  r.cholmod_minor = theirs->minor;
+  r.supernodes = ours->nsuper;
+  EXPECT_TRUE(ours->is_super && ours->is_ll && ours->xtype == CHOLMOD_REAL);
+  if (r.ours_minor == static_cast<size_t>(M.n) && r.cholmod_minor == static_cast<size_t>(M.n)) {
+    EXPECT_EQ(ours->xsize, theirs->xsize);
+    const double* a = static_cast<const double*>(ours->x);
+    const double* b = static_cast<const double*>(theirs->x);
+    double largest = 0;
+    for (size_t k = 0; k < theirs->xsize; ++k) largest = std::max(largest, std::abs(b[k]));
+    for (size_t k = 0; k < theirs->xsize; ++k) r.difference = std::max(r.difference, std::abs(a[k] - b[k]) / largest);
+  }
+  cholmod_free_factor(&ours, &cm.c);
+  cholmod_free_factor(&theirs, &cm.c);
+  return r;
+}
+
+}  // namespace
+
+TEST(Supernodal, SameFactorAsCholmod) {
+  for (const auto& [name, mesh] : std::vector<std::pair<std::string, Mesh>>{{"icosphere-2", make_icosphere(2)},
+                                                                            {"cube sphere 60", make_cube_sphere(60, true)},
+                                                                            {"torus 120x48", make_torus(120, 48)},
+                                                                            {"holed grid", make_holed_grid(80, 5)}}) {
+    Upper M = shifted_laplacian(mesh, 1e-3, 7);
+    const Comparison r = compare(M);
+    EXPECT_EQ(r.ours_minor, static_cast<size_t>(M.n)) << name;
+    EXPECT_EQ(r.cholmod_minor, static_cast<size_t>(M.n)) << name;
+    EXPECT_LT(r.difference, 1e-12) << name << " (" << r.supernodes << " supernodes)";
+  }
+}
+
+TEST(Supernodal, SameFactorOnOneThread) {
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  Upper M = shifted_laplacian(make_cube_sphere(50, true), 1e-3, 11);
+  const Comparison r = compare(M);
+  omp_set_num_threads(threads);
+  EXPECT_EQ(r.ours_minor, static_cast<size_t>(M.n));
+  EXPECT_LT(r.difference, 1e-12);
+}
+
+TEST(Supernodal, ReportsTheColumnThatIsNotPositiveDefinite) {
+  // A diagonally dominant matrix stays so as columns are eliminated: only the row made negative fails,
+  // at its own factor column, wherever the ordering put it.
+  for (int bad : {0, 777, 5000}) {
+    Upper M = shifted_laplacian(make_cube_sphere(40, true), 1.0, 3);
+    for (int k = M.outer[bad]; k < M.outer[bad + 1]; ++k)
+      if (M.inner[k] == bad) M.values[k] = -50.0;
+    Cholmod cm;
+    cholmod_sparse A = view(M);
+    cholmod_factor* L = cholmod_analyze(&A, &cm.c);
+    const int* perm = static_cast<const int*>(L->Perm);
+    const int column = static_cast<int>(std::find(perm, perm + M.n, bad) - perm);
+    EXPECT_EQ(supernodal::factorize(*L, M.outer, M.inner, M.values, cm.c), column) << "row " << bad;
+    cholmod_free_factor(&L, &cm.c);
+    const Comparison r = compare(M);
+    EXPECT_EQ(r.ours_minor, r.cholmod_minor) << "row " << bad;
+  }
+}
+
+TEST(Supernodal, TreeSplitIsIndependentAndBalanced) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 50; ++trial) {
+    const int count = 1 + static_cast<int>(rng() % 400);
+    std::vector<int> parent(count, -1);
+    std::vector<double> work(count);
+    for (int s = 0; s < count; ++s) {
+      work[s] = 1 + rng() % 1000;
+      if (s + 1 < count && rng() % 20 != 0) parent[s] = s + 1 + static_cast<int>(rng() % std::min(5, count - s - 1));
+    }
+    const supernodal::TreeSplit split = supernodal::split_tree(parent, work, 100);
+    std::vector<int> where(count, -2);  // −1: top, 0/1: part
+    for (int s : split.top) {
+      EXPECT_EQ(where[s], -2);
+      where[s] = -1;
+    }
+    for (int k = 0; k < 2; ++k)
+      for (int s : split.part[k]) {
+        EXPECT_EQ(where[s], -2);
+        where[s] = k;
+      }
+    for (int s = 0; s < count; ++s) {
+      ASSERT_NE(where[s], -2) << "supernode " << s << " in no list";
+      // The top is closed upwards, and a part's supernode has its ancestors in its part or the top.
+      if (parent[s] < 0) continue;
+      EXPECT_TRUE(where[s] == -1 ? where[parent[s]] == -1 : where[parent[s]] == where[s] || where[parent[s]] == -1) << "supernode " << s;
+    }
+    for (const auto* list : {&split.top, &split.part[0], &split.part[1]}) EXPECT_TRUE(std::is_sorted(list->begin(), list->end()));
+    // Balanced: the parts differ by at most the largest subtree below the top.
+    std::vector<double> subtree = work;
+    for (int s = 0; s < count; ++s)
+      if (parent[s] >= 0) subtree[parent[s]] += subtree[s];
+    double largest = 0;
+    std::array<double, 2> load{0, 0};
+    for (int s = 0; s < count; ++s)
+      if (where[s] >= 0) {
+        load[where[s]] += work[s];
+        if (parent[s] < 0 || where[parent[s]] == -1) largest = std::max(largest, subtree[s]);
+      }
+    EXPECT_LE(std::abs(load[0] - load[1]), largest + 1e-9) << "trial " << trial;
+  }
+}
