@@ -77,7 +77,6 @@ class Numeric {
         px_(static_cast<const int*>(L.px)),
         rows_(static_cast<const int*>(L.s)),
         x_(static_cast<double*>(L.x)),
-        head_(L.nsuper, -1),
         next_(L.nsuper, -1),
         lpos_(L.nsuper, 0),
         super_of_col_(L.n) {
@@ -95,38 +94,41 @@ class Numeric {
     return w;
   }
 
-  // Computes supernode s: its entries of A, minus the updates of the descendants linked to it, then the
-  // Cholesky factor of its diagonal block and the triangular solve of the rows below. Then links s to
-  // the supernode of its first row below (its next update); `defer` (if given) receives the links into
-  // supernodes that another thread may be linking into at the same time. Returns the factor column where
-  // the matrix was found not positive definite, or −1.
-  int compute(int s, Workspace& w, const std::vector<char>* shared, std::vector<std::array<int, 2>>* defer) {
-    const int k1 = super_[s], k2 = super_[s + 1], ncol = k2 - k1;
-    const int p0 = pi_[s], nrow = pi_[s + 1] - p0;
+  // Computes supernode s: its entries of A minus the updates of the descendants linked to it in `head`,
+  // then the Cholesky factor of its diagonal block and the triangular solve of the rows below; then
+  // links s, in `head`, to the supernode of its first row below (its next update). Returns the factor
+  // column where the matrix was found not positive definite, or −1.
+  int compute(int s, Workspace& w, std::vector<int>& head) {
+    const int k1 = super_[s], ncol = super_[s + 1] - k1, p0 = pi_[s], nrow = pi_[s + 1] - p0;
     double* Ls = x_ + px_[s];
-    for (int i = 0; i < nrow; ++i) w.map[rows_[p0 + i]] = i;
     std::fill(Ls, Ls + static_cast<size_t>(nrow) * ncol, 0.0);
-    for (int k = k1; k < k2; ++k) {
+    for (int i = 0; i < nrow; ++i) w.map[rows_[p0 + i]] = i;
+    for (int k = k1; k < k1 + ncol; ++k) {
       double* column = Ls + static_cast<size_t>(k - k1) * nrow;
       for (int q = A_.start[k]; q < A_.start[k + 1]; ++q) column[w.map[A_.row[q]]] += A_.value[q];
     }
-    for (int d = head_[s]; d != -1;) {
+    for (int d = head[s]; d != -1;) {
       const int next = next_[d];
-      update_from(d, k2, Ls, nrow, w);
-      link(d, shared, defer);
+      update_from(d, super_[s + 1], Ls, nrow, w);
+      link(d, head);
       d = next;
     }
-    head_[s] = -1;
+    head[s] = -1;
     const int failed = factor_panel(Ls, nrow, ncol);
     if (failed >= 0) return k1 + failed;
     lpos_[s] = ncol;
-    link(s, shared, defer);
+    link(s, head);
     return -1;
   }
 
-  void link(int d, int target) {
-    next_[d] = head_[target];
-    head_[target] = d;
+  // Moves the descendants linked to s in `from` to the front of its list in `to`.
+  void move_list(int s, std::vector<int>& from, std::vector<int>& to) {
+    for (int d = from[s]; d != -1;) {
+      const int next = next_[d];
+      next_[d] = to[s], to[s] = d;
+      d = next;
+    }
+    from[s] = -1;
   }
 
  private:
@@ -161,13 +163,13 @@ class Numeric {
     }
   }
 
-  // Links d (computed, its next rows starting at lpos_[d]) to the supernode of that row, if any.
-  void link(int d, const std::vector<char>* shared, std::vector<std::array<int, 2>>* defer) {
+  // Links d (computed, its next rows starting at lpos_[d]) to the supernode of that row in `head`, if any.
+  void link(int d, std::vector<int>& head) {
     const int pd = pi_[d], ndrow = pi_[d + 1] - pd;
     if (lpos_[d] >= ndrow) return;
     const int target = super_of_col_[rows_[pd + lpos_[d]]];
-    if (shared && (*shared)[target]) defer->push_back({target, d});
-    else link(d, target);
+    next_[d] = head[target];
+    head[target] = d;
   }
 
   // Cholesky factor of the ncol × ncol diagonal block of the nrow × ncol panel, and the rows below
@@ -205,7 +207,7 @@ class Numeric {
   const PermutedLower& A_;
   const int *super_, *pi_, *px_, *rows_;
   double* x_;
-  std::vector<int> head_, next_, lpos_, super_of_col_;
+  std::vector<int> next_, lpos_, super_of_col_;  // a linked list's next, and where each supernode's next update starts
 };
 
 }  // namespace
@@ -286,15 +288,15 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
     work[s] = ncol * nrow * nrow + 64 * nrow;
   }
   const TreeSplit split = split_tree(parent, work, 1e5);
-  std::vector<char> in_top(L.nsuper, 0);
-  for (int s : split.top) in_top[s] = 1;
-
   Numeric numeric(L, A);
-  std::array<std::vector<std::array<int, 2>>, 2> deferred;  // (target, descendant) per thread
-  // Below the top, two threads (each subtree needs only its own descendants); each update from a
-  // descendant into a top supernode is linked after both are done. Then the top, one supernode at a
-  // time, with OpenBLAS's threads inside the large dense blocks there.
+  // Below the top, two threads: a subtree needs only its own descendants. Each thread keeps its own
+  // lists of pending updates (`head`); its lists for the supernodes of the top are handed over when both
+  // are done. Then the top, one supernode at a time, with OpenBLAS's threads inside the large dense
+  // blocks there. (Gathering each thread's updates to the top in buffers of its own, so that they are
+  // computed on both cores too, saved nothing: on the 400k-face sphere it took each thread as long as it
+  // saved the top.) The sums are in the same order with one thread or two.
   const bool two = !split.part[1].empty() && omp_get_max_threads() > 1;
+  std::array<std::vector<int>, 2> head;
   std::array<int, 2> failed{-1, -1};
   std::array<std::exception_ptr, 2> error;
   {
@@ -303,9 +305,10 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
 #pragma omp parallel for schedule(static, 1) num_threads(2) if (two)
     for (int k = 0; k < 2; ++k) {
       try {
+        head[k].assign(L.nsuper, -1);
         Workspace w = numeric.workspace(L);
         for (int s : split.part[k])
-          if ((failed[k] = numeric.compute(s, w, &in_top, &deferred[k])) >= 0) break;
+          if ((failed[k] = numeric.compute(s, w, head[k])) >= 0) break;
       } catch (...) {  // an exception must not leave an OpenMP region
         error[k] = std::current_exception();
       }
@@ -317,11 +320,12 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
   for (int f : failed)
     if (f >= 0) minor = std::min(minor, f);
   if (minor == n) {
-    for (const auto& links : deferred)
-      for (const auto& [target, d] : links) numeric.link(d, target);
+    std::vector<int> top_head(L.nsuper, -1);
+    for (int t : split.top)
+      for (auto& h : head) numeric.move_list(t, h, top_head);
     Workspace w = numeric.workspace(L);
-    for (int s : split.top)
-      if (const int f = numeric.compute(s, w, nullptr, nullptr); f >= 0) {
+    for (int t : split.top)
+      if (const int f = numeric.compute(t, w, top_head); f >= 0) {
         minor = f;
         break;
       }

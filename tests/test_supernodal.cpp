@@ -115,6 +115,31 @@ TEST(Supernodal, SameFactorAsCholmod) {
   }
 }
 
+// The Laplacian of a small mesh with `extra` rows that couple with each other and with every tenth vertex:
+// the top of the elimination tree is then a large dense block that both threads' subtrees update.
+Upper with_dense_block(const Mesh& mesh, int extra) {
+  Upper M = shifted_laplacian(mesh, 1e-3, 13);
+  const int n = M.n;
+  for (int c = n; c < n + extra; ++c) {
+    for (int r = 0; r < n; r += 10) M.inner.push_back(r), M.values.push_back(-0.01);
+    for (int r = n; r < c; ++r) M.inner.push_back(r), M.values.push_back(-0.001);
+    M.inner.push_back(c), M.values.push_back(10.0 + 0.01 * n / 10);
+    M.outer.push_back(static_cast<int>(M.inner.size()));
+  }
+  for (int r = 0; r < n; r += 10)  // keep the vertex rows diagonally dominant
+    for (int k = M.outer[r]; k < M.outer[r + 1]; ++k)
+      if (M.inner[k] == r) M.values[k] += 0.01 * extra;
+  M.n = n + extra;
+  return M;
+}
+
+TEST(Supernodal, SameFactorWithALargeTop) {
+  Upper M = with_dense_block(make_cube_sphere(30, true), 700);
+  const Comparison r = compare(M);
+  EXPECT_EQ(r.ours_minor, static_cast<size_t>(M.n));
+  EXPECT_LT(r.difference, 1e-12);
+}
+
 TEST(Supernodal, SameFactorOnOneThread) {
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);
