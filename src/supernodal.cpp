@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -65,7 +66,8 @@ PermutedLower permuted_lower(const std::vector<int>& outer, const std::vector<in
 // Per thread: where each factor row sits in the supernode being computed, and the update buffer.
 struct Workspace {
   std::vector<int> map, relative;
-  std::vector<double> update;
+  std::unique_ptr<double[]> update;  // not initialised: every update overwrites what it reads
+  size_t update_size = 0;
 };
 
 class Numeric {
@@ -90,7 +92,6 @@ class Numeric {
     int height = 0;
     for (size_t s = 0; s < L.nsuper; ++s) height = std::max(height, pi_[s + 1] - pi_[s]);
     w.relative.resize(height);
-    w.update.resize(L.maxcsize);  // the largest update, from the symbolic analysis (update_from checks)
     return w;
   }
 
@@ -142,9 +143,16 @@ class Numeric {
     while (last < ndrow && rows_[pd + last] < k2) ++last;
     const int ndrow1 = last - first, ndrow2 = ndrow - first;
     lpos_[d] = last;
-    if (static_cast<size_t>(ndrow2) * ndrow1 > w.update.size()) w.update.resize(static_cast<size_t>(ndrow2) * ndrow1);
+    // Grown as needed: the largest updates (L.maxcsize) go to the top of the tree, which the threads
+    // below it never reach.
+    const size_t size = static_cast<size_t>(ndrow2) * ndrow1;
+    if (size > w.update_size) {
+      w.update.reset();
+      w.update.reset(new double[size]);
+      w.update_size = size;
+    }
     const double* Ld = x_ + px_[d] + first;  // rows first … ndrow − 1 of d, leading dimension ndrow
-    double* C = w.update.data();             // ndrow2 × ndrow1, leading dimension ndrow2
+    double* C = w.update.get();             // ndrow2 × ndrow1, leading dimension ndrow2
     if (static_cast<double>(ndrow2) * ndrow1 * ndcol < kBlasUpdateFlops) {
       const ConstBlock below(Ld, ndrow2, ndcol, Eigen::OuterStride<>(ndrow));
       Block(C, ndrow2, ndrow1, Eigen::OuterStride<>(ndrow2)).noalias() = below * below.topRows(ndrow1).transpose();
