@@ -302,7 +302,8 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
   // are done. Then the top, one supernode at a time, with OpenBLAS's threads inside the large dense
   // blocks there. (Gathering each thread's updates to the top in buffers of its own, so that they are
   // computed on both cores too, saved nothing: on the 400k-face sphere it took each thread as long as it
-  // saved the top.) The sums are in the same order with one thread or two.
+  // saved the top.) The result does not depend on the timing of the threads: each part is computed in
+  // its own order and the lists are handed over in a fixed one.
   const bool two = !split.part[1].empty() && omp_get_max_threads() > 1;
   std::array<std::vector<int>, 2> head;
   std::array<int, 2> failed{-1, -1};
