@@ -1,17 +1,22 @@
 // Connectivity and validation in (near) linear time: half-edges are bucketed by their smaller vertex
-// (counting sort), so matching the two sides of an edge costs O(degree) per vertex.
+// (counting sort), so matching the two sides of an edge costs O(degree) per vertex. Above 50k faces the
+// independent passes (non-manifold vertices and orientation; the vertex-face and vertex-edge lists) run
+// on two threads.
 #include "trivcon/topology.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <exception>
 #include <sstream>
 
 #include "trivcon/error.h"
 
 namespace trivcon {
 namespace {
+
+constexpr int kParallelFaces = 50000;  // smaller meshes: starting a second thread costs more than it saves
 
 // Union-find with path halving; used for face fans around vertices.
 struct DisjointSets {
@@ -82,6 +87,88 @@ std::vector<int> match_half_edges(const MatrixX3i& F, int num_vertices, int& num
   return edge_of;
 }
 
+// Non-manifold vertices: corners (f, k) at the same vertex are joined across every edge with two faces;
+// a manifold vertex has one group (one fan).
+void check_manifold_vertices(const MatrixX3i& F_in, int num_vertices, const std::vector<int>& edge_count,
+                             const std::vector<std::array<int, 2>>& edge_half) {
+  const int H = 3 * static_cast<int>(F_in.rows()), nE = static_cast<int>(edge_count.size());
+  DisjointSets corners(H);
+  for (int e = 0; e < nE; ++e) {
+    if (edge_count[e] != 2) continue;
+    const int h0 = edge_half[e][0], h1 = edge_half[e][1];
+    const int f0 = h0 / 3, f1 = h1 / 3;
+    for (int end = 0; end < 2; ++end) {
+      const int v = end == 0 ? F_in(f0, h0 % 3) : F_in(f0, (h0 % 3 + 1) % 3);
+      int c1 = -1;
+      for (int k = 0; k < 3; ++k)
+        if (F_in(f1, k) == v) c1 = 3 * f1 + k;
+      int c0 = end == 0 ? h0 : 3 * f0 + (h0 % 3 + 1) % 3;
+      corners.unite(c0, c1);
+    }
+  }
+  std::vector<int> fans(num_vertices, 0);
+  for (int c = 0; c < H; ++c)
+    if (corners.find(c) == c) ++fans[F_in(c / 3, c % 3)];
+  for (int v = 0; v < num_vertices; ++v)
+    if (fans[v] > 1)
+      throw Error("non-manifold vertex " + std::to_string(v) + ": its faces form " + std::to_string(fans[v]) +
+                  " separate fans");
+}
+
+// Components and orientation: breadth-first over faces; flip[g] says whether g must be reversed to agree
+// with its component's first face (the majority's orientation is kept). Fills t.face_component and
+// t.components (one per connected set of faces, first_face set).
+void orient_components(const MatrixX3i& F_in, const std::vector<int>& edge_count, const std::vector<std::array<int, 2>>& edge_half,
+                       Topology& t, std::vector<char>& flip) {
+  const int nF = static_cast<int>(F_in.rows()), H = 3 * nF, nE = static_cast<int>(edge_count.size());
+  // twin[h] = 2 h' + s for the other half-edge h' of h's edge, s = 1 when both run the same way (one of
+  // the two faces must flip); −1 on the boundary. Built once so that the search reads it in sequence.
+  std::vector<int> twin(H, -1);
+  for (int e = 0; e < nE; ++e) {
+    if (edge_count[e] != 2) continue;
+    const int h0 = edge_half[e][0], h1 = edge_half[e][1];
+    const int same = F_in(h0 / 3, h0 % 3) == F_in(h1 / 3, h1 % 3);
+    twin[h0] = 2 * h1 + same, twin[h1] = 2 * h0 + same;
+  }
+  t.face_component.assign(nF, -1);
+  std::vector<int> queue;
+  queue.reserve(nF);
+  for (int root = 0; root < nF; ++root) {
+    if (t.face_component[root] >= 0) continue;
+    const int c = static_cast<int>(t.components.size());
+    t.components.emplace_back();
+    t.components.back().first_face = root;
+    const size_t begin = queue.size();
+    queue.push_back(root);
+    t.face_component[root] = c;
+    for (size_t q = begin; q < queue.size(); ++q) {
+      const int f = queue[q];
+      for (int k = 0; k < 3; ++k) {
+        const int code = twin[3 * f + k];
+        if (code < 0) continue;
+        const int g = (code >> 1) / 3;
+        const char want = flip[f] ^ static_cast<char>(code & 1);
+        if (t.face_component[g] < 0) {
+          t.face_component[g] = c;
+          flip[g] = want;
+          queue.push_back(g);
+        } else if (flip[g] != want) {
+          const int a = F_in(f, k), b = F_in(f, (k + 1) % 3);
+          throw Error("non-orientable component " + std::to_string(c) + " (containing face " + std::to_string(root) +
+                      "): faces " + std::to_string(std::min(f, g)) + " and " + std::to_string(std::max(f, g)) +
+                      " cannot be oriented consistently across edge (" + std::to_string(std::min(a, b)) + ", " +
+                      std::to_string(std::max(a, b)) + ")");
+        }
+      }
+    }
+    // Keep the orientation of the majority (ties: the first face's).
+    size_t flipped = 0;
+    for (size_t q = begin; q < queue.size(); ++q) flipped += flip[queue[q]];
+    if (2 * flipped > queue.size() - begin)
+      for (size_t q = begin; q < queue.size(); ++q) flip[queue[q]] ^= 1;
+  }
+}
+
 }  // namespace
 
 void check_finite(const MatrixX3d& V) {
@@ -126,81 +213,27 @@ Topology build_topology(const MatrixX3i& F_in, int num_vertices) {
     throw Error(s.str());
   }
 
-  // Non-manifold vertices: corners (f, k) at the same vertex are joined across every edge with two
-  // faces; a manifold vertex has one group (one fan).
-  {
-    DisjointSets corners(H);
-    for (int e = 0; e < nE; ++e) {
-      if (edge_count[e] != 2) continue;
-      const int h0 = edge_half[e][0], h1 = edge_half[e][1];
-      const int f0 = h0 / 3, f1 = h1 / 3;
-      for (int end = 0; end < 2; ++end) {
-        const int v = end == 0 ? F_in(f0, h0 % 3) : F_in(f0, (h0 % 3 + 1) % 3);
-        int c1 = -1;
-        for (int k = 0; k < 3; ++k)
-          if (F_in(f1, k) == v) c1 = 3 * f1 + k;
-        int c0 = end == 0 ? h0 : 3 * f0 + (h0 % 3 + 1) % 3;
-        corners.unite(c0, c1);
-      }
-    }
-    std::vector<int> fans(num_vertices, 0);
-    for (int c = 0; c < H; ++c)
-      if (corners.find(c) == c) ++fans[F_in(c / 3, c % 3)];
-    for (int v = 0; v < num_vertices; ++v)
-      if (fans[v] > 1)
-        throw Error("non-manifold vertex " + std::to_string(v) + ": its faces form " + std::to_string(fans[v]) +
-                    " separate fans");
-  }
-
-  // Components and orientation: breadth-first over faces; flip[g] says whether g must be reversed to
-  // agree with the component's first face.
-  // twin[h] = 2 h' + s for the other half-edge h' of h's edge, s = 1 when both run the same way (one of
-  // the two faces must flip); −1 on the boundary. Built once so that the search reads it in sequence.
-  std::vector<int> twin(H, -1);
-  for (int e = 0; e < nE; ++e) {
-    if (edge_count[e] != 2) continue;
-    const int h0 = edge_half[e][0], h1 = edge_half[e][1];
-    const int same = F_in(h0 / 3, h0 % 3) == F_in(h1 / 3, h1 % 3);
-    twin[h0] = 2 * h1 + same, twin[h1] = 2 * h0 + same;
-  }
-  t.face_component.assign(nF, -1);
+  // Two independent checks, on two threads for large meshes: non-manifold vertices, and components with
+  // their orientation. Their errors are reported in this order, as if one ran after the other.
   std::vector<char> flip(nF, 0);
-  std::vector<int> queue;
-  queue.reserve(nF);
-  for (int root = 0; root < nF; ++root) {
-    if (t.face_component[root] >= 0) continue;
-    const int c = static_cast<int>(t.components.size());
-    t.components.emplace_back();
-    t.components.back().first_face = root;
-    const size_t begin = queue.size();
-    queue.push_back(root);
-    t.face_component[root] = c;
-    for (size_t q = begin; q < queue.size(); ++q) {
-      const int f = queue[q];
-      for (int k = 0; k < 3; ++k) {
-        const int code = twin[3 * f + k];
-        if (code < 0) continue;
-        const int g = (code >> 1) / 3;
-        const char want = flip[f] ^ static_cast<char>(code & 1);
-        if (t.face_component[g] < 0) {
-          t.face_component[g] = c;
-          flip[g] = want;
-          queue.push_back(g);
-        } else if (flip[g] != want) {
-          const int a = F_in(f, k), b = F_in(f, (k + 1) % 3);
-          throw Error("non-orientable component " + std::to_string(c) + " (containing face " + std::to_string(root) +
-                      "): faces " + std::to_string(std::min(f, g)) + " and " + std::to_string(std::max(f, g)) +
-                      " cannot be oriented consistently across edge (" + std::to_string(std::min(a, b)) + ", " +
-                      std::to_string(std::max(a, b)) + ")");
-        }
-      }
+  std::array<std::exception_ptr, 2> error;
+#pragma omp parallel sections num_threads(2) if (nF > kParallelFaces)
+  {
+#pragma omp section
+    try {
+      check_manifold_vertices(F_in, num_vertices, edge_count, edge_half);
+    } catch (...) {
+      error[0] = std::current_exception();
     }
-    // Keep the orientation of the majority (ties: the first face's).
-    size_t flipped = 0;
-    for (size_t q = begin; q < queue.size(); ++q) flipped += flip[queue[q]];
-    if (2 * flipped > queue.size() - begin)
-      for (size_t q = begin; q < queue.size(); ++q) flip[queue[q]] ^= 1;
+#pragma omp section
+    try {
+      orient_components(F_in, edge_count, edge_half, t, flip);
+    } catch (...) {
+      error[1] = std::current_exception();
+    }
   }
+  for (const auto& e : error)
+    if (e) std::rethrow_exception(e);
 
   // Oriented faces and their edges.
   t.F = F_in;
@@ -224,32 +257,37 @@ Topology build_topology(const MatrixX3i& F_in, int num_vertices) {
     }
   }
 
-  // Vertices: component, adjacency (CSR), unreferenced.
-  t.vertex_component.assign(num_vertices, -1);
-  t.vertex_face_offsets.assign(num_vertices + 1, 0);
-  t.vertex_edge_offsets.assign(num_vertices + 1, 0);
-  for (int f = 0; f < nF; ++f)
-    for (int k = 0; k < 3; ++k) {
-      t.vertex_component[t.F(f, k)] = t.face_component[f];
-      ++t.vertex_face_offsets[t.F(f, k) + 1];
-    }
-  for (int e = 0; e < nE; ++e) {
-    ++t.vertex_edge_offsets[t.edge_vertices(e, 0) + 1];
-    ++t.vertex_edge_offsets[t.edge_vertices(e, 1) + 1];
-  }
-  for (int v = 0; v < num_vertices; ++v) {
-    t.vertex_face_offsets[v + 1] += t.vertex_face_offsets[v];
-    t.vertex_edge_offsets[v + 1] += t.vertex_edge_offsets[v];
-  }
-  t.vertex_faces.resize(H);
-  t.vertex_edges.resize(2 * static_cast<size_t>(nE));
+  // Vertices: component and faces (CSR), and edges (CSR), on two threads for large meshes.
+#pragma omp parallel sections num_threads(2) if (nF > kParallelFaces)
   {
-    std::vector<int> fill(t.vertex_face_offsets.begin(), t.vertex_face_offsets.end() - 1);
-    for (int f = 0; f < nF; ++f)
-      for (int k = 0; k < 3; ++k) t.vertex_faces[fill[t.F(f, k)]++] = f;
-    fill.assign(t.vertex_edge_offsets.begin(), t.vertex_edge_offsets.end() - 1);
-    for (int e = 0; e < nE; ++e)
-      for (int k = 0; k < 2; ++k) t.vertex_edges[fill[t.edge_vertices(e, k)]++] = e;
+#pragma omp section
+    {
+      t.vertex_component.assign(num_vertices, -1);
+      t.vertex_face_offsets.assign(num_vertices + 1, 0);
+      for (int f = 0; f < nF; ++f)
+        for (int k = 0; k < 3; ++k) {
+          t.vertex_component[t.F(f, k)] = t.face_component[f];
+          ++t.vertex_face_offsets[t.F(f, k) + 1];
+        }
+      for (int v = 0; v < num_vertices; ++v) t.vertex_face_offsets[v + 1] += t.vertex_face_offsets[v];
+      t.vertex_faces.resize(H);
+      std::vector<int> fill(t.vertex_face_offsets.begin(), t.vertex_face_offsets.end() - 1);
+      for (int f = 0; f < nF; ++f)
+        for (int k = 0; k < 3; ++k) t.vertex_faces[fill[t.F(f, k)]++] = f;
+    }
+#pragma omp section
+    {
+      t.vertex_edge_offsets.assign(num_vertices + 1, 0);
+      for (int e = 0; e < nE; ++e) {
+        ++t.vertex_edge_offsets[t.edge_vertices(e, 0) + 1];
+        ++t.vertex_edge_offsets[t.edge_vertices(e, 1) + 1];
+      }
+      for (int v = 0; v < num_vertices; ++v) t.vertex_edge_offsets[v + 1] += t.vertex_edge_offsets[v];
+      t.vertex_edges.resize(2 * static_cast<size_t>(nE));
+      std::vector<int> fill(t.vertex_edge_offsets.begin(), t.vertex_edge_offsets.end() - 1);
+      for (int e = 0; e < nE; ++e)
+        for (int k = 0; k < 2; ++k) t.vertex_edges[fill[t.edge_vertices(e, k)]++] = e;
+    }
   }
   for (int v = 0; v < num_vertices; ++v)
     if (t.vertex_component[v] < 0) t.unreferenced_vertices.push_back(v);

@@ -957,6 +957,25 @@ TEST(TopologyErrors, NonOrientable) {
   }
 }
 
+TEST(TopologyErrors, LargeMeshesReportTheSameErrorsInTheSameOrder) {
+  // Above 50k faces the non-manifold-vertex check and the orientation search run on two threads; the
+  // non-manifold vertex is still the error reported when both are present.
+  const Mesh big = make_icosphere(6);  // 81,920 faces, 40,962 vertices
+  Mesh two_tets;
+  two_tets.V = Eigen::MatrixXd::Random(7, 3);
+  two_tets.F = faces({{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}, {0, 5, 4}, {0, 4, 6}, {0, 6, 5}, {4, 5, 6}});
+  {
+    const Mesh m = concatenate({big, mobius_strip(8)});
+    const std::string e = topology_error(m.F, static_cast<int>(m.V.rows()));
+    EXPECT_EQ(e.rfind("non-orientable component 1 (containing face 81920)", 0), 0u) << e;
+    expect_orientation_witness(e, m.F);
+  }
+  {
+    const Mesh m = concatenate({big, mobius_strip(8), two_tets});  // the tetrahedra's vertex 0 is 40962 + 16
+    EXPECT_EQ(topology_error(m.F, static_cast<int>(m.V.rows())), "non-manifold vertex 40978: its faces form 2 separate fans");
+  }
+}
+
 TEST(TopologyErrors, NonOrientableMessageMatchesTheHeader) {
   // topology.h documents "non-orientable component 0 (faces 0..): faces 3 and 8 cannot be oriented
   // consistently across edge (4, 5)"; the message must name the component's first face.
