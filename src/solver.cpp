@@ -240,22 +240,7 @@ struct SolverAnalysis::Impl {
 
 namespace {
 
-// CHOLMOD's supernodal factor, read in place: supernode s holds the columns first(s) … first(s) + cols(s)
-// − 1; its rows (its own columns first, then rows of its ancestors) are row(s, 0 … height(s) − 1), its
-// entries the height(s) × cols(s) column-major block values(s).
-struct Supernodes {
-  const int *super, *pi, *px, *rows;
-  const double* x;
-  int count;
-  explicit Supernodes(const cholmod_factor* L)
-      : super(static_cast<const int*>(L->super)), pi(static_cast<const int*>(L->pi)), px(static_cast<const int*>(L->px)),
-        rows(static_cast<const int*>(L->s)), x(static_cast<const double*>(L->x)), count(static_cast<int>(L->nsuper)) {}
-  int first(int s) const { return super[s]; }
-  int cols(int s) const { return super[s + 1] - super[s]; }
-  int height(int s) const { return pi[s + 1] - pi[s]; }
-  int row(int s, int i) const { return rows[pi[s] + i]; }
-  Eigen::Map<const Eigen::MatrixXd> values(int s) const { return {x + px[s], height(s), cols(s)}; }
-};
+using supernodal::Supernodes;
 
 // One supernodal Cholesky factorization R Rᵀ = Π M Πᵀ of the whole normal matrix
 //   M = A W Aᵀ = [ D W Dᵀ   D W Cᵀ ]
@@ -379,10 +364,8 @@ struct CholeskyEngine : ConnectionSolver::Engine {
     position_.resize(n);
     for (int k = 0; k < n; ++k) position_[perm[k]] = k;
     const Supernodes L(factor);
-    super_of_col_.resize(n);
-    for (int s = 0; s < L.count; ++s)
-      for (int k = L.first(s); k < L.first(s) + L.cols(s); ++k) super_of_col_[k] = s;
-    super_parent_ = supernodal::supernode_parents(*factor);
+    super_of_col_ = L.owners();
+    super_parent_ = supernodal::supernode_parents(L, super_of_col_);
     super_stamp_.assign(L.count, -1);
     for (int& r : edge_rows_.row) r = position_[r];
     plan_backward();

@@ -72,25 +72,14 @@ struct Workspace {
 
 class Numeric {
  public:
-  Numeric(cholmod_factor& L, const PermutedLower& A)
-      : A_(A),
-        super_(static_cast<const int*>(L.super)),
-        pi_(static_cast<const int*>(L.pi)),
-        px_(static_cast<const int*>(L.px)),
-        rows_(static_cast<const int*>(L.s)),
-        x_(static_cast<double*>(L.x)),
-        next_(L.nsuper, -1),
-        lpos_(L.nsuper, 0),
-        super_of_col_(L.n) {
-    for (size_t s = 0; s < L.nsuper; ++s)
-      for (int k = super_[s]; k < super_[s + 1]; ++k) super_of_col_[k] = static_cast<int>(s);
-  }
+  Numeric(const Supernodes& L, const std::vector<int>& owner, double* x, const PermutedLower& A)
+      : A_(A), L_(L), owner_(owner), x_(x), next_(L.count, -1), lpos_(L.count, 0) {}
 
-  Workspace workspace(const cholmod_factor& L) const {
+  Workspace workspace() const {
     Workspace w;
-    w.map.assign(L.n, -1);
+    w.map.assign(owner_.size(), -1);
     int height = 0;
-    for (size_t s = 0; s < L.nsuper; ++s) height = std::max(height, pi_[s + 1] - pi_[s]);
+    for (int s = 0; s < L_.count; ++s) height = std::max(height, L_.height(s));
     w.relative.resize(height);
     return w;
   }
@@ -100,17 +89,17 @@ class Numeric {
   // links s, in `head`, to the supernode of its first row below (its next update). Returns the factor
   // column where the matrix was found not positive definite, or −1.
   int compute(int s, Workspace& w, std::vector<int>& head) {
-    const int k1 = super_[s], ncol = super_[s + 1] - k1, p0 = pi_[s], nrow = pi_[s + 1] - p0;
-    double* Ls = x_ + px_[s];
+    const int k1 = L_.first(s), ncol = L_.cols(s), nrow = L_.height(s);
+    double* Ls = x_ + L_.px[s];
     std::fill(Ls, Ls + static_cast<size_t>(nrow) * ncol, 0.0);
-    for (int i = 0; i < nrow; ++i) w.map[rows_[p0 + i]] = i;
+    for (int i = 0; i < nrow; ++i) w.map[L_.row(s, i)] = i;
     for (int k = k1; k < k1 + ncol; ++k) {
       double* column = Ls + static_cast<size_t>(k - k1) * nrow;
       for (int q = A_.start[k]; q < A_.start[k + 1]; ++q) column[w.map[A_.row[q]]] += A_.value[q];
     }
     for (int d = head[s]; d != -1;) {
       const int next = next_[d];
-      update_from(d, super_[s + 1], Ls, nrow, w);
+      update_from(d, k1 + ncol, Ls, nrow, w);
       link(d, head);
       d = next;
     }
@@ -136,11 +125,10 @@ class Numeric {
   // Ls −= the part of descendant d's columns that falls in supernode s (columns up to k2 − 1, from the
   // row where d's last update stopped).
   void update_from(int d, int k2, double* Ls, int nrow, Workspace& w) {
-    const int ndcol = super_[d + 1] - super_[d];
-    const int pd = pi_[d], ndrow = pi_[d + 1] - pd;
+    const int ndcol = L_.cols(d), ndrow = L_.height(d);
     const int first = lpos_[d];
     int last = first;
-    while (last < ndrow && rows_[pd + last] < k2) ++last;
+    while (last < ndrow && L_.row(d, last) < k2) ++last;
     const int ndrow1 = last - first, ndrow2 = ndrow - first;
     lpos_[d] = last;
     // Grown as needed: the largest updates (L.maxcsize) go to the top of the tree, which the threads
@@ -151,7 +139,7 @@ class Numeric {
       w.update.reset(new double[size]);
       w.update_size = size;
     }
-    const double* Ld = x_ + px_[d] + first;  // rows first … ndrow − 1 of d, leading dimension ndrow
+    const double* Ld = x_ + L_.px[d] + first;  // rows first … ndrow − 1 of d, leading dimension ndrow
     double* C = w.update.get();             // ndrow2 × ndrow1, leading dimension ndrow2
     if (static_cast<double>(ndrow2) * ndrow1 * ndcol < kBlasUpdateFlops) {
       const ConstBlock below(Ld, ndrow2, ndcol, Eigen::OuterStride<>(ndrow));
@@ -163,7 +151,7 @@ class Numeric {
       if (ndrow3 > 0) dgemm_("N", "T", &ndrow3, &ndrow1, &ndcol, &one, Ld + ndrow1, &ndrow, Ld, &ndrow, &zero, C + ndrow1, &ndrow2);
     }
     int* relative = w.relative.data();
-    for (int i = 0; i < ndrow2; ++i) relative[i] = w.map[rows_[pd + first + i]];
+    for (int i = 0; i < ndrow2; ++i) relative[i] = w.map[L_.row(d, first + i)];
     for (int j = 0; j < ndrow1; ++j) {
       double* column = Ls + static_cast<size_t>(relative[j]) * nrow;  // rows k1 … k2 − 1 are s's own columns
       const double* c = C + static_cast<size_t>(j) * ndrow2;
@@ -173,9 +161,8 @@ class Numeric {
 
   // Links d (computed, its next rows starting at lpos_[d]) to the supernode of that row in `head`, if any.
   void link(int d, std::vector<int>& head) {
-    const int pd = pi_[d], ndrow = pi_[d + 1] - pd;
-    if (lpos_[d] >= ndrow) return;
-    const int target = super_of_col_[rows_[pd + lpos_[d]]];
+    if (lpos_[d] >= L_.height(d)) return;
+    const int target = owner_[L_.row(d, lpos_[d])];
     next_[d] = head[target];
     head[target] = d;
   }
@@ -213,9 +200,10 @@ class Numeric {
   }
 
   const PermutedLower& A_;
-  const int *super_, *pi_, *px_, *rows_;
-  double* x_;
-  std::vector<int> next_, lpos_, super_of_col_;  // a linked list's next, and where each supernode's next update starts
+  const Supernodes& L_;
+  const std::vector<int>& owner_;
+  double* x_;  // L_.x, written
+  std::vector<int> next_, lpos_;  // a linked list's next, and where each supernode's next update starts
 };
 
 }  // namespace
@@ -261,17 +249,16 @@ TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& 
   return split;
 }
 
-std::vector<int> supernode_parents(const cholmod_factor& L) {
-  const int* super = static_cast<const int*>(L.super);
-  const int* pi = static_cast<const int*>(L.pi);
-  const int* rows = static_cast<const int*>(L.s);
-  std::vector<int> super_of_col(L.n), parent(L.nsuper, -1);
-  for (size_t s = 0; s < L.nsuper; ++s)
-    for (int k = super[s]; k < super[s + 1]; ++k) super_of_col[k] = static_cast<int>(s);
-  for (size_t s = 0; s < L.nsuper; ++s) {
-    const int ncol = super[s + 1] - super[s];
-    if (pi[s + 1] - pi[s] > ncol) parent[s] = super_of_col[rows[pi[s] + ncol]];
-  }
+std::vector<int> Supernodes::owners() const {
+  std::vector<int> owner(super[count]);
+  for (int s = 0; s < count; ++s) std::fill(owner.begin() + first(s), owner.begin() + first(s) + cols(s), s);
+  return owner;
+}
+
+std::vector<int> supernode_parents(const Supernodes& L, const std::vector<int>& owner) {
+  std::vector<int> parent(L.count, -1);
+  for (int s = 0; s < L.count; ++s)
+    if (L.height(s) > L.cols(s)) parent[s] = owner[L.row(s, L.cols(s))];
   return parent;
 }
 
@@ -287,16 +274,15 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
   for (int k = 0; k < n; ++k) position[perm[k]] = k;
   const PermutedLower A = permuted_lower(outer, inner, values, position);
 
-  const std::vector<int> parent = supernode_parents(L);
-  const int* super = static_cast<const int*>(L.super);
-  const int* pi = static_cast<const int*>(L.pi);
-  std::vector<double> work(L.nsuper);  // flops of its own factorization and of the updates it sends, and a fixed cost
-  for (size_t s = 0; s < L.nsuper; ++s) {
-    const double ncol = super[s + 1] - super[s], nrow = pi[s + 1] - pi[s];
+  const Supernodes S(&L);
+  const std::vector<int> owner = S.owners();
+  std::vector<double> work(S.count);  // flops of its own factorization and of the updates it sends, and a fixed cost
+  for (int s = 0; s < S.count; ++s) {
+    const double ncol = S.cols(s), nrow = S.height(s);
     work[s] = ncol * nrow * nrow + 64 * nrow;
   }
-  const TreeSplit split = split_tree(parent, work, 1e5);
-  Numeric numeric(L, A);
+  const TreeSplit split = split_tree(supernode_parents(S, owner), work, 1e5);
+  Numeric numeric(S, owner, static_cast<double*>(L.x), A);
   // Below the top, two threads: a subtree needs only its own descendants. Each thread keeps its own
   // lists of pending updates (`head`); its lists for the supernodes of the top are handed over when both
   // are done. Then the top, one supernode at a time, with OpenBLAS's threads inside the large dense
@@ -315,7 +301,7 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
     for (int k = 0; k < 2; ++k) {
       try {
         head[k].assign(L.nsuper, -1);
-        Workspace w = numeric.workspace(L);
+        Workspace w = numeric.workspace();
         for (int s : split.part[k])
           if ((failed[k] = numeric.compute(s, w, head[k])) >= 0) break;
       } catch (...) {  // an exception must not leave an OpenMP region
@@ -332,7 +318,7 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
     std::vector<int> top_head(L.nsuper, -1);
     for (int t : split.top)
       for (auto& h : head) numeric.move_list(t, h, top_head);
-    Workspace w = numeric.workspace(L);
+    Workspace w = numeric.workspace();
     for (int t : split.top)
       if (const int f = numeric.compute(t, w, top_head); f >= 0) {
         minor = f;

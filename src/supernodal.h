@@ -12,6 +12,8 @@
 #pragma once
 #include <cholmod.h>
 
+#include <Eigen/Core>
+
 #include <array>
 #include <vector>
 
@@ -28,8 +30,27 @@ struct TreeSplit {
 };
 TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& work, double min_split);
 
-// Parent of each supernode of L in the supernodal elimination tree (−1 at a root).
-std::vector<int> supernode_parents(const cholmod_factor& L);
+// CHOLMOD's supernodal factor, read in place: supernode s holds the columns first(s) … first(s) + cols(s)
+// − 1; its rows (its own columns first, then rows of its ancestors) are row(s, 0 … height(s) − 1), its
+// entries the height(s) × cols(s) column-major block values(s), starting at x + px[s].
+struct Supernodes {
+  const int *super, *pi, *px, *rows;
+  const double* x;
+  int count;
+  explicit Supernodes(const cholmod_factor* L)
+      : super(static_cast<const int*>(L->super)), pi(static_cast<const int*>(L->pi)), px(static_cast<const int*>(L->px)),
+        rows(static_cast<const int*>(L->s)), x(static_cast<const double*>(L->x)), count(static_cast<int>(L->nsuper)) {}
+  int first(int s) const { return super[s]; }
+  int cols(int s) const { return super[s + 1] - super[s]; }
+  int height(int s) const { return pi[s + 1] - pi[s]; }
+  int row(int s, int i) const { return rows[pi[s] + i]; }
+  Eigen::Map<const Eigen::MatrixXd> values(int s) const { return {x + px[s], height(s), cols(s)}; }
+  // The supernode of each column.
+  std::vector<int> owners() const;
+};
+
+// Parent of each supernode in the supernodal elimination tree (−1 at a root), given owners().
+std::vector<int> supernode_parents(const Supernodes& L, const std::vector<int>& owner);
 
 // Computes the numeric LLᵀ factor in L (a supernodal symbolic factor from cholmod_analyze_p, with its
 // permutation L.Perm) of the symmetric n × n matrix whose upper triangle is given in compressed columns
