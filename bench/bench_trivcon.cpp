@@ -250,7 +250,7 @@ json verify_edit(const Pipeline& p, const bench::EditGenerator& gen, const std::
   }
   if (verify_time) verify_time->add(seconds_since(t0));
   int large_turns = 0;
-  for (int e = 0; e < p.topology().num_edges; ++e) large_turns += std::abs(r.connection.x(e)) >= 3.14159265358979323846 / prescription.N;
+  for (int e = 0; e < p.topology().num_edges; ++e) large_turns += std::abs(r.connection.x(e)) >= trivcon::kPi / prescription.N;
   return json{{"max_vertex_residual", r.connection.max_vertex_residual},
               {"max_cycle_residual", r.connection.max_cycle_residual},
               {"rhs_scale", r.connection.rhs_scale},

@@ -167,7 +167,7 @@ std::map<int, double> boundary_alignment(const MatrixX3d& V, const Topology& t, 
 
 std::vector<FixedConflict> fixed_conflicts(const Topology& t, const Geometry& g, const std::map<int, double>& fixed, int N) {
   std::vector<FixedConflict> out;
-  const double limit = 3.14159265358979323846 / (2 * N);
+  const double limit = kPi / (2 * N);
   for (int e = 0; e < t.num_edges; ++e) {
     if (t.is_boundary_edge(e)) continue;
     const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);

@@ -5,14 +5,13 @@
 #include <cmath>
 #include <omp.h>
 
+#include "detail/timing.h"
 #include "trivcon/error.h"
 
 namespace trivcon {
 
-namespace {
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-}  // namespace
+using detail::Clock;
+using detail::seconds_since;
 
 FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptions options) : V_(V), options_(options) {
   const auto start = Clock::now();
@@ -104,7 +103,7 @@ Design FieldDesigner::design(const IndexPrescription& prescription, const std::v
     if (d.indices.vertex[v] != (it == prescription.vertex.end() ? 0 : it->second)) d.index_mismatch_vertices.push_back(v);
   }
   // A turn of exactly ±π/N is ambiguous for the field (both give the same N-direction), hence the margin.
-  const double half_period = 3.14159265358979323846 / prescription.N - 1e-9;
+  const double half_period = kPi / prescription.N - 1e-9;
   auto large = [&](int e) { return std::abs(d.connection.x(e)) >= half_period; };
   for (int e = 0; e < topology_.num_edges; ++e) d.large_turn_edges += large(e);
   for (int v : d.index_mismatch_vertices) {

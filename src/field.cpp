@@ -7,7 +7,6 @@
 namespace trivcon {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kParallelFaces = 100000;  // propagate_field's per-face loops run on all cores (OpenMP) above this
 // Into [0, 2π), through wrap_angle's (−π, π].
 double wrap_positive(double a) {

@@ -19,7 +19,7 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 // The N unit directions of face f, counter-clockwise.
 Eigen::Vector3d direction_k(const Geometry& g, const Field& field, int f, int k) {
-  return g.direction_in_face(f, field.angle(f) + 2 * 3.14159265358979323846 * k / field.N);
+  return g.direction_in_face(f, field.angle(f) + 2 * kPi * k / field.N);
 }
 
 void put_double(std::ostream& out, double v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); }

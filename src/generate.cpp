@@ -22,7 +22,6 @@
 namespace trivcon {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Ids are int and index_edges packs half-edge ids (3·F) into 32 bits; a quarter of INT_MAX keeps
 // every derived count (half-edges, subdivided faces) representable.
 constexpr double kMaxElements = std::numeric_limits<int>::max() / 4;

@@ -8,7 +8,6 @@
 namespace trivcon {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegenerateArea = 1e-14;  // relative to the longest edge squared
 constexpr int kParallelMin = 50000;        // smaller meshes: starting the threads costs more than it saves
 

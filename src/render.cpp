@@ -48,7 +48,6 @@ namespace trivcon {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kReferencePixels = 900;  // sizes in RenderOptions and below are for a 900-pixel image side
 constexpr double kMargin = 0.04;          // fraction of the image left free on each side
 constexpr double kHalfFieldOfView = 12 * kPi / 180;

@@ -10,6 +10,7 @@
 #include <numeric>
 #include <omp.h>
 
+#include "detail/timing.h"
 #include "ordering.h"
 #include "supernodal.h"
 #include "trivcon/error.h"
@@ -21,16 +22,15 @@
 namespace trivcon {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 // Beyond this many fixed-face paths the Cholesky route keeps them out of the dense block.
 constexpr int kMaxDensePaths = 256;
 // Per-edit loops over edges or vertices run on all cores (OpenMP) above this size.
 constexpr int kParallelEdits = 100000;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
-using Clock = std::chrono::steady_clock;
+using detail::Clock;
+using detail::seconds_since;
 using EdgeEnds = std::vector<std::array<int, 2>>;  // per active edge, the vertex rows of its ends (−1: none)
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 }  // namespace
 
 // The constraint system in the space of the system edges (system_edges: every interior edge on the

@@ -17,7 +17,6 @@ namespace trivcon {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kVertexTolerance = 1e-6;  // fraction of an edge: closer to an end counts as hitting the vertex
 constexpr double kInwardTolerance = 1e-9;  // a direction must enter a face at least this steeply (sine)
 

@@ -31,7 +31,6 @@ using nlohmann::json;
 using test::CommandResult;
 using test::run_cli;
 
-constexpr double kPi = 3.14159265358979323846;
 const std::string kError = "trivcon: error: ";
 
 std::string q(const std::string& s) { return "'" + s + "'"; }

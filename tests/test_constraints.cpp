@@ -15,7 +15,6 @@ using namespace trivcon;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 std::vector<int> keys(const std::map<int, double>& m) {
   std::vector<int> k;

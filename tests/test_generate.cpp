@@ -25,7 +25,6 @@
 namespace trivcon {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Everything the tests assert about a mesh, computed by brute force.
 struct MeshReport {

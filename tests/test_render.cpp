@@ -24,7 +24,6 @@
 namespace trivcon {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 using Eigen::Vector3d;
 
 std::string slurp(const std::string& path) {

@@ -18,7 +18,6 @@ using namespace trivcon;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Vertices of a given valence (e.g. the 8 corners of a cube sphere, the 12 of an icosphere).
 std::vector<int> vertices_of_valence(const Mesh& m, int valence) {

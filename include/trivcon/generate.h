@@ -11,14 +11,11 @@
 #pragma once
 #include <vector>
 
-#include "trivcon/io.h"
+#include "trivcon/common.h"
 
 namespace trivcon {
 
-struct Mesh {
-  MatrixX3d V;
-  MatrixX3i F;
-};
+// Mesh (V, F) is declared in trivcon/common.h.
 
 // Unit sphere: icosahedron subdivided `level` ≥ 0 times (1→4), projected; 10·4^level + 2 vertices,
 // 20·4^level faces. The vertices of level l are the first vertices of level l + 1, unchanged.

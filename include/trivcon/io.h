@@ -15,20 +15,18 @@
 //   never leaves a half-written file. Everything written can be read back identically (binary PLY
 //   stores doubles; OBJ stores coordinates with 17 significant digits).
 #pragma once
-#include <Eigen/Core>
 #include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
 
+#include "trivcon/common.h"
+
 namespace trivcon {
 
-using MatrixX3d = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
-using MatrixX3i = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
-
-struct MeshData {
-  MatrixX3d V;                          // vertex positions, file order
-  MatrixX3i F;                          // triangles, file order after fan triangulation
+// A mesh as read from a file: V (vertex positions, file order) and F (triangles, file order after fan
+// triangulation) of trivcon::Mesh, plus where each triangle came from.
+struct MeshData : Mesh {
   std::vector<int> polygon_of_triangle; // file polygon of each triangle
   int polygon_count = 0;                // polygons in the file
   std::string format;                   // "obj", "off", "ply-ascii", "ply-binary-le", "ply-binary-be"

@@ -27,11 +27,9 @@
 #include <string>
 #include <vector>
 
-#include "trivcon/io.h"
+#include "trivcon/common.h"
 
 namespace trivcon {
-
-using MatrixX2i = Eigen::Matrix<int, Eigen::Dynamic, 2, Eigen::RowMajor>;
 
 struct ComponentInfo {
   int faces = 0;
