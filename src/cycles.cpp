@@ -127,11 +127,13 @@ Cycles compute_cycles(const Topology& t) {
   return cycles;
 }
 
-double levi_civita_holonomy(const DualCycle& cycle, const Geometry& g) {
+double cycle_sum(const DualCycle& cycle, const Eigen::VectorXd& per_edge) {
   double sum = 0;
-  for (size_t i = 0; i < cycle.edges.size(); ++i) sum += cycle.signs[i] * g.rho(cycle.edges[i]);
+  for (size_t i = 0; i < cycle.edges.size(); ++i) sum += cycle.signs[i] * per_edge(cycle.edges[i]);
   return sum;
 }
+
+double levi_civita_holonomy(const DualCycle& cycle, const Geometry& g) { return cycle_sum(cycle, g.rho); }
 
 double loop_curvature(const Topology& t, const Geometry& g, int loop) {
   double sum = 0;

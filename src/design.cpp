@@ -5,6 +5,7 @@
 #include <cmath>
 #include <omp.h>
 
+#include "detail/parallel.h"
 #include "detail/timing.h"
 #include "trivcon/error.h"
 
@@ -42,7 +43,7 @@ FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptio
     });
   // With the analysis running, the geometry leaves it a core: on two cores, OpenMP's two threads and the
   // analysis would share them, and the analysis, the longer of the two, would finish later (dragon: 0.15 s).
-  const int threads = concurrent ? std::max(1, omp_get_max_threads() - 1) : 0;
+  const int threads = concurrent ? std::max(1, detail::max_threads() - 1) : 0;
   timed(timings_.geometry, [&] { geometry_ = compute_geometry(V_, topology_, threads); });
   if (!concurrent) timed(timings_.cycles, [&] { cycles_ = compute_cycles(topology_); });
   timed(timings_.plan, [&] { plan_ = plan_propagation(topology_); });

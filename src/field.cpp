@@ -143,14 +143,9 @@ FieldIndices field_indices(const Topology& t, const Geometry& g, const Cycles& c
   out.vertex.assign(t.num_vertices, 0);
   for (int v = 0; v < t.num_vertices; ++v)
     if (t.is_interior_vertex(v)) out.vertex[v] = to_n((g.angle_defect(v) + sum(v)) / (2 * kPi));
-  auto cycle_sum = [&](const DualCycle& c) {
-    double s = 0;
-    for (size_t k = 0; k < c.edges.size(); ++k) s += c.signs[k] * d(c.edges[k]);
-    return s;
-  };
   for (size_t l = 0; l < cycles.loops.size(); ++l)
-    out.loop.push_back(to_n((loop_curvature(t, g, static_cast<int>(l)) + cycle_sum(cycles.loops[l])) / (2 * kPi)));
-  for (const DualCycle& c : cycles.generators) out.generator.push_back(to_n((levi_civita_holonomy(c, g) + cycle_sum(c)) / (2 * kPi)));
+    out.loop.push_back(to_n((loop_curvature(t, g, static_cast<int>(l)) + cycle_sum(cycles.loops[l], d)) / (2 * kPi)));
+  for (const DualCycle& c : cycles.generators) out.generator.push_back(to_n((levi_civita_holonomy(c, g) + cycle_sum(c, d)) / (2 * kPi)));
   return out;
 }
 

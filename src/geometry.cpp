@@ -3,13 +3,13 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <omp.h>
+#include "detail/parallel.h"
 
 namespace trivcon {
 
 namespace {
 constexpr double kDegenerateArea = 1e-14;  // relative to the longest edge squared
-constexpr int kParallelMin = 50000;        // smaller meshes: starting the threads costs more than it saves
+using detail::kParallelMinElements;
 
 // Intrinsic corner angles with the documented conventions for degenerate triangles.
 Eigen::Vector3d corner_angles_of(const Eigen::Vector3d p[3]) {
@@ -50,7 +50,7 @@ Eigen::Vector3d Geometry::direction_in_face(int f, double beta) const {
 
 Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   const int nF = t.num_faces, nE = t.num_edges, nV = t.num_vertices;
-  const int team = threads > 0 ? threads : omp_get_max_threads();
+  const int team = threads > 0 ? threads : detail::max_threads();
   Geometry g;
   g.corner_angles.resize(nF, 3);
   g.half_edge_angle.resize(nF, 3);
@@ -63,7 +63,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   std::vector<Eigen::Vector3d> raw_normal(nF);
   int degenerate_faces = 0, zero_area_faces = 0;
   // Faces, then edges, are independent of one another: both loops run on all cores (OpenMP).
-#pragma omp parallel for schedule(static) reduction(+ : degenerate_faces, zero_area_faces) num_threads(team) if (nF > kParallelMin)
+#pragma omp parallel for schedule(static) reduction(+ : degenerate_faces, zero_area_faces) num_threads(team) if (nF > kParallelMinElements)
   for (int f = 0; f < nF; ++f) {
     const Eigen::Vector3d p[3] = {V.row(t.F(f, 0)), V.row(t.F(f, 1)), V.row(t.F(f, 2))};
     const Eigen::Vector3d a = corner_angles_of(p);
@@ -91,7 +91,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   g.degenerate_faces = degenerate_faces, g.zero_area_faces = zero_area_faces;
   // Frames. A degenerate face borrows the summed normal of its edge neighbours (any unit vector
   // perpendicular to its first edge as a last resort), so every output stays finite.
-#pragma omp parallel for schedule(static) num_threads(team) if (nF > kParallelMin)
+#pragma omp parallel for schedule(static) num_threads(team) if (nF > kParallelMinElements)
   for (int f = 0; f < nF; ++f) {
     Eigen::Vector3d n = raw_normal[f];
     if (g.degenerate_face[f]) {
@@ -135,7 +135,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   g.rho.setZero(nE);
   g.cotan_weight.setZero(nE);
   int negative_cotan_edges = 0;
-#pragma omp parallel for schedule(static) reduction(+ : negative_cotan_edges) num_threads(team) if (nE > kParallelMin)
+#pragma omp parallel for schedule(static) reduction(+ : negative_cotan_edges) num_threads(team) if (nE > kParallelMinElements)
   for (int e = 0; e < nE; ++e) {
     if (t.is_boundary_edge(e)) continue;
     const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);

@@ -1,4 +1,4 @@
-#include "ordering.h"
+#include "detail/ordering.h"
 
 #include <algorithm>
 #include <numeric>

@@ -1,4 +1,4 @@
-#include "supernodal.h"
+#include "detail/supernodal.h"
 
 #include <omp.h>
 
@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "detail/parallel.h"
 #include "trivcon/blas.h"
 #include "trivcon/error.h"
 
@@ -290,14 +291,14 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
   // computed on both cores too, saved nothing: on the 400k-face sphere it took each thread as long as it
   // saved the top.) The result does not depend on the timing of the threads: each part is computed in
   // its own order and the lists are handed over in a fixed one.
-  const bool two = !split.part[1].empty() && omp_get_max_threads() > 1;
+  const bool two = !split.part[1].empty() && detail::threads_for(2) > 1;
   std::array<std::vector<int>, 2> head;
   std::array<int, 2> failed{-1, -1};
   std::array<std::exception_ptr, 2> error;
   {
     std::optional<SingleThreadedBlas> one_thread_per_call;
     if (two) one_thread_per_call.emplace();
-#pragma omp parallel for schedule(static, 1) num_threads(2) if (two)
+#pragma omp parallel for schedule(static, 1) num_threads(detail::threads_for(2)) if (two)
     for (int k = 0; k < 2; ++k) {
       try {
         head[k].assign(L.nsuper, -1);

@@ -11,12 +11,14 @@
 #include <exception>
 #include <sstream>
 
+#include "detail/parallel.h"
 #include "trivcon/error.h"
 
 namespace trivcon {
 namespace {
 
-constexpr int kParallelFaces = 50000;  // smaller meshes: starting a second thread costs more than it saves
+using detail::kParallelMinElements;
+using detail::threads_for;
 
 // Union-find with path halving; used for face fans around vertices.
 struct DisjointSets {
@@ -217,7 +219,7 @@ Topology build_topology(const MatrixX3i& F_in, int num_vertices) {
   // their orientation. Their errors are reported in this order, as if one ran after the other.
   std::vector<char> flip(nF, 0);
   std::array<std::exception_ptr, 2> error;
-#pragma omp parallel sections num_threads(2) if (nF > kParallelFaces)
+#pragma omp parallel sections num_threads(threads_for(2)) if (nF > kParallelMinElements)
   {
 #pragma omp section
     try {
@@ -258,7 +260,7 @@ Topology build_topology(const MatrixX3i& F_in, int num_vertices) {
   }
 
   // Vertices: component and faces (CSR), and edges (CSR), on two threads for large meshes.
-#pragma omp parallel sections num_threads(2) if (nF > kParallelFaces)
+#pragma omp parallel sections num_threads(threads_for(2)) if (nF > kParallelMinElements)
   {
 #pragma omp section
     {

@@ -10,7 +10,7 @@
 #include <random>
 #include <set>
 
-#include "supernodal.h"
+#include "detail/supernodal.h"
 #include "trivcon/generate.h"
 
 using namespace trivcon;

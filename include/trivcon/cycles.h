@@ -38,6 +38,9 @@ struct Cycles {
 
 Cycles compute_cycles(const Topology& topology);
 
+// Σ sign · value_e along the cycle, for any per-edge quantity (e.g. a connection's x).
+double cycle_sum(const DualCycle& cycle, const Eigen::VectorXd& per_edge);
+
 // Σ sign · ρ_e along the cycle: the Levi-Civita holonomy with each ρ_e taken in (−π, π].
 double levi_civita_holonomy(const DualCycle& cycle, const Geometry& geometry);
 // Σ over the loop's vertices of (π − Σ corner angles): the curvature of the virtual vertex capping loop ℓ

@@ -17,7 +17,7 @@
 // interior vertices; on a closed component one vertex row is dropped (Gauss–Bonnet makes it redundant),
 // and on a component with boundary one loop row is (its index follows from the others). A W Aᵀ is
 // factored once (supernodal LLᵀ: CHOLMOD's symbolic analysis, our numeric factorization into CHOLMOD's
-// factor on two threads, src/supernodal.h; OpenBLAS), the vertex rows in a fill-reducing order and the
+// factor on two threads, src/detail/supernodal.h, or CHOLMOD's own with Factorization::Cholmod; OpenBLAS), the vertex rows in a fill-reducing order and the
 // cycle rows last, so that the trailing block of the factor is the Cholesky factor of the Schur complement S = CWCᵀ −
 // CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is minimum degree: CAMD with the cycle rows constrained last, or
 // AMD without cycle rows. A new prescription only changes b: nothing is refactored. The forward substitution
@@ -53,10 +53,18 @@ namespace trivcon {
 
 enum class WeightKind { Cotan, Unit };
 enum class SolverKind { Cholesky, QR };
+// Who computes the Cholesky route's numeric factor: trivcon's own supernodal factorization on several
+// threads (Parallel: the default, independent subtrees of the elimination tree on OpenMP threads, then the
+// top of the tree with multithreaded BLAS), or CHOLMOD's cholmod_factorize (Cholmod: one supernode after
+// another, slower on a mesh, the reference). Both fill the same factor and give the same results to
+// round-off. Construction throws trivcon::Error if the CHOLMOD or BLAS library loaded is not the kind the
+// library was built for (src/detail/cholmod.h).
+enum class Factorization { Parallel, Cholmod };
 
 struct SolverOptions {
   WeightKind weights = WeightKind::Cotan;
   SolverKind solver = SolverKind::Cholesky;
+  Factorization factorization = Factorization::Parallel;
 };
 
 struct Connection {
@@ -81,6 +89,10 @@ struct SetupTimings {
   bool analysis_adopted = false;  // the factorization used the given SolverAnalysis
 };
 
+namespace detail {
+struct AnalysisState;
+}
+
 // The fill-reducing order and CHOLMOD's symbolic factorization of the Cholesky route's A W Aᵀ for a mesh
 // without fixed faces. The pattern of A W Aᵀ is that of the mesh's vertices, interior edges and cycles
 // (an edge of zero weight is an explicit zero): it does not depend on the geometry or the weights, so
@@ -95,10 +107,8 @@ class SolverAnalysis {
   SolverAnalysis& operator=(SolverAnalysis&&) noexcept;
   double seconds() const;  // how long the analysis took (on whichever thread ran it)
 
-  struct Impl;
-
  private:
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<detail::AnalysisState> state_;
   friend class ConnectionSolver;
 };
 
@@ -109,7 +119,8 @@ class ConnectionSolver {
   // `fixed_faces`: faces whose direction each prescription fixes (trivcon/constraints.h); they change the
   // matrix, their angles only the right-hand side. `analysis`, if given, is called once A W Aᵀ is
   // assembled, for a SolverAnalysis of this topology and these cycles (e.g. one computed concurrently);
-  // only the Cholesky route without fixed faces calls it.
+  // only the Cholesky route without fixed faces calls it. The solver keeps references to `topology`,
+  // `geometry` and `cycles`: they must outlive it.
   ConnectionSolver(const Topology& topology, const Geometry& geometry, const Cycles& cycles, SolverOptions options = {},
                    const std::vector<int>& fixed_faces = {}, const std::function<SolverAnalysis()>& analysis = {});
   ~ConnectionSolver();
@@ -119,52 +130,23 @@ class ConnectionSolver {
   // Validates the prescription and returns the connection. Only right-hand sides change per call.
   Connection solve(const IndexPrescription& prescription) const;
 
-  const Eigen::VectorXd& weights() const { return weights_; }  // per edge, 0 on boundary edges
-  const SetupTimings& timings() const { return timings_; }
+  const Eigen::VectorXd& weights() const;  // per edge, 0 on boundary edges
+  const SetupTimings& timings() const;
   // The fill-reducing order of the factorization: "AMD" or "CAMD" (see the route above), or
   // "SuiteSparseQR default".
   std::string ordering() const;
-  int num_generators() const { return static_cast<int>(cycles_.generators.size()); }
+  int num_generators() const;
   // Levi-Civita holonomy the constraints use: K_ℓ per loop, z_γ per generator.
-  const std::vector<double>& loop_curvatures() const { return loop_curvature_; }
-  const std::vector<double>& generator_holonomies() const { return generator_holonomy_; }
-  const std::vector<int>& fixed_faces() const { return fixed_faces_; }
+  const std::vector<double>& loop_curvatures() const;
+  const std::vector<double>& generator_holonomies() const;
+  const std::vector<int>& fixed_faces() const;  // sorted, without repeats
   // Zero-weight edges given a small weight (see above).
-  int regularized_edges() const { return regularized_edges_; }
-  const std::vector<FixedPath>& fixed_paths() const { return paths_; }
-
-  struct Engine;  // the factorization (Cholesky + Schur, or QR)
+  int regularized_edges() const;
+  const std::vector<FixedPath>& fixed_paths() const;
 
  private:
-  const Topology& topology_;
-  const Geometry& geometry_;
-  const Cycles& cycles_;
-  SolverOptions options_;
-  Eigen::VectorXd weights_;
-  std::vector<double> loop_curvature_, generator_holonomy_, path_holonomy_;  // Levi-Civita, per loop / generator / fixed-face path
-  SetupTimings timings_;
-  std::unique_ptr<Engine> engine_;
-  std::unique_ptr<Engine> relaxed_engine_;  // vertex rows only, when the path rows are sparse
-  bool sparse_paths_ = false;
-
-  // Rows of the reduced system: interior vertices (minus one per closed component), then the cycle
-  // rows C: boundary loops (minus one per component with boundary), then generators.
-  std::vector<int> active_edges_, edge_column_;  // the system edges (see solver.cpp), and their column
-  std::vector<int> vertex_row_;                  // row of each vertex, −1 if none
-  int num_vertex_rows_ = 0;
-  std::vector<int> dropped_vertex_, dropped_loop_;  // per component, −1 if none
-  enum class RowKind { Loop, Generator, Path };
-  struct Row {
-    RowKind kind;
-    int id;  // loop, generator or path id
-  };
-  std::vector<Row> rows_;                        // the cycle rows C
-  std::vector<int> fixed_faces_;
-  std::vector<FixedPath> paths_;
-  int regularized_edges_ = 0;
-  const DualCycle& cycle_of_row(int r) const;
-  int component_of_row(int r) const;
-  void connect_isolated_vertices(double epsilon);
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 // Residuals of `x` against every constraint for the given indices (n/N): fills the verification fields.

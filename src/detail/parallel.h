@@ -13,6 +13,9 @@ namespace trivcon::detail {
 // Meshes with more faces (or edges, for per-edge loops) than this run their per-element loops and
 // independent passes on several threads.
 constexpr int kParallelMinElements = 50000;
+// An edit's per-edge and per-vertex loops (a few flops per element, run many times) start threads above
+// this size.
+constexpr int kParallelMinEditElements = 100000;
 
 // The number of threads OpenMP would use for a parallel region here.
 inline int max_threads() { return std::max(1, omp_get_max_threads()); }
