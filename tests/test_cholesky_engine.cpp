@@ -1,0 +1,134 @@
+// The Cholesky route's two numeric factorizations (SolverOptions::factorization): trivcon's own on
+// several threads (src/detail/supernodal.h) and CHOLMOD's cholmod_factorize give the same connection,
+// the same chosen indices and the same energy, on every kind of system (vertex rows only, with cycle
+// rows, with fixed-face paths dense and sparse), and fail alike; the numeric libraries pass the start-up
+// check (src/detail/cholmod.h).
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "detail/cholmod.h"
+#include "trivcon/constraints.h"
+#include "trivcon/design.h"
+#include "trivcon/error.h"
+#include "trivcon/generate.h"
+
+using namespace trivcon;
+
+namespace {
+
+struct Case {
+  const char* name;
+  Mesh mesh;
+  int N;
+  std::map<int, int> vertex;  // n per vertex (index n/N)
+  bool align_boundary;
+};
+
+std::vector<Case> cases() {
+  std::vector<Case> out;
+  out.push_back({"icosphere", make_icosphere(4), 1, {{0, 1}, {5, 1}}, false});
+  out.push_back({"cube sphere", make_cube_sphere(8, true), 4, {}, false});
+  out.push_back({"genus 3", make_genus_surface(3, 2), 4, {}, false});
+  out.push_back({"torus", make_torus(40, 20), 6, {{10, 1}, {400, -1}}, false});
+  out.push_back({"holed grid, aligned (dense paths)", make_holed_grid(12, 2), 4, {}, true});
+  out.push_back({"disk, aligned (sparse paths)", make_disk(24, 12), 4, {}, true});
+  out.push_back({"two components", concatenate({make_icosphere(2), make_annulus(4, 30)}), 2, {}, false});
+  return out;
+}
+
+// Sings that balance Gauss–Bonnet on closed components (n = N·χ spread as +1s at the first vertices).
+void balance(const Topology& t, IndexPrescription& p) {
+  for (size_t c = 0; c < t.components.size(); ++c) {
+    if (!t.components[c].boundary_loops.empty()) continue;
+    int missing = p.N * t.components[c].euler_characteristic;
+    for (auto [v, n] : p.vertex)
+      if (t.vertex_component[v] == static_cast<int>(c)) missing -= n;
+    for (int v = 0; v < t.num_vertices && missing != 0; v += 7) {
+      if (t.vertex_component[v] != static_cast<int>(c) || p.vertex.count(v)) continue;
+      const int step = missing > 0 ? 1 : -1;
+      p.vertex[v] = step, missing -= step;
+    }
+  }
+}
+
+Design solve(const Case& c, Factorization factorization, std::vector<int>* fixed_used = nullptr) {
+  SolverOptions options;
+  options.factorization = factorization;
+  FieldDesigner designer(c.mesh.V, c.mesh.F, options);
+  IndexPrescription p;
+  p.N = c.N;
+  p.vertex = c.vertex;
+  balance(designer.topology(), p);
+  if (c.align_boundary) {
+    const std::map<int, double> fixed = boundary_alignment(c.mesh.V, designer.topology(), designer.geometry());
+    std::vector<int> faces;
+    for (auto [f, angle] : fixed) faces.push_back(f), p.fixed[f] = angle;
+    designer.set_fixed_faces(faces);
+    if (fixed_used) *fixed_used = faces;
+  }
+  return designer.design(p);
+}
+
+TEST(CholeskyEngine, CholmodFactorizationGivesTheSameResults) {
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    std::vector<int> fixed;
+    const Design ours = solve(c, Factorization::Parallel, &fixed);
+    const Design theirs = solve(c, Factorization::Cholmod);
+    if (c.align_boundary) EXPECT_GT(fixed.size(), 0u);
+    const double scale = std::max(1.0, ours.connection.x.cwiseAbs().maxCoeff());
+    EXPECT_LE((ours.connection.x - theirs.connection.x).cwiseAbs().maxCoeff(), 1e-10 * scale);
+    EXPECT_NEAR(ours.connection.energy, theirs.connection.energy, 1e-10 * std::max(1.0, ours.connection.energy));
+    EXPECT_EQ(ours.connection.generator_index, theirs.connection.generator_index);
+    EXPECT_EQ(ours.connection.loop_index, theirs.connection.loop_index);
+    EXPECT_EQ(ours.connection.path_turn, theirs.connection.path_turn);
+    EXPECT_EQ(ours.indices.vertex, theirs.indices.vertex);
+    for (const Design* d : {&ours, &theirs}) {
+      EXPECT_LE(d->connection.max_vertex_residual, 1e-9 * std::max(1.0, d->connection.rhs_scale));
+      EXPECT_LE(d->connection.max_cycle_residual, 1e-9 * std::max(1.0, d->connection.rhs_scale));
+      EXPECT_TRUE(d->unexplained_mismatch_vertices.empty());
+    }
+  }
+}
+
+TEST(CholeskyEngine, SparsePathRouteIsTakenOnTheAlignedDisk) {
+  // More than 256 fixed-face paths: the route that orders the path rows with the vertex rows.
+  const Case c = cases()[5];
+  std::vector<int> fixed;
+  const Design d = solve(c, Factorization::Cholmod, &fixed);
+  EXPECT_GT(fixed.size(), 257u);
+  EXPECT_EQ(d.connection.path_turn.size(), fixed.size() - 1);
+}
+
+TEST(CholeskyEngine, BothFactorizationsSolveARegularizedSystemAlike) {
+  // An annulus collapsed onto a line: every triangle has zero area, every cotan weight is 0, and only the
+  // regularized weights (1e-6 × … , trivcon/solver.h) let the field turn. The factor is then badly scaled;
+  // both factorizations must still agree and be exact.
+  Mesh flat = make_annulus(2, 12);
+  for (int v = 0; v < flat.V.rows(); ++v) flat.V(v, 1) = 0;
+  Eigen::VectorXd x[2];
+  int k = 0;
+  for (Factorization f : {Factorization::Parallel, Factorization::Cholmod}) {
+    SolverOptions options;
+    options.factorization = f;
+    FieldDesigner designer(flat.V, flat.F, options);
+    IndexPrescription p;
+    p.N = 4;
+    const Design d = designer.design(p);
+    EXPECT_GT(designer.solver().regularized_edges(), 0);
+    EXPECT_LE(d.connection.max_vertex_residual, 1e-9 * std::max(1.0, d.connection.rhs_scale));
+    EXPECT_LE(d.connection.max_cycle_residual, 1e-9 * std::max(1.0, d.connection.rhs_scale));
+    x[k++] = d.connection.x;
+  }
+  EXPECT_LE((x[0] - x[1]).cwiseAbs().maxCoeff(), 1e-9 * std::max(1.0, x[0].cwiseAbs().maxCoeff()));
+}
+
+TEST(CholeskyEngine, NumericLibrariesPassTheStartUpCheck) {
+  EXPECT_NO_THROW(detail::check_numeric_libraries());
+  int version[3] = {0, 0, 0};
+  cholmod_version(version);
+  EXPECT_EQ(version[0], CHOLMOD_MAIN_VERSION);
+}
+
+}  // namespace
