@@ -5,12 +5,31 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
+#include "trivcon/error.h"
+
 namespace trivcon::test {
+
+namespace {
+
+std::uint64_t key(int a, int b) {
+  return static_cast<std::uint64_t>(std::min(a, b)) << 32 | static_cast<std::uint32_t>(std::max(a, b));
+}
+
+int brute_force_edges(const MatrixX3i& F) {
+  std::set<std::uint64_t> edges;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) edges.insert(key(F(f, k), F(f, (k + 1) % 3)));
+  return static_cast<int>(edges.size());
+}
+
+}  // namespace
 
 std::string shared_mesh(const std::string& name) {
   const std::filesystem::path dir = TRIVCON_SHARED_MESHES;
@@ -25,6 +44,25 @@ std::string temp_dir(const std::string& name) {
   return dir.string();
 }
 
+std::string temp_file(const std::string& name) {
+  static int counter = 0;
+  const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string owner = test ? std::string(test->test_suite_name()) + "." + test->name() : "no-test";
+  return temp_dir(owner + "-" + std::to_string(counter++)) + "/" + name;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
 CommandResult run_cli(const std::string& args) {
   static int counter = 0;
   const std::string base = temp_dir("cli-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
@@ -33,12 +71,6 @@ CommandResult run_cli(const std::string& args) {
   const int raw = std::system(command.c_str());
   CommandResult r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
-  auto slurp = [](const std::string& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  };
   r.out = slurp(out);
   r.err = slurp(err);
   std::filesystem::remove_all(base);
@@ -66,6 +98,277 @@ double max_face_optimality(const FieldDesigner& designer, const Connection& c, c
     if (interior) worst = std::max(worst, std::abs(sum));
   }
   return worst / scale;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    return std::string("<not a trivcon::Error: ") + e.what() + ">";
+  }
+  return "<no error>";
+}
+
+Topology topo(const Mesh& m) { return build_topology(m.F, static_cast<int>(m.V.rows())); }
+
+MatrixX3i faces(const std::vector<std::array<int, 3>>& list) {
+  MatrixX3i F(static_cast<int>(list.size()), 3);
+  for (size_t f = 0; f < list.size(); ++f) F.row(static_cast<int>(f)) << list[f][0], list[f][1], list[f][2];
+  return F;
+}
+
+std::vector<int> vertices_of_valence(const Mesh& m, int valence) {
+  std::vector<int> count(m.V.rows(), 0);
+  for (int f = 0; f < m.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) ++count[m.F(f, k)];
+  std::vector<int> out;
+  for (int v = 0; v < m.V.rows(); ++v)
+    if (count[v] == valence) out.push_back(v);
+  return out;
+}
+
+void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const std::string& what) {
+  SCOPED_TRACE(what);
+  const int nF = static_cast<int>(F_in.rows());
+  ASSERT_EQ(t.num_vertices, nv);
+  ASSERT_EQ(t.num_faces, nF);
+  ASSERT_EQ(t.F.rows(), nF);
+  ASSERT_EQ(t.edge_vertices.rows(), t.num_edges);
+  ASSERT_EQ(t.edge_faces.rows(), t.num_edges);
+  ASSERT_EQ(t.face_edges.rows(), nF);
+  ASSERT_EQ(t.num_edges, brute_force_edges(F_in));
+
+  // F is F_in with exactly the listed faces flipped, (a, b, c) → (a, c, b).
+  std::vector<char> flipped(nF, 0);
+  for (size_t i = 0; i < t.flipped_faces.size(); ++i) {
+    ASSERT_TRUE(i == 0 || t.flipped_faces[i - 1] < t.flipped_faces[i]) << "flipped_faces not increasing";
+    flipped[t.flipped_faces[i]] = 1;
+  }
+  int bad_rows = 0;
+  for (int f = 0; f < nF; ++f) {
+    const bool ok = flipped[f] ? (t.F(f, 0) == F_in(f, 0) && t.F(f, 1) == F_in(f, 2) && t.F(f, 2) == F_in(f, 1))
+                               : (t.F.row(f) == F_in.row(f));
+    bad_rows += !ok;
+  }
+  EXPECT_EQ(bad_rows, 0) << "rows of F that are not the input (flipped where listed)";
+
+  // face_edges joins corners k, k+1; the half-edge i→j with i < j is in L, j→i in R.
+  int bad_face_edges = 0, bad_sides = 0;
+  std::vector<int> uses(t.num_edges, 0);
+  for (int f = 0; f < nF; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int e = t.face_edges(f, k), a = t.F(f, k), b = t.F(f, (k + 1) % 3);
+      if (e < 0 || e >= t.num_edges) {
+        ++bad_face_edges;
+        continue;
+      }
+      ++uses[e];
+      bad_face_edges += !(t.edge_vertices(e, 0) == std::min(a, b) && t.edge_vertices(e, 1) == std::max(a, b));
+      bad_sides += t.edge_faces(e, a < b ? 0 : 1) != f;
+    }
+  EXPECT_EQ(bad_face_edges, 0);
+  EXPECT_EQ(bad_sides, 0) << "edge_faces(e, 0) must hold i→j (i < j), edge_faces(e, 1) j→i";
+  int bad_edges = 0, boundary_edges = 0;
+  for (int e = 0; e < t.num_edges; ++e) {
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    bad_edges += !(t.edge_vertices(e, 0) < t.edge_vertices(e, 1));
+    bad_edges += !(L >= -1 && L < nF && R >= -1 && R < nF && (L >= 0 || R >= 0));
+    bad_edges += uses[e] != (L >= 0) + (R >= 0);
+    boundary_edges += t.is_boundary_edge(e);
+  }
+  EXPECT_EQ(bad_edges, 0);
+
+  // Components: numbered by smallest face id, counts.
+  ASSERT_EQ(static_cast<int>(t.face_component.size()), nF);
+  std::vector<int> first(t.components.size(), -1), cf(t.components.size(), 0), cv(t.components.size(), 0),
+      ce(t.components.size(), 0);
+  for (int f = 0; f < nF; ++f) {
+    const int c = t.face_component[f];
+    ASSERT_TRUE(c >= 0 && c < static_cast<int>(t.components.size()));
+    if (first[c] < 0) first[c] = f;
+    ++cf[c];
+  }
+  for (size_t c = 0; c < t.components.size(); ++c) {
+    EXPECT_EQ(t.components[c].first_face, first[c]) << "component " << c;
+    if (c > 0) {
+      EXPECT_LT(first[c - 1], first[c]) << "components must be numbered by smallest face id";
+    }
+  }
+  for (int e = 0; e < t.num_edges; ++e) {
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    if (L >= 0 && R >= 0) {
+      EXPECT_EQ(t.face_component[L], t.face_component[R]);
+    }
+    ++ce[t.face_component[L >= 0 ? L : R]];
+  }
+  ASSERT_EQ(static_cast<int>(t.vertex_component.size()), nv);
+  std::vector<int> unreferenced;
+  std::vector<char> referenced(nv, 0);
+  for (int f = 0; f < nF; ++f)
+    for (int k = 0; k < 3; ++k) {
+      referenced[F_in(f, k)] = 1;
+      EXPECT_EQ(t.vertex_component[F_in(f, k)], t.face_component[f]);
+    }
+  for (int v = 0; v < nv; ++v) {
+    if (!referenced[v]) {
+      unreferenced.push_back(v);
+      EXPECT_EQ(t.vertex_component[v], -1);
+    } else {
+      ++cv[t.vertex_component[v]];
+    }
+  }
+  EXPECT_EQ(t.unreferenced_vertices, unreferenced);
+  int chi = 0;
+  for (size_t c = 0; c < t.components.size(); ++c) {
+    const ComponentInfo& info = t.components[c];
+    EXPECT_EQ(info.faces, cf[c]);
+    EXPECT_EQ(info.vertices, cv[c]);
+    EXPECT_EQ(info.edges, ce[c]);
+    EXPECT_EQ(info.euler_characteristic, cv[c] - ce[c] + cf[c]);
+    EXPECT_EQ(2 * info.genus, 2 - info.euler_characteristic - static_cast<int>(info.boundary_loops.size()));
+    EXPECT_GE(info.genus, 0);
+    chi += info.euler_characteristic;
+  }
+  EXPECT_EQ(t.euler_characteristic(), chi);
+
+  // Boundary loops: ordered cycles following the orientation, starting at their smallest vertex,
+  // numbered by smallest vertex, covering every boundary edge once.
+  std::map<std::pair<int, int>, int> boundary_half_edges;  // a→b of a boundary edge → face
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (!t.is_boundary_edge(e)) continue;
+    const int f = t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1);
+    for (int k = 0; k < 3; ++k)
+      if (t.face_edges(f, k) == e) boundary_half_edges[{t.F(f, k), t.F(f, (k + 1) % 3)}] = f;
+  }
+  ASSERT_EQ(static_cast<int>(t.vertex_boundary_loop.size()), nv);
+  size_t loop_edges = 0;
+  std::vector<int> loops_of_component(t.components.size(), 0);
+  for (size_t l = 0; l < t.boundary_loops.size(); ++l) {
+    const std::vector<int>& loop = t.boundary_loops[l];
+    ASSERT_GE(loop.size(), 3u) << "loop " << l;
+    EXPECT_EQ(loop[0], *std::min_element(loop.begin(), loop.end())) << "loop " << l << " must start at its smallest vertex";
+    if (l > 0) {
+      EXPECT_LT(t.boundary_loops[l - 1][0], loop[0]) << "loops must be numbered by smallest vertex";
+    }
+    int bad_steps = 0;
+    for (size_t i = 0; i < loop.size(); ++i) {
+      bad_steps += !boundary_half_edges.count({loop[i], loop[(i + 1) % loop.size()]});
+      EXPECT_EQ(t.vertex_boundary_loop[loop[i]], static_cast<int>(l));
+    }
+    EXPECT_EQ(bad_steps, 0) << "loop " << l << ": consecutive vertices that are not a boundary half-edge a→b";
+    loop_edges += loop.size();
+    const int c = t.vertex_component[loop[0]];
+    ASSERT_GE(c, 0);
+    const auto& ids = t.components[c].boundary_loops;
+    EXPECT_NE(std::find(ids.begin(), ids.end(), static_cast<int>(l)), ids.end()) << "loop " << l << " not listed by its component";
+    ++loops_of_component[c];
+  }
+  EXPECT_EQ(loop_edges, boundary_half_edges.size()) << "boundary edges not on exactly one loop";
+  EXPECT_EQ(static_cast<int>(loop_edges), boundary_edges);
+  for (size_t c = 0; c < t.components.size(); ++c)
+    EXPECT_EQ(static_cast<int>(t.components[c].boundary_loops.size()), loops_of_component[c]);
+  int boundary_vertices = 0;
+  for (int v = 0; v < nv; ++v) {
+    boundary_vertices += t.vertex_boundary_loop[v] >= 0;
+    EXPECT_EQ(t.is_interior_vertex(v), referenced[v] && t.vertex_boundary_loop[v] < 0);
+  }
+  EXPECT_EQ(static_cast<size_t>(boundary_vertices), loop_edges) << "a boundary vertex on two loops";
+
+  // CSR adjacency.
+  ASSERT_EQ(static_cast<int>(t.vertex_face_offsets.size()), nv + 1);
+  ASSERT_EQ(static_cast<int>(t.vertex_edge_offsets.size()), nv + 1);
+  std::vector<std::vector<int>> vf(nv), ve(nv);
+  for (int f = 0; f < nF; ++f)
+    for (int k = 0; k < 3; ++k) vf[F_in(f, k)].push_back(f);
+  for (int e = 0; e < t.num_edges; ++e) {
+    ve[t.edge_vertices(e, 0)].push_back(e);
+    ve[t.edge_vertices(e, 1)].push_back(e);
+  }
+  int bad_csr = 0;
+  for (int v = 0; v < nv; ++v) {
+    std::vector<int> a(t.vertex_faces.begin() + t.vertex_face_offsets[v], t.vertex_faces.begin() + t.vertex_face_offsets[v + 1]);
+    std::vector<int> b(t.vertex_edges.begin() + t.vertex_edge_offsets[v], t.vertex_edges.begin() + t.vertex_edge_offsets[v + 1]);
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    std::sort(ve[v].begin(), ve[v].end());
+    bad_csr += a != vf[v];
+    bad_csr += b != ve[v];
+  }
+  EXPECT_EQ(bad_csr, 0) << "vertices whose vertex_faces / vertex_edges differ from brute force";
+}
+
+void expect_geometry_sane(const MatrixX3d& V, const Topology& t, const std::string& what, double gb_tol) {
+  SCOPED_TRACE(what);
+  const Geometry g = compute_geometry(V, t);
+  auto all_finite = [](const auto& m) { return m.size() == 0 || m.array().isFinite().all(); };
+  EXPECT_TRUE(all_finite(g.corner_angles));
+  EXPECT_TRUE(all_finite(g.half_edge_angle));
+  EXPECT_TRUE(all_finite(g.face_area));
+  EXPECT_TRUE(all_finite(g.frame_x));
+  EXPECT_TRUE(all_finite(g.frame_y));
+  EXPECT_TRUE(all_finite(g.normal));
+  EXPECT_TRUE(all_finite(g.angle_defect));
+  EXPECT_TRUE(all_finite(g.rho));
+  EXPECT_TRUE(all_finite(g.cotan_weight));
+  ASSERT_EQ(g.corner_angles.rows(), t.num_faces);
+  ASSERT_EQ(g.rho.size(), t.num_edges);
+  ASSERT_EQ(g.cotan_weight.size(), t.num_edges);
+  ASSERT_EQ(g.angle_defect.size(), t.num_vertices);
+  int bad_sum = 0, bad_frame = 0, bad_angle = 0;
+  double worst_sum = 0;
+  for (int f = 0; f < t.num_faces; ++f) {
+    const double s = g.corner_angles.row(f).sum();
+    worst_sum = std::max(worst_sum, std::abs(s - kPi));
+    bad_sum += !(std::abs(s - kPi) <= 1e-12);
+    for (int k = 0; k < 3; ++k) bad_angle += !(g.corner_angles(f, k) >= 0 && g.corner_angles(f, k) <= kPi);
+    const Eigen::Vector3d x = g.frame_x.row(f), y = g.frame_y.row(f), n = g.normal.row(f);
+    bad_frame += !(std::abs(x.norm() - 1) < 1e-12 && std::abs(y.norm() - 1) < 1e-12 && std::abs(n.norm() - 1) < 1e-12 &&
+                   std::abs(x.dot(y)) < 1e-12 && std::abs(x.dot(n)) < 1e-12 && std::abs(y.dot(n)) < 1e-12);
+  }
+  EXPECT_EQ(bad_sum, 0) << "faces whose corner angles do not sum to π (worst error " << worst_sum << ")";
+  EXPECT_EQ(bad_angle, 0) << "corner angles outside [0, π]";
+  EXPECT_EQ(bad_frame, 0) << "faces without an orthonormal frame";
+  int bad_edge = 0;
+  for (int e = 0; e < t.num_edges; ++e) {
+    bad_edge += !(g.cotan_weight(e) >= 0);
+    bad_edge += !(g.rho(e) > -kPi && g.rho(e) <= kPi);
+    if (t.is_boundary_edge(e)) bad_edge += g.rho(e) != 0 || g.cotan_weight(e) != 0;
+  }
+  EXPECT_EQ(bad_edge, 0) << "edges with negative weight, ρ outside (−π, π], or non-zero ρ/weight on the boundary";
+  std::vector<double> defect(t.components.size(), 0.0);
+  for (int v = 0; v < t.num_vertices; ++v) {
+    if (t.vertex_component[v] < 0) {
+      EXPECT_EQ(g.angle_defect(v), 0.0) << "unreferenced vertex " << v;
+      continue;
+    }
+    defect[t.vertex_component[v]] += g.angle_defect(v);
+  }
+  for (size_t c = 0; c < t.components.size(); ++c)
+    EXPECT_NEAR(defect[c], 2 * kPi * t.components[c].euler_characteristic, gb_tol) << "Gauss–Bonnet on component " << c;
+}
+
+Eigen::VectorXd edge_values_on_original(const Topology& original, const Topology& renumbered, const Eigen::VectorXd& x,
+                                        const std::vector<int>& vertex_perm) {
+  std::map<std::pair<int, int>, double> by_pair;
+  for (int e = 0; e < renumbered.num_edges; ++e) by_pair[{renumbered.edge_vertices(e, 0), renumbered.edge_vertices(e, 1)}] = x(e);
+  Eigen::VectorXd out(original.num_edges);
+  for (int e = 0; e < original.num_edges; ++e) {
+    const int a = vertex_perm[original.edge_vertices(e, 0)], b = vertex_perm[original.edge_vertices(e, 1)];
+    out(e) = (a < b ? 1 : -1) * by_pair.at({std::min(a, b), std::max(a, b)});
+  }
+  return out;
+}
+
+double max_field_difference(const Geometry& original, const Field& a, const Geometry& renumbered, const Field& b,
+                            const std::vector<int>& face_perm) {
+  double worst = 0;
+  for (int f = 0; f < a.angle.size(); ++f) {
+    const Eigen::Vector3d d = renumbered.direction_in_face(face_perm[f], b.angle(face_perm[f]));
+    worst = std::max(worst, std::abs(reduce_angle(original.angle_in_face(f, d) - a.angle(f), a.N)));
+  }
+  return worst;
 }
 
 }  // namespace trivcon::test

@@ -2,10 +2,14 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <array>
+#include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "trivcon/design.h"
+#include "trivcon/generate.h"
 
 namespace trivcon::test {
 
@@ -18,6 +22,27 @@ std::string shared_mesh(const std::string& name);
 
 // A fresh directory for this test's files (under the build tree).
 std::string temp_dir(const std::string& name);
+// A path ending in `name` in a fresh directory of its own, named after the running test (ctest runs the
+// tests of one program in parallel processes, so fixed directory names would collide).
+std::string temp_file(const std::string& name);
+// The bytes of a file ("" when it cannot be read), and a file written with exactly `text`.
+std::string slurp(const std::string& path);
+void write_text(const std::string& path, const std::string& text);
+
+// The message of the trivcon::Error thrown by `f`, or a marker when it throws nothing / something else.
+std::string error_of(const std::function<void()>& f);
+
+// Topology of a mesh (all its vertices counted).
+Topology topo(const Mesh& m);
+// Faces from a list of corner triples.
+MatrixX3i faces(const std::vector<std::array<int, 3>>& list);
+// Vertices of a given valence (e.g. the 8 corners of a cube sphere, the 12 of an icosphere).
+std::vector<int> vertices_of_valence(const Mesh& m, int valence);
+
+// Checks every structural invariant of a Topology against F (the input) alone. Cheap: O(F log F).
+void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const std::string& what);
+// Geometry checks: no NaN/inf anywhere, corner angles sum to π per face, Gauss–Bonnet per component.
+void expect_geometry_sane(const MatrixX3d& V, const Topology& t, const std::string& what, double gb_tol = 1e-9);
 
 struct CommandResult {
   int status = 0;  // exit status
@@ -31,5 +56,16 @@ CommandResult run_cli(const std::string& args);
 // faces), Σ σ_fe x_e / w_e = 0 (σ = +1 where f is the edge's L face, −1 where it is R). Returns the
 // largest such sum relative to max |x_e / w_e|.
 double max_face_optimality(const FieldDesigner& designer, const Connection& connection, const std::map<int, double>& skip = {});
+
+// Renumbering (generate.h permute(): vertex_perm[old] = new, face_perm[old] = new):
+// - per-edge values x of the renumbered mesh, on the original's edges: edges matched by their vertex pair,
+//   the sign flipped where the renumbering reverses the edge's i < j order (x is oriented from L, the face
+//   holding i → j, to R; trivcon/geometry.h, solver.h);
+Eigen::VectorXd edge_values_on_original(const Topology& original, const Topology& renumbered, const Eigen::VectorXd& x,
+                                        const std::vector<int>& vertex_perm);
+// - the largest angle, modulo 2π/N, between the world directions of a field on the original mesh and one on
+//   the renumbered mesh (the faces' frames differ: permute rotates corners).
+double max_field_difference(const Geometry& original, const Field& a, const Geometry& renumbered, const Field& b,
+                            const std::vector<int>& face_perm);
 
 }  // namespace trivcon::test

@@ -30,6 +30,8 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using test::CommandResult;
 using test::run_cli;
+using test::slurp;
+using test::write_text;
 
 const std::string kError = "trivcon: error: ";
 
@@ -37,18 +39,6 @@ std::string q(const std::string& s) { return "'" + s + "'"; }
 
 bool starts_with(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> lines;

@@ -166,6 +166,13 @@ TEST(Constraints, InvariantUnderRenumbering) {
   const Design r1 = d1.design(p1), r2 = d2.design(p2);
   expect_exact(d2, r2, p2);
   EXPECT_NEAR(r1.connection.energy, r2.connection.energy, 1e-8 * std::max(1.0, r1.connection.energy));
+  // The fixed boundary directions leave one optimum: the same x on every edge (by vertex pair, the sign
+  // following the edge's i < j order) and the same field in every face, compared as world directions.
+  const Eigen::VectorXd x2 = test::edge_values_on_original(d1.topology(), d2.topology(), r2.connection.x, vperm);
+  const double scale = std::max(1.0, r1.connection.x.cwiseAbs().maxCoeff());
+  EXPECT_LE((r1.connection.x - x2).cwiseAbs().maxCoeff(), 1e-8 * scale);
+  EXPECT_GT(r1.connection.x.cwiseAbs().maxCoeff(), 1e-3) << "a connection that is zero would compare trivially";
+  EXPECT_LE(test::max_field_difference(d1.geometry(), r1.field, d2.geometry(), r2.field, fperm), 1e-8);
 }
 
 TEST(Constraints, ConflictsBetweenAdjacentFixedFacesAreReported) {
@@ -251,5 +258,9 @@ TEST(Constraints, ManyFixedFacesSparseRoute) {
     EXPECT_GE(a.connection.energy, b.connection.energy - 1e-8 * std::max(1.0, b.connection.energy));
     EXPECT_LE(a.connection.energy, 1.01 * b.connection.energy);
     EXPECT_EQ(a.connection.loop_index, b.connection.loop_index);
+    // Concentric: the boundary-tangent field turns once with each circle, so neither loop has a singular
+    // turn (indices.h: 0 on both, where a constant field has +1 outside and −1 inside).
+    EXPECT_EQ(a.connection.loop_index, (std::vector<int>{0, 0}));
+    EXPECT_EQ(a.indices.loop, (std::vector<int>{0, 0}));
   }
 }

@@ -25,13 +25,7 @@ namespace trivcon {
 namespace {
 
 using Eigen::Vector3d;
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::slurp;
 
 // A mesh with a designed field.
 struct Scene {

@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <random>
@@ -187,9 +188,87 @@ TEST(Supernodal, ReportsTheColumnThatIsNotPositiveDefinite) {
   }
 }
 
+// Checks a split against split_tree's contract (src/supernodal.h) and returns what it left below the top:
+// the loads of the two parts (the sum of `work` over each) and the subtree roots there.
+struct BelowTop {
+  std::array<double, 2> load{0, 0};
+  std::vector<int> roots;
+  double heaviest = 0;  // the largest subtree below the top
+};
+BelowTop expect_valid_split(const std::vector<int>& parent, const std::vector<double>& work, double min_split,
+                            const supernodal::TreeSplit& split) {
+  const int count = static_cast<int>(parent.size());
+  std::vector<int> where(count, -2);  // −1: top, 0/1: part
+  for (int s : split.top) {
+    EXPECT_EQ(where[s], -2);
+    where[s] = -1;
+  }
+  for (int k = 0; k < 2; ++k)
+    for (int s : split.part[k]) {
+      EXPECT_EQ(where[s], -2);
+      where[s] = k;
+    }
+  for (const auto* list : {&split.top, &split.part[0], &split.part[1]}) EXPECT_TRUE(std::is_sorted(list->begin(), list->end()));
+  std::vector<double> subtree = work;  // a parent comes after its children
+  for (int s = 0; s < count; ++s)
+    if (parent[s] >= 0) subtree[parent[s]] += subtree[s];
+  BelowTop below;
+  for (int s = 0; s < count; ++s) {
+    EXPECT_NE(where[s], -2) << "supernode " << s << " in no list";
+    if (where[s] == -2) continue;
+    // The top is closed upwards, and a part's supernode has its ancestors in its part or the top: the
+    // parts are whole subtrees and do not depend on each other.
+    if (parent[s] >= 0) {
+      EXPECT_TRUE(where[s] == -1 ? where[parent[s]] == -1 : where[parent[s]] == where[s] || where[parent[s]] == -1) << "supernode " << s;
+    }
+    if (where[s] == -1) {
+      EXPECT_GT(subtree[s], min_split) << "supernode " << s << " is in the top, but its subtree is too small to split";
+    } else {
+      below.load[where[s]] += work[s];
+      if (parent[s] < 0 || where[parent[s]] == -1) below.roots.push_back(s), below.heaviest = std::max(below.heaviest, subtree[s]);
+    }
+  }
+  // Splitting stopped where it should: the largest subtree left holds at most half of the work below the
+  // top, or no more than min_split.
+  const double total = below.load[0] + below.load[1];
+  EXPECT_FALSE(below.heaviest > 0.5 * total && below.heaviest > min_split) << "the largest subtree below the top should have been split";
+  // Both parts get work whenever two subtrees are left; balanced by the work measure: the parts differ by
+  // at most the largest subtree (each subtree goes whole to the lighter part, largest first).
+  if (below.roots.size() >= 2) {
+    EXPECT_FALSE(split.part[0].empty() || split.part[1].empty()) << below.roots.size() << " subtrees below the top, one part empty";
+  }
+  EXPECT_LE(std::abs(below.load[0] - below.load[1]), below.heaviest + 1e-9);
+  return below;
+}
+
 TEST(Supernodal, TreeSplitIsIndependentAndBalanced) {
+  using supernodal::split_tree;
+  {  // Two equal leaves under a heavy root: the root is the top, one leaf per part.
+    const supernodal::TreeSplit s = split_tree({2, 2, -1}, {10, 10, 1}, 5);
+    expect_valid_split({2, 2, -1}, {10, 10, 1}, 5, s);
+    EXPECT_EQ(s.top, std::vector<int>{2});
+    EXPECT_EQ(s.part[0].size() + s.part[1].size(), 2u);
+    EXPECT_FALSE(s.part[0].empty() || s.part[1].empty());
+  }
+  {  // Two trees of equal work: nothing to split, one each.
+    const supernodal::TreeSplit s = split_tree({1, -1, 3, -1}, {5, 5, 5, 5}, 1);
+    expect_valid_split({1, -1, 3, -1}, {5, 5, 5, 5}, 1, s);
+    EXPECT_TRUE(s.top.empty());
+    EXPECT_EQ(s.part[0].size(), 2u);
+    EXPECT_EQ(s.part[1].size(), 2u);
+  }
+  {  // A chain allows no two independent parts: below min_split it stays whole, above it all goes to the top.
+    const supernodal::TreeSplit small = split_tree({1, 2, -1}, {10, 10, 10}, 100), large = split_tree({1, 2, -1}, {10, 10, 10}, 1);
+    expect_valid_split({1, 2, -1}, {10, 10, 10}, 100, small);
+    expect_valid_split({1, 2, -1}, {10, 10, 10}, 1, large);
+    EXPECT_TRUE(small.top.empty());
+    EXPECT_EQ(small.part[0].size() + small.part[1].size(), 3u);
+    EXPECT_EQ(large.top, (std::vector<int>{0, 1, 2}));
+  }
   std::mt19937 rng(5);
+  int split_in_two = 0;
   for (int trial = 0; trial < 50; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
     const int count = 1 + static_cast<int>(rng() % 400);
     std::vector<int> parent(count, -1);
     std::vector<double> work(count);
@@ -197,35 +276,40 @@ TEST(Supernodal, TreeSplitIsIndependentAndBalanced) {
       work[s] = 1 + rng() % 1000;
       if (s + 1 < count && rng() % 20 != 0) parent[s] = s + 1 + static_cast<int>(rng() % std::min(5, count - s - 1));
     }
-    const supernodal::TreeSplit split = supernodal::split_tree(parent, work, 100);
-    std::vector<int> where(count, -2);  // −1: top, 0/1: part
-    for (int s : split.top) {
-      EXPECT_EQ(where[s], -2);
-      where[s] = -1;
+    const supernodal::TreeSplit split = split_tree(parent, work, 100);
+    split_in_two += expect_valid_split(parent, work, 100, split).roots.size() >= 2;
+  }
+  EXPECT_GE(split_in_two, 40) << "most random forests leave several subtrees below the top";
+}
+
+// The elimination trees of mesh Laplacians, with the work measure and threshold supernodal::factorize
+// uses (per supernode cols · height² + 64 · height, split above 1e5): two non-empty parts, balanced.
+TEST(Supernodal, TreeSplitOfMeshFactorsWithTheFactorizationsWorkMeasure) {
+  for (const auto& [name, mesh] : std::vector<std::pair<std::string, Mesh>>{{"cube sphere 40", make_cube_sphere(40, true)},
+                                                                            {"torus 120x48", make_torus(120, 48)},
+                                                                            {"holed grid", make_holed_grid(120, 3)}}) {
+    SCOPED_TRACE(name);
+    Upper M = shifted_laplacian(mesh, 1e-3, 7);
+    Cholmod cm;
+    cholmod_sparse A = view(M);
+    cholmod_factor* L = cholmod_analyze(&A, &cm.c);
+    ASSERT_NE(L, nullptr);
+    ASSERT_TRUE(L->is_super);
+    const supernodal::Supernodes S(L);
+    const std::vector<int> parent = supernodal::supernode_parents(S, S.owners());
+    std::vector<double> work(S.count);
+    for (int s = 0; s < S.count; ++s) {
+      const double ncol = S.cols(s), nrow = S.height(s);
+      work[s] = ncol * nrow * nrow + 64 * nrow;
     }
-    for (int k = 0; k < 2; ++k)
-      for (int s : split.part[k]) {
-        EXPECT_EQ(where[s], -2);
-        where[s] = k;
-      }
-    for (int s = 0; s < count; ++s) {
-      ASSERT_NE(where[s], -2) << "supernode " << s << " in no list";
-      // The top is closed upwards, and a part's supernode has its ancestors in its part or the top.
-      if (parent[s] < 0) continue;
-      EXPECT_TRUE(where[s] == -1 ? where[parent[s]] == -1 : where[parent[s]] == where[s] || where[parent[s]] == -1) << "supernode " << s;
-    }
-    for (const auto* list : {&split.top, &split.part[0], &split.part[1]}) EXPECT_TRUE(std::is_sorted(list->begin(), list->end()));
-    // Balanced: the parts differ by at most the largest subtree below the top.
-    std::vector<double> subtree = work;
-    for (int s = 0; s < count; ++s)
-      if (parent[s] >= 0) subtree[parent[s]] += subtree[s];
-    double largest = 0;
-    std::array<double, 2> load{0, 0};
-    for (int s = 0; s < count; ++s)
-      if (where[s] >= 0) {
-        load[where[s]] += work[s];
-        if (parent[s] < 0 || where[parent[s]] == -1) largest = std::max(largest, subtree[s]);
-      }
-    EXPECT_LE(std::abs(load[0] - load[1]), largest + 1e-9) << "trial " << trial;
+    const supernodal::TreeSplit split = supernodal::split_tree(parent, work, 1e5);
+    const BelowTop below = expect_valid_split(parent, work, 1e5, split);
+    EXPECT_FALSE(split.part[0].empty() || split.part[1].empty());
+    EXPECT_GE(below.roots.size(), 2u);
+    const double total = below.load[0] + below.load[1];
+    // The contract bounds the difference by the largest subtree (up to half the work); on these trees the
+    // parts are within 6% of each other.
+    EXPECT_LE(std::abs(below.load[0] - below.load[1]), 0.2 * total) << below.load[0] << " vs " << below.load[1];
+    cholmod_free_factor(&L, &cm.c);
   }
 }
