@@ -9,10 +9,21 @@
 
 namespace trivcon::cli {
 
+// The program's exit statuses (README.md, "Exit status").
+enum ExitStatus : int {
+  kSuccess = 0,
+  kBadInput = 1,            // a trivcon::Error: bad input, a file that cannot be read or written; out of memory
+  kUsageError = 2,          // CLI11 rejected the command line
+  kVerificationFailed = 3,  // solve: a design did not pass verification
+  kIndicesDiffer = 4,       // check: the field's indices differ from the prescription
+  kInternalError = 70,      // any other exception: a bug
+};
+
 extern int exit_code;  // set by a subcommand that wants a status other than 0
 
 void register_info(CLI::App& app);
-void register_solve(CLI::App& app);  // also `check`
+void register_solve(CLI::App& app);
+void register_check(CLI::App& app);
 void register_render(CLI::App& app);
 
 // Reads a mesh file; messages name the file.

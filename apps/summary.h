@@ -1,5 +1,7 @@
-// JSON descriptions shared by `info` and the `solve` report (documented in README.md, "trivcon info --json").
+// JSON descriptions shared by `info` and the `solve` report (documented in README.md, "trivcon info --json"),
+// and the clock of the report's timings.
 #pragma once
+#include <chrono>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -12,5 +14,8 @@ namespace trivcon::cli {
 
 nlohmann::ordered_json mesh_summary(const std::string& path, const MeshData& mesh, const Topology& topology, const Geometry& geometry);
 nlohmann::ordered_json cycles_summary(const Topology& topology, const Geometry& geometry, const Cycles& cycles);
+
+using Clock = std::chrono::steady_clock;
+inline double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 }  // namespace trivcon::cli

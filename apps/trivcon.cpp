@@ -19,20 +19,23 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   trivcon::cli::register_info(app);
   trivcon::cli::register_solve(app);
+  trivcon::cli::register_check(app);
   trivcon::cli::register_render(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version come as ParseErrors too (status 0, text on stdout); for every usage error CLI11
+    // prints its message, and the status is 2 whatever CLI11's own code for that error.
+    return app.exit(e) == 0 ? trivcon::cli::kSuccess : trivcon::cli::kUsageError;
   } catch (const trivcon::Error& e) {
     std::cerr << "trivcon: error: " << e.what() << "\n";
-    return 1;
+    return trivcon::cli::kBadInput;
   } catch (const std::bad_alloc&) {
     std::cerr << "trivcon: error: out of memory\n";
-    return 1;
+    return trivcon::cli::kBadInput;
   } catch (const std::exception& e) {
     std::cerr << "trivcon: internal error: " << e.what() << "\n";
-    return 70;
+    return trivcon::cli::kInternalError;
   }
   return trivcon::cli::exit_code;
 }

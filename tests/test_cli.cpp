@@ -672,6 +672,42 @@ TEST(CliSolve, CrossFieldOnACubeFromASingularityFile) {
   EXPECT_TRUE(contains(r.out, "index 1/4\n")) << r.out;
 }
 
+TEST(CliSolve, FactorizationCholmodGivesTheSameConnection) {
+  // --factorization cholmod (CHOLMOD's own numeric factorization) against the default, on a genus-2
+  // surface (cycle rows): the same x on every edge to round-off, the same energy line.
+  const std::string dir = test::temp_dir("cli_solve_factorization");
+  const std::string mesh = save(dir, "genus2", make_genus_surface(2, 2), true);
+  std::string conn[2], energy[2];
+  int k = 0;
+  for (const char* f : {"own", "cholmod"}) {
+    const std::string path = dir + "/conn_" + f + ".txt";
+    const CommandResult r = run_cli("solve " + q(mesh) + " -N 4 --sing 0:-1/4 --sing 40:-1/4 --sing 80:-1/4 --sing 120:-1/4 --sing 160:-1/4"
+                                    " --sing 200:-1/4 --sing 240:-1/4 --sing 280:-1/4 --factorization " + f + " --connection-out " + q(path));
+    ASSERT_EQ(r.status, 0) << r.err;
+    conn[k] = slurp(path);
+    energy[k] = r.out.substr(r.out.find("energy "), r.out.find('\n', r.out.find("energy ")) - r.out.find("energy "));
+    ++k;
+  }
+  EXPECT_EQ(energy[0].substr(0, 14), energy[1].substr(0, 14));
+  std::istringstream a(conn[0]), b(conn[1]);
+  std::string la, lb;
+  int lines = 0;
+  double worst = 0;
+  while (std::getline(a, la) && std::getline(b, lb)) {
+    if (la.empty() || la[0] == '#') continue;
+    int i = 0, j = 0, i2 = 0, j2 = 0;
+    double x = 0, y = 0;
+    std::istringstream(la) >> i >> j >> x;
+    std::istringstream(lb) >> i2 >> j2 >> y;
+    ASSERT_EQ(i, i2);
+    ASSERT_EQ(j, j2);
+    worst = std::max(worst, std::abs(x - y));
+    ++lines;
+  }
+  EXPECT_GT(lines, 1000);
+  EXPECT_LE(worst, 1e-10);
+}
+
 TEST(CliSolve, TorusWithoutSingularities) {
   const std::string dir = test::temp_dir("cli_solve_torus");
   const std::string mesh = save(dir, "torus", make_torus(16, 8));

@@ -1,0 +1,88 @@
+// trivcon check MESH FIELD [options]: the indices of a per-face field, compared with a prescription.
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "prescription_options.h"
+#include "trivcon/cycles.h"
+#include "trivcon/error.h"
+#include "trivcon/field.h"
+#include "trivcon/field_io.h"
+#include "trivcon/geometry.h"
+#include "trivcon/topology.h"
+
+namespace trivcon::cli {
+
+namespace {
+
+struct CheckOptions {
+  std::string mesh, field;
+  PrescriptionOptions prescription;
+  bool json = false;
+};
+
+void run_check(CheckOptions& o) {
+  const MeshData mesh = load_mesh(o.mesh);
+  check_finite(mesh.V);
+  const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
+  const Geometry g = compute_geometry(mesh.V, t);
+  const Cycles cycles = compute_cycles(t);
+  int file_N = 0;
+  const MatrixX3d directions = read_field(o.field, t.num_faces, &file_N);
+  if (o.prescription.N_given() && file_N > 0 && file_N != o.prescription.N)
+    throw Error("the field file " + o.field + " holds an N = " + std::to_string(file_N) + " field but -N " +
+                std::to_string(o.prescription.N) + " was given");
+  if (!o.prescription.N_given() && file_N > 0) o.prescription.N = file_N;
+  // Without a prescription, check only lists the field's singularities.
+  const bool compare = !o.prescription.empty();
+  const IndexPrescription p = o.prescription.build();
+  if (compare) validate_prescription(t, static_cast<int>(cycles.generators.size()), p);
+  const Field field = field_from_directions(g, directions, p.N);
+  const FieldIndices idx = field_indices(t, g, cycles, field);
+  nlohmann::ordered_json found = nlohmann::ordered_json::array(), differ = nlohmann::ordered_json::array();
+  for (int v = 0; v < t.num_vertices; ++v) {
+    const int want = p.vertex.count(v) ? p.vertex.at(v) : 0;
+    if (idx.vertex[v] != 0) found.push_back({{"vertex", v}, {"index", format_index(idx.vertex[v], p.N)}});
+    if (compare && idx.vertex[v] != want)
+      differ.push_back({{"vertex", v}, {"found", format_index(idx.vertex[v], p.N)}, {"prescribed", format_index(want, p.N)}});
+  }
+  nlohmann::ordered_json j;
+  j["N"] = p.N;
+  j["singularities"] = found;
+  if (compare) j["differences"] = differ;
+  nlohmann::ordered_json loops = nlohmann::ordered_json::array(), gens = nlohmann::ordered_json::array();
+  for (size_t l = 0; l < idx.loop.size(); ++l) loops.push_back({{"id", l}, {"index", format_index(idx.loop[l], p.N)}});
+  for (size_t i = 0; i < idx.generator.size(); ++i) gens.push_back({{"id", i}, {"index", format_index(idx.generator[i], p.N)}});
+  j["boundary_loops"] = loops;
+  j["generators"] = gens;
+  if (o.json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "N " << p.N << ": " << found.size() << " singular vertices in the field\n";
+    for (const auto& s : found) std::cout << "  vertex " << s["vertex"] << " index " << s["index"].get<std::string>() << "\n";
+    for (size_t l = 0; l < idx.loop.size(); ++l)
+      std::cout << "  boundary loop " << l << " index " << format_index(idx.loop[l], p.N) << "\n";
+    if (compare)
+      std::cout << (differ.empty() ? "matches the prescription\n"
+                                   : std::to_string(differ.size()) + " vertices differ from the prescription\n");
+    for (const auto& s : differ)
+      std::cout << "  vertex " << s["vertex"] << ": found " << s["found"].get<std::string>() << ", prescribed "
+                << s["prescribed"].get<std::string>() << "\n";
+  }
+  if (!differ.empty()) exit_code = kIndicesDiffer;
+}
+
+}  // namespace
+
+void register_check(CLI::App& app) {
+  static CheckOptions c;
+  auto* check = app.add_subcommand(
+      "check", "Compute the indices of a per-face field (any tool's); with -s/--sing, compare them with that prescription");
+  check->add_option("mesh", c.mesh, "Mesh file")->required();
+  check->add_option("field", c.field, "Field: trivcon's .txt or .ply, or Directional's .rawfield")->required();
+  c.prescription.add_to(check, false);
+  check->add_flag("--json", c.json, "Print JSON");
+  check->callback([] { run_check(c); });
+}
+
+}  // namespace trivcon::cli

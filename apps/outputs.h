@@ -1,0 +1,41 @@
+// The files `solve` writes after a design. They appear together or not at all: each is written
+// (atomically) beside its final path under a temporary name, and all are renamed into place once every
+// one was written.
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "trivcon/design.h"
+#include "trivcon/io.h"
+
+namespace trivcon::cli {
+
+// The output paths given on the command line; an empty one is not written.
+struct OutputPaths {
+  std::string field, connection, lines, report, png;
+};
+
+// Output paths for one prescription of a batch: "{name}" in a path is replaced by the item's name;
+// without it, ".NAME" goes before the extension (field.txt → field.NAME.txt). Single solves keep paths.
+std::string output_path(const std::string& path, const std::string& name);
+
+class StagedOutputs {
+ public:
+  // The temporary name to write `final_path` under.
+  std::string path(const std::string& final_path);
+  // Renames every staged file into place; throws trivcon::Error naming a file that cannot be.
+  void commit();
+  // Removes the staged files not committed.
+  ~StagedOutputs();
+
+ private:
+  std::vector<std::pair<std::string, std::string>> staged_;  // (temporary, final path)
+};
+
+// Stages the field, connection, lines and picture of design `d` of `prescription` (item `name` of a
+// batch, or ""); the report is staged by its caller.
+void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const std::string& name, const MeshData& mesh,
+                          const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d);
+
+}  // namespace trivcon::cli

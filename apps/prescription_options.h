@@ -1,0 +1,24 @@
+// The options that describe a prescription (-N, -s, --sing, --generator, --boundary), shared by `solve`
+// and `check`.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "trivcon/indices.h"
+
+namespace trivcon::cli {
+
+struct PrescriptionOptions {
+  int N = 1;
+  std::vector<std::string> sing_files, sings, generators, loops;
+  CLI::Option* N_option = nullptr;
+  bool N_given() const { return N_option && N_option->count() > 0; }
+  bool empty() const { return sing_files.empty() && sings.empty() && generators.empty() && loops.empty(); }
+  // Adds the options to `cmd`; --generator and --boundary only `with_cycles`.
+  void add_to(CLI::App* cmd, bool with_cycles);
+  // The prescription the options give (files read, specs parsed; throws trivcon::Error).
+  IndexPrescription build() const;
+};
+
+}  // namespace trivcon::cli

@@ -1,0 +1,77 @@
+#include "report.h"
+
+#include "summary.h"
+#include "trivcon/blas.h"
+
+namespace trivcon::cli {
+
+nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, const FieldDesigner& designer,
+                                    const IndexPrescription& prescription, const Design& d) {
+  const Topology& t = designer.topology();
+  const Connection& c = d.connection;
+  nlohmann::ordered_json report;
+  report["mesh"] = mesh_summary(run.mesh_path, mesh, t, designer.geometry());
+  if (!run.name.empty()) report["name"] = run.name;
+  report["N"] = prescription.N;
+  report["weights"] = run.weights;
+  report["solver"] = run.solver;
+  report["blas_kernels"] = blas_kernels();
+  report["ordering"] = designer.solver().ordering();
+  nlohmann::ordered_json sing = nlohmann::ordered_json::array();
+  for (auto [v, n] : prescription.vertex) sing.push_back({{"vertex", v}, {"index", format_index(n, prescription.N)}});
+  report["singularities"] = sing;
+  nlohmann::ordered_json gens = nlohmann::ordered_json::array();
+  for (size_t g = 0; g < c.generator_index.size(); ++g)
+    gens.push_back({{"id", g},
+                    {"component", designer.cycles().generators[g].component},
+                    {"index", format_index(c.generator_index[g], prescription.N)},
+                    {"chosen", static_cast<bool>(c.generator_chosen[g])}});
+  report["generators"] = gens;
+  nlohmann::ordered_json loops = nlohmann::ordered_json::array();
+  for (size_t l = 0; l < c.loop_index.size(); ++l)
+    loops.push_back({{"id", l}, {"index", format_index(c.loop_index[l], prescription.N)}, {"chosen", static_cast<bool>(c.loop_chosen[l])}});
+  report["boundary_loops"] = loops;
+  nlohmann::ordered_json conflicts = nlohmann::ordered_json::array();
+  for (const FixedConflict& k : d.conflicts) conflicts.push_back({{"face_a", k.face_a}, {"face_b", k.face_b}, {"turn", k.turn}});
+  report["fixed"] = {{"faces", prescription.fixed.size()},
+                     {"align_boundary", run.align_boundary},
+                     {"paths", designer.solver().fixed_paths().size()},
+                     {"regularized_edges", designer.solver().regularized_edges()},
+                     {"max_error", d.max_fixed_error},
+                     {"conflicts", conflicts}};
+  report["energy"] = c.energy;
+  report["residuals"] = {{"max_vertex", c.max_vertex_residual},
+                         {"max_cycle", c.max_cycle_residual},
+                         {"rhs_scale", c.rhs_scale},
+                         {"transport_mismatch", d.transport_mismatch}};
+  nlohmann::ordered_json mism = nlohmann::ordered_json::array();
+  for (int v : d.index_mismatch_vertices)
+    mism.push_back({{"vertex", v}, {"field_index", format_index(d.indices.vertex[v], prescription.N)}});
+  report["indices"] = {{"singular_vertices", prescription.vertex.size()},
+                       {"field_mismatches", mism},
+                       {"unexplained_mismatches", d.unexplained_mismatch_vertices.size()},
+                       {"large_turn_edges", d.large_turn_edges}};
+  const PrepareTimings& pt = designer.timings();
+  const SetupTimings& st = designer.solver().timings();
+  report["symbolic_analysis"] = st.analysis_adopted ? "concurrent" : "in set-up";
+  report["seconds"] = {{"read", run.read_seconds},
+                       {"topology", pt.topology},
+                       {"geometry", pt.geometry},
+                       {"cycles", pt.cycles},
+                       {"plan", pt.plan},
+                       {"analysis", pt.analysis},
+                       {"setup", pt.setup},
+                       {"setup_assemble", st.assemble},
+                       {"setup_analysis_wait", st.analysis_wait},
+                       {"setup_factor", st.factor},
+                       {"setup_schur", st.schur},
+                       {"prepare", pt.prepare},
+                       {"solve", d.solve_seconds},
+                       {"field", d.field_seconds},
+                       {"verify", d.verify_seconds},
+                       {"write", run.write_seconds}};
+  report["verified"] = run.verified;
+  return report;
+}
+
+}  // namespace trivcon::cli

@@ -1,0 +1,23 @@
+// The JSON report of one `solve` design (--report; documented in README.md).
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "trivcon/design.h"
+#include "trivcon/io.h"
+
+namespace trivcon::cli {
+
+// What the report says about the run beside the design itself.
+struct ReportRun {
+  std::string mesh_path, name;  // name: the batch item's, or "" for a single solve
+  std::string weights, solver;  // as given on the command line
+  bool align_boundary = false;
+  double read_seconds = 0, write_seconds = 0;
+  bool verified = false;
+};
+
+nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, const FieldDesigner& designer,
+                                    const IndexPrescription& prescription, const Design& d);
+
+}  // namespace trivcon::cli
