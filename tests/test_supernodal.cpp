@@ -11,6 +11,7 @@
 #include <random>
 #include <set>
 
+#include "detail/cholmod.h"
 #include "detail/supernodal.h"
 #include "trivcon/generate.h"
 
@@ -49,23 +50,12 @@ Upper shifted_laplacian(const Mesh& mesh, double shift, unsigned seed) {
   return M;
 }
 
-cholmod_sparse view(Upper& M) {
-  cholmod_sparse s{};
-  s.nrow = s.ncol = static_cast<size_t>(M.n), s.nzmax = M.inner.size();
-  s.p = M.outer.data(), s.i = M.inner.data(), s.x = M.values.data();
-  s.stype = 1, s.itype = CHOLMOD_INT, s.xtype = CHOLMOD_REAL, s.dtype = CHOLMOD_DOUBLE, s.sorted = 1, s.packed = 1;
-  return s;
-}
+cholmod_sparse view(const Upper& M) { return detail::upper_view(M.outer, M.inner, M.values, M.n); }
 
+// The library's CHOLMOD workspace (src/detail/cholmod.h), as the solver sets it up.
 struct Cholmod {
-  cholmod_common c;
-  Cholmod() {
-    cholmod_start(&c);
-    c.print = 0;
-    c.supernodal = CHOLMOD_SUPERNODAL;
-    c.final_ll = 1;
-  }
-  ~Cholmod() { cholmod_finish(&c); }
+  detail::CholmodContext context;
+  cholmod_common& c = *context;
 };
 
 // Factors M with CHOLMOD and with supernodal::factorize from one symbolic analysis; returns the largest
