@@ -37,8 +37,8 @@ void register_info(CLI::App& app) {
               << "components " << t.components.size() << ", boundary loops " << t.boundary_loops.size() << "\n";
     for (size_t c = 0; c < t.components.size(); ++c) {
       const ComponentInfo& info = t.components[c];
-      std::cout << "  component " << c << ": faces " << info.faces << ", vertices " << info.vertices << ", chi " << info.euler_characteristic
-                << ", genus " << info.genus << ", boundary loops " << info.boundary_loops.size() << "\n";
+      std::cout << "  component " << c << ": faces " << info.faces << ", vertices " << info.vertices << ", chi "
+                << info.euler_characteristic << ", genus " << info.genus << ", boundary loops " << info.boundary_loops.size() << "\n";
     }
     std::cout << "unreferenced vertices " << t.unreferenced_vertices.size() << "\n"
               << "zero-area faces " << g.zero_area_faces << " (degenerate, treated specially: " << g.degenerate_faces << ")\n"
@@ -50,7 +50,8 @@ void register_info(CLI::App& app) {
                   << " dual edges, Levi-Civita holonomy " << levi_civita_holonomy(cycles.generators[i], g) << "\n";
       for (size_t l = 0; l < t.boundary_loops.size(); ++l)
         std::cout << "loop " << l << ": component " << t.vertex_component[t.boundary_loops[l][0]] << ", " << t.boundary_loops[l].size()
-                  << " vertices starting at " << t.boundary_loops[l][0] << ", curvature " << loop_curvature(t, g, static_cast<int>(l)) << "\n";
+                  << " vertices starting at " << t.boundary_loops[l][0] << ", curvature " << loop_curvature(t, g, static_cast<int>(l))
+                  << "\n";
     }
   });
 }

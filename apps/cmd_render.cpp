@@ -40,7 +40,8 @@ std::pair<T, T> parse_pair(const std::string& text, char separator, Parse parse,
 // "WxH" → (W, H).
 void parse_size(const std::string& text, RenderOptions& o) {
   std::tie(o.width, o.height) = parse_pair<int>(
-      text, 'x', [](const std::string& s, size_t* end) { return std::stoi(s, end); }, "--size " + text + ": expected WIDTHxHEIGHT, e.g. 1200x900");
+      text, 'x', [](const std::string& s, size_t* end) { return std::stoi(s, end); },
+      "--size " + text + ": expected WIDTHxHEIGHT, e.g. 1200x900");
 }
 
 // "AZ,EL" in degrees.

@@ -55,8 +55,7 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   const double tolerance = 1e-9 * std::max(1.0, c.rhs_scale);
   const double residual = std::max(c.max_vertex_residual, c.max_cycle_residual);
   const std::vector<int>& unexplained = d.unexplained_mismatch_vertices;
-  const bool ok =
-      residual <= tolerance && d.transport_mismatch <= tolerance && d.max_fixed_error <= tolerance && unexplained.empty();
+  const bool ok = residual <= tolerance && d.transport_mismatch <= tolerance && d.max_fixed_error <= tolerance && unexplained.empty();
 
   auto t1 = Clock::now();
   StagedOutputs staged;
@@ -70,12 +69,12 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
 
   if (!o.quiet) {
     if (!name.empty()) std::cout << "== " << name << "\n";
-    std::cout << "N " << prescription.N << ", " << prescription.vertex.size() << " singular vertices, weights " << o.weights
-              << ", solver " << o.solver << "\n"
-              << (prescription.fixed.empty() ? std::string()
-                                             : std::to_string(prescription.fixed.size()) + " fixed faces, max deviation " +
-                                                   fmt(d.max_fixed_error) + " rad, " + std::to_string(d.conflicts.size()) +
-                                                   " sharp turns between adjacent fixed faces\n")
+    std::cout << "N " << prescription.N << ", " << prescription.vertex.size() << " singular vertices, weights " << o.weights << ", solver "
+              << o.solver << "\n"
+              << (prescription.fixed.empty()
+                      ? std::string()
+                      : std::to_string(prescription.fixed.size()) + " fixed faces, max deviation " + fmt(d.max_fixed_error) + " rad, " +
+                            std::to_string(d.conflicts.size()) + " sharp turns between adjacent fixed faces\n")
               << "energy " << std::setprecision(10) << c.energy << "\n"
               << "max residual " << fmt(residual) << " rad (vertex " << fmt(c.max_vertex_residual) << ", cycles "
               << fmt(c.max_cycle_residual) << "), transport mismatch " << fmt(d.transport_mismatch) << " rad\n"
@@ -99,8 +98,7 @@ void run_solve(const SolveOptions& o) {
   IndexPrescription prescription = o.prescription.build();
   if (o.root_angles.size() > o.root_faces.size()) throw Error("--root-angle given without a matching --root-face");
   std::vector<std::pair<int, double>> roots;
-  for (size_t i = 0; i < o.root_faces.size(); ++i)
-    roots.emplace_back(o.root_faces[i], i < o.root_angles.size() ? o.root_angles[i] : 0.0);
+  for (size_t i = 0; i < o.root_faces.size(); ++i) roots.emplace_back(o.root_faces[i], i < o.root_angles.size() ? o.root_angles[i] : 0.0);
   std::vector<BatchItem> batch;
   if (!o.sing_batch.empty()) batch = read_batch(o.sing_batch, prescription);
 
@@ -112,8 +110,10 @@ void run_solve(const SolveOptions& o) {
   if (o.align_boundary) prescription.fixed = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
   std::map<int, double> explicit_fixed;  // --fix wins over --align-boundary on the same face
   for (const auto& f : o.fixes) {
-    if (is_fix_spec(f)) add_fixed_direction(f, designer.topology(), designer.geometry(), explicit_fixed);
-    else read_fixed_directions(f, designer.topology(), designer.geometry(), explicit_fixed);
+    if (is_fix_spec(f))
+      add_fixed_direction(f, designer.topology(), designer.geometry(), explicit_fixed);
+    else
+      read_fixed_directions(f, designer.topology(), designer.geometry(), explicit_fixed);
   }
   for (auto [f, angle] : explicit_fixed) prescription.fixed[f] = angle;
   std::vector<int> fixed_faces;

@@ -81,8 +81,11 @@ struct Samples {
   }
   json to_json() const {
     if (v.empty()) return nullptr;
-    return json{{"median", median()}, {"min", *std::min_element(v.begin(), v.end())}, {"max", *std::max_element(v.begin(), v.end())},
-                {"n", v.size()}, {"samples", v}};
+    return json{{"median", median()},
+                {"min", *std::min_element(v.begin(), v.end())},
+                {"max", *std::max_element(v.begin(), v.end())},
+                {"n", v.size()},
+                {"samples", v}};
   }
 };
 
@@ -138,7 +141,8 @@ std::string cache_stem(const std::string& spec) {
   const size_t colon = s.find(':');
   if (colon != std::string::npos && (s.substr(0, colon) == "file" || s.substr(0, colon) == "subdiv")) {
     const std::string path = s.substr(colon + 1);
-    s = s.substr(0, colon) + "_" + fs::path(path).filename().string() + "_" + std::to_string(std::hash<std::string>{}(fs::weakly_canonical(path).string()) % 100000);
+    s = s.substr(0, colon) + "_" + fs::path(path).filename().string() + "_" +
+        std::to_string(std::hash<std::string>{}(fs::weakly_canonical(path).string()) % 100000);
   }
   for (char& c : s)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-') c = '_';
@@ -208,7 +212,8 @@ struct EditResult {
   double solve = 0, field_time = 0, whole = 0;
 };
 
-EditResult timed_edit(const ConnectionSolver& solver, const Pipeline& p, const bench::EditGenerator& gen, const std::string& name, int index) {
+EditResult timed_edit(const ConnectionSolver& solver, const Pipeline& p, const bench::EditGenerator& gen, const std::string& name,
+                      int index) {
   EditResult r;
   std::mt19937_64 rng(bench::edit_seed(name, index));
   const auto t0 = Clock::now();
@@ -228,15 +233,21 @@ json mesh_summary(const Pipeline& p) {
   const Topology& t = p.topology();
   int max_genus = 0;
   for (const auto& c : t.components) max_genus = std::max(max_genus, c.genus);
-  return json{{"vertices", t.num_vertices},    {"faces", t.num_faces},
-              {"edges", t.num_edges},          {"components", t.components.size()},
-              {"boundary_loops", t.boundary_loops.size()}, {"generators", p.cycles().generators.size()},
-              {"max_genus", max_genus},        {"euler_characteristic", t.euler_characteristic()},
-              {"negative_cotan_edges", p.geometry().negative_cotan_edges}, {"degenerate_faces", p.geometry().degenerate_faces}};
+  return json{{"vertices", t.num_vertices},
+              {"faces", t.num_faces},
+              {"edges", t.num_edges},
+              {"components", t.components.size()},
+              {"boundary_loops", t.boundary_loops.size()},
+              {"generators", p.cycles().generators.size()},
+              {"max_genus", max_genus},
+              {"euler_characteristic", t.euler_characteristic()},
+              {"negative_cotan_edges", p.geometry().negative_cotan_edges},
+              {"degenerate_faces", p.geometry().degenerate_faces}};
 }
 
 // Verification of one edit (outside the timings): the solver's residuals and the indices read back.
-json verify_edit(const Pipeline& p, const bench::EditGenerator& gen, const std::string& name, int index, const EditResult& r, Samples* verify_time) {
+json verify_edit(const Pipeline& p, const bench::EditGenerator& gen, const std::string& name, int index, const EditResult& r,
+                 Samples* verify_time) {
   std::mt19937_64 rng(bench::edit_seed(name, index));
   const IndexPrescription prescription = gen.next(rng);
   const auto t0 = Clock::now();
@@ -287,9 +298,9 @@ int child_run(const RunOptions& o) {
     // Fewer repetitions on the largest meshes, where one run takes tens of seconds.
     if (r == 0 && p.topology().num_faces > kFewRepsFaces) reps = std::min(reps, 3), edits = std::min(edits, 10);
     log("  " + o.name + (keep ? " rep " : " warm-up ") + std::to_string(r) + ": read " + std::to_string(t_read) + " prepare " +
-        std::to_string(t_prepare) + " s (topology " + std::to_string(pt.topology) + " geometry " + std::to_string(pt.geometry) + " cycles " +
-        std::to_string(pt.cycles) + " field plan " + std::to_string(pt.plan) + " analysis " + std::to_string(pt.analysis) + " set-up " +
-        std::to_string(pt.setup) + (st.analysis_adopted ? "" : ", own analysis") + ")");
+        std::to_string(t_prepare) + " s (topology " + std::to_string(pt.topology) + " geometry " + std::to_string(pt.geometry) +
+        " cycles " + std::to_string(pt.cycles) + " field plan " + std::to_string(pt.plan) + " analysis " + std::to_string(pt.analysis) +
+        " set-up " + std::to_string(pt.setup) + (st.analysis_adopted ? "" : ", own analysis") + ")");
     if (!keep) continue;
     read_ply.add(t_read), topo.add(pt.topology), geom.add(pt.geometry), cyc.add(pt.cycles), plan.add(pt.plan), analysis.add(pt.analysis);
     setup.add(pt.setup), assemble.add(st.assemble), wait.add(st.analysis_wait), factor.add(st.factor), schur.add(st.schur);
@@ -333,12 +344,13 @@ int child_run(const RunOptions& o) {
   result["singularities"] = gen.singularities();
   result["ordering"] = p.designer->solver().ordering();
   result["analysis_concurrent"] = adopted;
-  result["stages"] = json{{"read_ply", read_ply.to_json()}, {"read_obj", read_obj.to_json()}, {"read_ascii", read_ascii.to_json()},
-                          {"topology", topo.to_json()},     {"geometry", geom.to_json()},     {"cycles", cyc.to_json()},
-                          {"plan", plan.to_json()},         {"analysis", analysis.to_json()}, {"setup", setup.to_json()},
+  result["stages"] = json{{"read_ply", read_ply.to_json()}, {"read_obj", read_obj.to_json()},  {"read_ascii", read_ascii.to_json()},
+                          {"topology", topo.to_json()},     {"geometry", geom.to_json()},      {"cycles", cyc.to_json()},
+                          {"plan", plan.to_json()},         {"analysis", analysis.to_json()},  {"setup", setup.to_json()},
                           {"assemble", assemble.to_json()}, {"analysis_wait", wait.to_json()}, {"factor", factor.to_json()},
-                          {"schur", schur.to_json()},       {"prepare", prepare.to_json()},   {"read_to_setup", to_setup.to_json()}};
-  result["edits"] = json{{"solve", solve.to_json()}, {"field", field.to_json()}, {"whole", whole.to_json()}, {"verify", verify_time.to_json()}};
+                          {"schur", schur.to_json()},       {"prepare", prepare.to_json()},    {"read_to_setup", to_setup.to_json()}};
+  result["edits"] =
+      json{{"solve", solve.to_json()}, {"field", field.to_json()}, {"whole", whole.to_json()}, {"verify", verify_time.to_json()}};
   result["status"] = "ok";
   write_json(o.out, result);
   return 0;
@@ -375,8 +387,8 @@ class Watchdog {
         reason = what_ + " abandoned: resident memory " + std::to_string(rss / 1e9) + " GB > limit " + std::to_string(limit_b_ / 1e9) +
                  " GB after " + std::to_string(t) + " s";
       else if (t > limit_s_)
-        reason = what_ + " abandoned: still running after " + std::to_string(limit_s_) + " s (resident memory " + std::to_string(rss / 1e9) +
-                 " GB)";
+        reason = what_ + " abandoned: still running after " + std::to_string(limit_s_) + " s (resident memory " +
+                 std::to_string(rss / 1e9) + " GB)";
       if (!reason.empty()) {
         std::lock_guard<std::mutex> lock(g_partial_mutex);
         g_partial["qr"]["status"] = "aborted";
@@ -429,13 +441,15 @@ int child_qr(const RunOptions& o) {
     qr.reset();
     Watchdog dog(o.qr_time_limit, o.qr_mem_limit_gb * 1e9, "QR set-up");
     auto t0 = Clock::now();
-    qr = std::make_unique<ConnectionSolver>(p.topology(), p.geometry(), p.cycles(), SolverOptions{solver_options(o).weights, SolverKind::QR});
+    qr = std::make_unique<ConnectionSolver>(p.topology(), p.geometry(), p.cycles(),
+                                            SolverOptions{solver_options(o).weights, SolverKind::QR});
     const double t = seconds_since(t0);
     qr_peak = std::max(qr_peak, dog.peak_seen());
     qr_setup.add(t);
     const SetupTimings& st = qr->timings();
     qr_assemble.add(st.assemble), qr_factor.add(st.factor), qr_schur.add(st.schur);
-    log("  " + o.name + " QR set-up rep " + std::to_string(r) + ": " + std::to_string(t) + " s (factor " + std::to_string(st.factor) + " s)");
+    log("  " + o.name + " QR set-up rep " + std::to_string(r) + ": " + std::to_string(t) + " s (factor " + std::to_string(st.factor) +
+        " s)");
     if (t > 20) break;  // one is enough to make the point; more would take minutes
   }
   result["qr"]["setup"] = qr_setup.to_json();
@@ -465,7 +479,8 @@ int child_qr(const RunOptions& o) {
     max_x = std::max(max_x, a.x.cwiseAbs().maxCoeff());
     max_denergy = std::max(max_denergy, std::abs(a.energy - b.connection.energy) / std::max(1e-300, a.energy));
   }
-  log("  " + o.name + ": edit ours " + std::to_string(ours_whole.median() * 1e3) + " ms, QR " + std::to_string(qr_whole.median() * 1e3) + " ms");
+  log("  " + o.name + ": edit ours " + std::to_string(ours_whole.median() * 1e3) + " ms, QR " + std::to_string(qr_whole.median() * 1e3) +
+      " ms");
   result["ours"]["solve"] = ours_solve.to_json();
   result["ours"]["whole"] = ours_whole.to_json();
   result["qr"]["solve"] = qr_solve.to_json();
@@ -553,7 +568,8 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
   std::ostream& out = std::cout;
   out << "### Per mesh (medians; " << o.reps << " runs after " << o.warmup << " warm-up for the stages, " << o.edits << " edits after "
       << o.edit_warmup << " warm-up; above 2M faces at most 3 runs and 10 edits)\n\n";
-  out << "| mesh | faces | read (bin. PLY) | read (OBJ) | topology | geometry | cycles ² | field plan | analysis ² | set-up (assemble / wait / "
+  out << "| mesh | faces | read (bin. PLY) | read (OBJ) | topology | geometry | cycles ² | field plan | analysis ² | set-up (assemble / "
+         "wait / "
          "factor / schur) | prepare (wall) | edit solve | edit field | whole edit | peak RSS |\n";
   out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const json& r : runs) {
@@ -565,9 +581,9 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
     const json& e = r["edits"];
     std::string obj = sec(med(s, "read_obj"));
     if (s["read_ascii"].is_object()) obj += " (ASCII PLY " + sec(med(s, "read_ascii")) + ")";
-    out << "| " << label(r) << " | " << r["mesh"]["faces"].get<long>() << " | " << sec(med(s, "read_ply")) << " | " << obj
-        << " | " << sec(med(s, "topology")) << " | " << sec(med(s, "geometry")) << " | " << sec(med(s, "cycles")) << " | "
-        << sec(med(s, "plan")) << " | " << sec(med(s, "analysis")) << " | " << sec(med(s, "setup")) << " (" << fmt(med(s, "assemble")) << " / "
+    out << "| " << label(r) << " | " << r["mesh"]["faces"].get<long>() << " | " << sec(med(s, "read_ply")) << " | " << obj << " | "
+        << sec(med(s, "topology")) << " | " << sec(med(s, "geometry")) << " | " << sec(med(s, "cycles")) << " | " << sec(med(s, "plan"))
+        << " | " << sec(med(s, "analysis")) << " | " << sec(med(s, "setup")) << " (" << fmt(med(s, "assemble")) << " / "
         << fmt(med(s, "analysis_wait")) << " / " << fmt(med(s, "factor")) << " / " << fmt(med(s, "schur")) << ")"
         << " | " << sec(med(s, "prepare")) << " | " << ms(med(e, "solve")) << " | " << ms(med(e, "field")) << " | " << ms(med(e, "whole"))
         << " | " << gb(r["rss"]["peak"].get<double>()) << " |\n";
@@ -575,12 +591,14 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
   out << "\n² On the second thread, while the first computes the geometry and the field plan (trivcon/design.h); *wait* is the "
          "time the set-up waited for that thread's analysis (ordering and symbolic factorization), and *factor* is the numeric "
          "factorization (with the ordering and symbolic factorization where the analysis was not adopted: "
-      << [&] {
-           std::string own;
-           for (const json& r : runs)
-             if (r.value("status", "") == "ok" && !r.value("analysis_concurrent", true)) own += (own.empty() ? "" : ", ") + r["name"].get<std::string>();
-           return own.empty() ? std::string("none") : own;
-         }()
+      <<
+      [&] {
+        std::string own;
+        for (const json& r : runs)
+          if (r.value("status", "") == "ok" && !r.value("analysis_concurrent", true))
+            own += (own.empty() ? "" : ", ") + r["name"].get<std::string>();
+        return own.empty() ? std::string("none") : own;
+      }()
       << "). *prepare* is the wall time of the whole (less than the sum of the stages).\n";
   for (const json& r : runs)
     if (r.contains("cotan_error"))
@@ -588,19 +606,22 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
           << r["cotan_error"].get<std::string>().substr(7) << "\". Measured with unit weights instead (the same matrix structure, "
           << "except that no edge is dropped for a zero weight).\n";
   out << "\n### Spread (min–max over the same runs; seconds for stages, milliseconds for edits)\n\n";
-  out << "| mesh | read | topology | geometry | cycles | field plan | analysis | set-up | prepare | edit solve (ms) | edit field (ms) | whole edit (ms) |\n";
+  out << "| mesh | read | topology | geometry | cycles | field plan | analysis | set-up | prepare | edit solve (ms) | edit field (ms) | "
+         "whole edit (ms) |\n";
   out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const json& r : runs) {
     if (r.value("status", "") != "ok") continue;
     const json& s = r["stages"];
     const json& e = r["edits"];
-    out << "| " << label(r) << " | " << range_s(s, "read_ply") << " | " << range_s(s, "topology") << " | "
-        << range_s(s, "geometry") << " | " << range_s(s, "cycles") << " | " << range_s(s, "plan") << " | " << range_s(s, "analysis") << " | " << range_s(s, "setup") << " | " << range_s(s, "prepare") << " | "
-        << range_ms(e, "solve") << " | " << range_ms(e, "field") << " | " << range_ms(e, "whole") << " |\n";
+    out << "| " << label(r) << " | " << range_s(s, "read_ply") << " | " << range_s(s, "topology") << " | " << range_s(s, "geometry")
+        << " | " << range_s(s, "cycles") << " | " << range_s(s, "plan") << " | " << range_s(s, "analysis") << " | " << range_s(s, "setup")
+        << " | " << range_s(s, "prepare") << " | " << range_ms(e, "solve") << " | " << range_ms(e, "field") << " | " << range_ms(e, "whole")
+        << " |\n";
   }
   out << "\n### Mesh facts and checks (last edit, verified outside the timings)\n\n";
   out << "| mesh | vertices | components | loops | generators | singularities (N) | max vertex residual | max cycle residual | "
-         "transport mismatch | index mismatches | edges with \\|x\\| ≥ π/N | verify (not in edit) | fill-reducing order | load avg before / after |\n";
+         "transport mismatch | index mismatches | edges with \\|x\\| ≥ π/N | verify (not in edit) | fill-reducing order | load avg before "
+         "/ after |\n";
   out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|\n";
   for (const json& r : runs) {
     if (r.value("status", "") != "ok") continue;
@@ -613,14 +634,15 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
     out << "| " << label(r) << " | " << m["vertices"].get<long>() << " | " << m["components"].get<long>() << " | "
         << m["boundary_loops"].get<long>() << " | " << m["generators"].get<long>() << " | " << r["singularities"].get<int>() << " ("
         << r["N"].get<int>() << ") | " << res[0] << " | " << res[1] << " | " << res[2] << " | " << c["index_mismatch_vertices"].get<int>()
-        << " | " << c.value("large_turn_edges", -1) << " | " << ms(med(r["edits"], "verify")) << " | " << r.value("ordering", std::string("?"))
-        << " | " << fmt(r.value("loadavg_before", NAN), 2) << " / "
+        << " | " << c.value("large_turn_edges", -1) << " | " << ms(med(r["edits"], "verify")) << " | "
+        << r.value("ordering", std::string("?")) << " | " << fmt(r.value("loadavg_before", NAN), 2) << " / "
         << fmt(r.value("loadavg_after", NAN), 2) << " |\n";
   }
 
   if (!qrs.empty()) {
     out << "\n### Ours against the paper-literal QR solver (SolverKind::QR), same process, same edits\n\n";
-    out << "| mesh | faces | set-up ours | set-up QR (factor) | QR / ours | edit ours | edit QR | QR / ours | peak RSS during QR set-up | max. difference of x (rad) |\n";
+    out << "| mesh | faces | set-up ours | set-up QR (factor) | QR / ours | edit ours | edit QR | QR / ours | peak RSS during QR set-up | "
+           "max. difference of x (rad) |\n";
     out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const json& q : qrs) {
       const std::string name = q["name"].get<std::string>();
@@ -631,16 +653,16 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
       const double so = med(q["ours"], "setup");
       const json& Q = q["qr"];
       if (Q["status"] != "ok") {
-        out << "| " << name << " | " << q["mesh"]["faces"].get<long>() << " | " << sec(so) << " | " << Q.value("reason", std::string("")) << " | — | — | — | — | "
-            << gb(Q.value("peak_rss", NAN)) << " | — |\n";
+        out << "| " << name << " | " << q["mesh"]["faces"].get<long>() << " | " << sec(so) << " | " << Q.value("reason", std::string(""))
+            << " | — | — | — | — | " << gb(Q.value("peak_rss", NAN)) << " | — |\n";
         continue;
       }
       const double sq = med(Q, "setup"), eo = med(q["ours"], "whole"), eq = med(Q, "whole");
       char dx[32];
       std::snprintf(dx, 32, "%.1e", q["agreement"]["max_abs_dx"].get<double>());
-      out << "| " << name << " | " << q["mesh"]["faces"].get<long>() << " | " << sec(so) << " | " << sec(sq) << " (" << fmt(med(Q, "factor"))
-          << ", n=" << Q["setup"]["n"].get<int>() << ") | " << fmt(sq / so) << "× | " << ms(eo) << " | " << ms(eq) << " | " << fmt(eq / eo)
-          << "× | " << gb(Q["rss_peak_during_setup"].get<double>()) << " | " << dx << " |\n";
+      out << "| " << name << " | " << q["mesh"]["faces"].get<long>() << " | " << sec(so) << " | " << sec(sq) << " ("
+          << fmt(med(Q, "factor")) << ", n=" << Q["setup"]["n"].get<int>() << ") | " << fmt(sq / so) << "× | " << ms(eo) << " | " << ms(eq)
+          << " | " << fmt(eq / eo) << "× | " << gb(Q["rss_peak_during_setup"].get<double>()) << " | " << dx << " |\n";
     }
   }
 
@@ -655,7 +677,9 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
     for (auto& [fam, list] : families) {
       std::vector<double> x;
       std::string sizes;
-      for (const json* r : list) x.push_back((*r)["mesh"]["faces"].get<double>()), sizes += (sizes.empty() ? "" : ", ") + faces_str((*r)["mesh"]["faces"].get<long>());
+      for (const json* r : list)
+        x.push_back((*r)["mesh"]["faces"].get<double>()),
+            sizes += (sizes.empty() ? "" : ", ") + faces_str((*r)["mesh"]["faces"].get<long>());
       auto slope = [&](const char* group, const char* key) {
         std::vector<double> y;
         for (const json* r : list) y.push_back(med((*r)[group], key));
@@ -664,8 +688,8 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
       std::vector<double> mem;
       for (const json* r : list) mem.push_back((*r)["rss"]["peak"].get<double>());
       out << "| " << fam << " | " << sizes << " | " << slope("stages", "prepare") << " | " << slope("stages", "setup") << " | "
-          << slope("stages", "factor") << " | " << slope("edits", "solve") << " | " << slope("edits", "field") << " | " << slope("edits", "whole")
-          << " | " << fmt(loglog_slope(x, mem), 3) << " |\n";
+          << slope("stages", "factor") << " | " << slope("edits", "solve") << " | " << slope("edits", "field") << " | "
+          << slope("edits", "whole") << " | " << fmt(loglog_slope(x, mem), 3) << " |\n";
     }
   }
 
@@ -725,18 +749,23 @@ int driver(const std::string& cache, const std::string& dragon, const std::strin
     if (quick && k >= 2) break;
     const bool qr = (k == 0 || k == 1) && (k == 0 ? 1e5 : 4e5) <= qr_max_faces;
     entries.push_back({{"sphere-" + cube[k].first, "sphere (cube-like)", "cube:" + std::to_string(cube[k].second), qr},
-                       cube[k].first == "400k" ? "400k" : "", true, ""});
+                       cube[k].first == "400k" ? "400k" : "",
+                       true,
+                       ""});
   }
   for (size_t k = 0; k < torus.size(); ++k) {
     if (quick && k >= 2) break;
     const bool qr = (k == 0 || k == 1) && (k == 0 ? 1e5 : 4e5) <= qr_max_faces;
     entries.push_back({{"torus-" + torus[k].first, "torus",
                         "torus:" + std::to_string(torus[k].second.first) + ":" + std::to_string(torus[k].second.second), qr},
-                       torus[k].first == "400k" ? "400k" : "", true, ""});
+                       torus[k].first == "400k" ? "400k" : "",
+                       true,
+                       ""});
   }
   if (!quick) {
     if (!dragon.empty() && fs::exists(dragon)) {
-      entries.push_back({{"dragon", "", "file:" + fs::weakly_canonical(dragon).string(), false}, "dragon", false, fs::weakly_canonical(dragon).string()});
+      entries.push_back(
+          {{"dragon", "", "file:" + fs::weakly_canonical(dragon).string(), false}, "dragon", false, fs::weakly_canonical(dragon).string()});
       entries.push_back({{"dragon-subdivided", "", "subdiv:" + fs::weakly_canonical(dragon).string(), false}, "3.5M", false, ""});
     } else {
       log("dragon not found (" + dragon + "): skipping the dragon meshes");
@@ -752,9 +781,9 @@ int driver(const std::string& cache, const std::string& dragon, const std::strin
 
   json runs = json::array(), qrs = json::array();
   auto reps_args = [&](const RunOptions& ro) {
-    return std::vector<std::string>{"--warmup", std::to_string(ro.warmup), "--reps", std::to_string(ro.reps), "--edit-warmup",
-                                    std::to_string(ro.edit_warmup), "--edits", std::to_string(ro.edits), "--N", std::to_string(ro.N),
-                                    "--count", std::to_string(ro.count)};
+    return std::vector<std::string>{"--warmup",      std::to_string(ro.warmup),      "--reps",  std::to_string(ro.reps),
+                                    "--edit-warmup", std::to_string(ro.edit_warmup), "--edits", std::to_string(ro.edits),
+                                    "--N",           std::to_string(ro.N),           "--count", std::to_string(ro.count)};
   };
   for (const Entry& e : entries) {
     const std::string stem = cache + "/" + cache_stem(e.mesh.spec);
@@ -809,8 +838,22 @@ int driver(const std::string& cache, const std::string& dragon, const std::strin
     if (e.mesh.qr) {
       const std::string qout = stem + ".qr.json";
       fs::remove(qout, ec);
-      std::vector<std::string> qargs{"--child", "qr", "--name", e.mesh.name, "--ply", ply, "--out", qout, "--weights", weights, "--qr-reps", std::to_string(o.qr_reps),
-                                     "--qr-time-limit", std::to_string(o.qr_time_limit), "--qr-mem-limit-gb", std::to_string(o.qr_mem_limit_gb)};
+      std::vector<std::string> qargs{"--child",
+                                     "qr",
+                                     "--name",
+                                     e.mesh.name,
+                                     "--ply",
+                                     ply,
+                                     "--out",
+                                     qout,
+                                     "--weights",
+                                     weights,
+                                     "--qr-reps",
+                                     std::to_string(o.qr_reps),
+                                     "--qr-time-limit",
+                                     std::to_string(o.qr_time_limit),
+                                     "--qr-mem-limit-gb",
+                                     std::to_string(o.qr_mem_limit_gb)};
       RunOptions qo = o;
       qo.edits = std::min(o.edits, 10), qo.edit_warmup = std::min(o.edit_warmup, 1);
       for (auto& a : reps_args(qo)) qargs.push_back(a);
@@ -857,7 +900,8 @@ int main(int argc, char** argv) {
   app.add_option("--reps", o.reps, "timed pipeline runs per mesh (3 at most above 2M faces)")->capture_default_str();
   app.add_option("--edit-warmup", o.edit_warmup, "discarded edits per mesh")->capture_default_str();
   app.add_option("--edits", o.edits, "timed edits per mesh (10 at most above 2M faces)")->capture_default_str();
-  app.add_option("--weights", o.weights, "cotan | unit (meshes whose cotan weights fail are rerun with unit weights)")->capture_default_str();
+  app.add_option("--weights", o.weights, "cotan | unit (meshes whose cotan weights fail are rerun with unit weights)")
+      ->capture_default_str();
   app.add_option("--N", o.N, "symmetry of the edited field")->capture_default_str();
   app.add_option("--count", o.count, "singularities per edit (adjusted for Gauss-Bonnet, see bench/edits.h)")->capture_default_str();
   app.add_option("--qr-reps", o.qr_reps, "QR set-up runs (1 when the first takes over 20 s)")->capture_default_str();

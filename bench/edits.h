@@ -60,9 +60,8 @@ class EditGenerator {
         continue;
       }
       if (slot.plus + slot.minus > static_cast<int>(interior_[c].size()))
-        throw std::invalid_argument("EditGenerator: component " + std::to_string(c) + " has only " +
-                                    std::to_string(interior_[c].size()) + " interior vertices for " +
-                                    std::to_string(slot.plus + slot.minus) + " singularities");
+        throw std::invalid_argument("EditGenerator: component " + std::to_string(c) + " has only " + std::to_string(interior_[c].size()) +
+                                    " interior vertices for " + std::to_string(slot.plus + slot.minus) + " singularities");
       plan.push_back(slot);
     }
     slots_ = std::move(plan);

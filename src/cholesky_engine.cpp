@@ -90,7 +90,7 @@ class CholeskyEngine : public SolverEngine {
   EdgeRows edge_rows_;
   Eigen::MatrixXd R_CC, R_inv;  // lower triangular; P = R_invᵀ R_inv
   // Sparse forward substitution (see forward_update).
-  std::vector<int> position_;     // factor position of each row of M (the inverse of factor->Perm)
+  std::vector<int> position_;  // factor position of each row of M (the inverse of factor->Perm)
   std::vector<int> super_of_col_, super_parent_;
   Eigen::VectorXd base_b_, base_z_;  // base right-hand side of the vertex rows, and L⁻¹ Π [base_b; 0]
   mutable std::vector<int> super_stamp_;
@@ -181,8 +181,9 @@ class CholeskyEngine : public SolverEngine {
     if (nC > 0) {
       const double min_diag = R_CC.diagonal().minCoeff(), max_diag = R_CC.diagonal().maxCoeff();
       if (!(min_diag > 1e-8 * max_diag))
-        throw Error("the holonomy of the generators, boundary loops or fixed-direction paths is nearly undetermined with these weights "
-                    "(ill-conditioned Schur complement); try --weights unit");
+        throw Error(
+            "the holonomy of the generators, boundary loops or fixed-direction paths is nearly undetermined with these weights "
+            "(ill-conditioned Schur complement); try --weights unit");
       R_inv = R_CC.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(nC, nC));
       P_diagonal_ = R_inv.colwise().squaredNorm().transpose();
     }
@@ -248,7 +249,8 @@ class CholeskyEngine : public SolverEngine {
     ++stamp_;
     std::vector<int> path;
     for (const auto& [k, value] : entries)
-      for (int s = super_of_col_[k]; s != -1 && super_stamp_[s] != stamp_; s = super_parent_[s]) super_stamp_[s] = stamp_, path.push_back(s);
+      for (int s = super_of_col_[k]; s != -1 && super_stamp_[s] != stamp_; s = super_parent_[s])
+        super_stamp_[s] = stamp_, path.push_back(s);
     std::sort(path.begin(), path.end());
     Eigen::VectorXd& d = forward_work_;  // zero outside a call
     if (d.size() != z.size()) d.setZero(z.size());
@@ -362,9 +364,9 @@ class CholeskyEngine : public SolverEngine {
 
 }  // namespace
 
-std::unique_ptr<SolverEngine> make_cholesky_engine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et, const SparseMatrix& Ct,
-                                                   const Eigen::VectorXd& w, Factorization factorization, SetupTimings& timings,
-                                                   const std::function<std::unique_ptr<AnalysisState>()>& analysis) {
+std::unique_ptr<SolverEngine> make_cholesky_engine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et,
+                                                   const SparseMatrix& Ct, const Eigen::VectorXd& w, Factorization factorization,
+                                                   SetupTimings& timings, const std::function<std::unique_ptr<AnalysisState>()>& analysis) {
   return std::make_unique<CholeskyEngine>(ends, num_vertex_rows, Et, Ct, w, factorization, timings, analysis);
 }
 

@@ -41,9 +41,8 @@ std::vector<FixedPath> fixed_face_paths(const Topology& t, const std::vector<int
     const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
     if (region[L] >= 0 && region[R] >= 0 && region[L] != region[R]) links.push_back({usable[e] ? 0 : 1, depth[L] + depth[R] + 1, e});
   }
-  std::sort(links.begin(), links.end(), [](const Link& a, const Link& b) {
-    return std::tie(a.rigid, a.length, a.edge) < std::tie(b.rigid, b.length, b.edge);
-  });
+  std::sort(links.begin(), links.end(),
+            [](const Link& a, const Link& b) { return std::tie(a.rigid, a.length, a.edge) < std::tie(b.rigid, b.length, b.edge); });
   std::vector<int> set(fixed.size());
   std::iota(set.begin(), set.end(), 0);
   auto find = [&](int a) {

@@ -109,7 +109,8 @@ Design FieldDesigner::design(const IndexPrescription& prescription, const std::v
   for (int e = 0; e < topology_.num_edges; ++e) d.large_turn_edges += large(e);
   for (int v : d.index_mismatch_vertices) {
     bool explained = false;
-    for (int a = topology_.vertex_edge_offsets[v]; a < topology_.vertex_edge_offsets[v + 1]; ++a) explained |= large(topology_.vertex_edges[a]);
+    for (int a = topology_.vertex_edge_offsets[v]; a < topology_.vertex_edge_offsets[v + 1]; ++a)
+      explained |= large(topology_.vertex_edges[a]);
     if (!explained) d.unexplained_mismatch_vertices.push_back(v);
   }
   for (auto [f, angle] : prescription.fixed)

@@ -97,7 +97,8 @@ Field propagate_field(const Topology& t, const Geometry& g, const PropagationPla
   return field;
 }
 
-Field propagate_field(const Topology& t, const Geometry& g, const Eigen::VectorXd& x, int N, const std::vector<std::pair<int, double>>& roots) {
+Field propagate_field(const Topology& t, const Geometry& g, const Eigen::VectorXd& x, int N,
+                      const std::vector<std::pair<int, double>>& roots) {
   return propagate_field(t, g, plan_propagation(t), x, N, roots);
 }
 

@@ -61,7 +61,8 @@ std::vector<double> parse_numbers(const TextLines& lines, size_t expected) {
 MatrixX3d read_field_ply(const std::string& path, int num_faces) {
   const std::string bytes = read_file_bytes(path);
   const std::string expected_vertex = "property double x\nproperty double y\nproperty double z\n";
-  const std::string expected_face = "property list uchar int vertex_indices\nproperty double fx\nproperty double fy\nproperty double fz\nend_header\n";
+  const std::string expected_face =
+      "property list uchar int vertex_indices\nproperty double fx\nproperty double fy\nproperty double fz\nend_header\n";
   const size_t header_end = bytes.find("end_header\n");
   if (bytes.compare(0, 4, "ply\n") != 0 || header_end == std::string::npos ||
       bytes.find("format binary_little_endian 1.0\n") == std::string::npos || bytes.find(expected_face) == std::string::npos ||
@@ -124,8 +125,8 @@ void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F
     });
   } else {
     write_file_atomically(path, [&](std::ostream& out) {
-      out << "# trivcon field: per face, the first of N unit directions (x y z, world coordinates)\n# N " << field.N
-          << "\n# faces " << nF << "\n"
+      out << "# trivcon field: per face, the first of N unit directions (x y z, world coordinates)\n# N " << field.N << "\n# faces " << nF
+          << "\n"
           << std::setprecision(17);
       for (int f = 0; f < nF; ++f) {
         const Eigen::Vector3d d = direction_k(g, field, f, 0);
@@ -166,7 +167,8 @@ MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file) {
   }
   TextLines lines(path);
   for (int f = 0; f < num_faces; ++f) {
-    if (!lines.next()) throw Error(path + ": has " + std::to_string(f) + " directions, the mesh has " + std::to_string(num_faces) + " faces");
+    if (!lines.next())
+      throw Error(path + ": has " + std::to_string(f) + " directions, the mesh has " + std::to_string(num_faces) + " faces");
     const std::vector<double> v = parse_numbers(lines, 3);
     d.row(f) << v[0], v[1], v[2];
   }
@@ -207,14 +209,16 @@ Eigen::VectorXd read_connection(const std::string& path, const Topology& t) {
     const std::vector<double> v = parse_numbers(lines, 3);
     const int i = static_cast<int>(v[0]), j = static_cast<int>(v[1]);
     const int e = (v[0] == i && v[1] == j && i < j) ? find_edge(i, j) : -1;
-    if (e < 0 || t.is_boundary_edge(e)) throw Error(lines.where() + ": (" + std::to_string(i) + ", " + std::to_string(j) + ") is not an interior edge with i < j");
+    if (e < 0 || t.is_boundary_edge(e))
+      throw Error(lines.where() + ": (" + std::to_string(i) + ", " + std::to_string(j) + ") is not an interior edge with i < j");
     if (seen[e]) throw Error(lines.where() + ": edge (" + std::to_string(i) + ", " + std::to_string(j) + ") is listed twice");
     seen[e] = 1;
     x(e) = v[2];
   }
   for (int e = 0; e < t.num_edges; ++e)
     if (!t.is_boundary_edge(e) && !seen[e])
-      throw Error(path + ": interior edge (" + std::to_string(t.edge_vertices(e, 0)) + ", " + std::to_string(t.edge_vertices(e, 1)) + ") is missing");
+      throw Error(path + ": interior edge (" + std::to_string(t.edge_vertices(e, 0)) + ", " + std::to_string(t.edge_vertices(e, 1)) +
+                  ") is missing");
   return x;
 }
 

@@ -36,16 +36,15 @@ std::string to_text(const T& value) {
 template <class T>
 void require(bool ok, const char* function, const char* name, const T& value, const std::string& condition) {
   if (!ok) {
-    throw Error(std::string(function) + ": invalid " + name + " = " + to_text(value) + " (need " +
-                condition + ")");
+    throw Error(std::string(function) + ": invalid " + name + " = " + to_text(value) + " (need " + condition + ")");
   }
 }
 
 // Counts are computed in double by the callers so that absurd parameters cannot overflow first.
 void require_size(const char* function, double vertices, double faces) {
   if (vertices > kMaxElements || faces > kMaxElements) {
-    throw Error(std::string(function) + ": parameters give " + to_text(vertices) + " vertices and " +
-                to_text(faces) + " faces, more than the supported " + to_text(kMaxElements));
+    throw Error(std::string(function) + ": parameters give " + to_text(vertices) + " vertices and " + to_text(faces) +
+                " faces, more than the supported " + to_text(kMaxElements));
   }
 }
 
@@ -55,8 +54,8 @@ void require_valid_faces(const char* function, const Mesh& mesh) {
     for (int k = 0; k < 3; ++k) {
       const int v = mesh.F(f, k);
       if (v < 0 || v >= num_vertices) {
-        throw Error(std::string(function) + ": vertex index " + to_text(v) + " out of range in face " +
-                    to_text(f) + " (mesh has " + to_text(num_vertices) + " vertices)");
+        throw Error(std::string(function) + ": vertex index " + to_text(v) + " out of range in face " + to_text(f) + " (mesh has " +
+                    to_text(num_vertices) + " vertices)");
       }
     }
   }
@@ -137,8 +136,7 @@ using Lattice = std::array<int, 3>;
 // its positive or negative side, as a size×size grid oriented outward. `id(lattice point)` returns
 // (creating if needed) the vertex there; `ids` is scratch space reused between calls.
 template <class LatticeId>
-void add_box_face(MeshBuilder& out, const Lattice& corner, int size, int axis, bool positive,
-                  LatticeId& id, std::vector<int>& ids) {
+void add_box_face(MeshBuilder& out, const Lattice& corner, int size, int axis, bool positive, LatticeId& id, std::vector<int>& ids) {
   // (u, v, axis) is right-handed, so u × v = +axis; swapping u and v turns the face to −axis.
   int u = (axis + 1) % 3, v = (axis + 2) % 3;
   if (!positive) std::swap(u, v);
@@ -248,14 +246,12 @@ Mesh make_icosphere(int level) {
   require(level >= 0, "make_icosphere", "level", level, "level >= 0");
   require_size("make_icosphere", 10 * std::pow(4.0, level) + 2, 20 * std::pow(4.0, level));
   const double t = (1 + std::sqrt(5.0)) / 2;
-  const double corners[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
-                                 {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
-                                 {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  const double corners[12][3] = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   // Counter-clockwise seen from outside.
-  const int faces[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                            {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                            {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                            {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  const int faces[20][3] = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                            {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                            {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   MeshBuilder builder(12, 20);
   for (const auto& c : corners) builder.add_vertex(c[0], c[1], c[2]);
   for (const auto& f : faces) builder.add_triangle(f[0], f[1], f[2]);
@@ -359,8 +355,8 @@ Mesh make_genus_surface(int g, int resolution) {
   vertex_at.reserve(static_cast<size_t>(expected_vertices));
   const double step = 1.0 / (3.0 * resolution);  // voxel edge 1/3
   auto id = [&](const Lattice& p) {
-    const std::uint64_t key = static_cast<std::uint64_t>(p[0]) | static_cast<std::uint64_t>(p[1]) << 21 |
-                              static_cast<std::uint64_t>(p[2]) << 42;
+    const std::uint64_t key =
+        static_cast<std::uint64_t>(p[0]) | static_cast<std::uint64_t>(p[1]) << 21 | static_cast<std::uint64_t>(p[2]) << 42;
     const auto [it, inserted] = vertex_at.try_emplace(key, builder.num_vertices());
     if (inserted) {
       builder.add_vertex(p[0] * step - nx / 6.0, p[1] * step - ny / 6.0, p[2] * step - nz / 6.0);
@@ -412,8 +408,8 @@ Mesh make_disk(int rings, int segments) {
     // one on ties), each step making one counter-clockwise triangle.
     int i = 0, o = 0;
     while (i < inner_count || o < outer_count) {
-      const bool step_outer = i == inner_count ||
-                              (o < outer_count && std::int64_t(o + 1) * inner_count <= std::int64_t(i + 1) * outer_count);
+      const bool step_outer =
+          i == inner_count || (o < outer_count && std::int64_t(o + 1) * inner_count <= std::int64_t(i + 1) * outer_count);
       const int a = inner + i % inner_count, b = outer + o % outer_count;
       if (step_outer) {
         ++o;
@@ -450,9 +446,8 @@ Mesh make_holed_grid(int n, int holes) {
   require(n >= 1, "make_holed_grid", "n", n, "n >= 1");
   require(holes >= 0, "make_holed_grid", "holes", holes, "holes >= 0");
   if (n < 2 * double(holes) + 1) {
-    throw Error("make_holed_grid: n = " + to_text(n) + " is too small for " + to_text(holes) +
-                " holes (need n >= 2·holes + 1 = " + to_text(2 * double(holes) + 1) +
-                " so that holes are at least one cell apart and away from the border)");
+    throw Error("make_holed_grid: n = " + to_text(n) + " is too small for " + to_text(holes) + " holes (need n >= 2·holes + 1 = " +
+                to_text(2 * double(holes) + 1) + " so that holes are at least one cell apart and away from the border)");
   }
   require_size("make_holed_grid", (n + 1.0) * (n + 1.0), 2.0 * n * n);
   // Hole t: cells [start_t, start_t + w) in x with start_t = ⌊(2t+1)·n/(2·holes+1)⌋, and a centred

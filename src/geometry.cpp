@@ -33,16 +33,14 @@ Eigen::Vector3d corner_angles_of(const Eigen::Vector3d p[3]) {
 }  // namespace
 
 double wrap_angle(double a) {
-  if (a > -kPi && a <= kPi) return a;  // the usual case, exact
+  if (a > -kPi && a <= kPi) return a;                      // the usual case, exact
   a -= 2 * kPi * std::floor((a + kPi) * (1 / (2 * kPi)));  // floor, not fmod: several times faster
   if (a <= -kPi) a += 2 * kPi;
   if (a > kPi) a -= 2 * kPi;
   return a;
 }
 
-double Geometry::angle_in_face(int f, const Eigen::Vector3d& d) const {
-  return std::atan2(d.dot(frame_y.row(f)), d.dot(frame_x.row(f)));
-}
+double Geometry::angle_in_face(int f, const Eigen::Vector3d& d) const { return std::atan2(d.dot(frame_y.row(f)), d.dot(frame_x.row(f))); }
 
 Eigen::Vector3d Geometry::direction_in_face(int f, double beta) const {
   return std::cos(beta) * frame_x.row(f).transpose() + std::sin(beta) * frame_y.row(f).transpose();
@@ -73,8 +71,8 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
     raw_normal[f] = n;
     const double longest2 = std::max({(p[1] - p[0]).squaredNorm(), (p[2] - p[1]).squaredNorm(), (p[0] - p[2]).squaredNorm()});
     const double area = 0.5 * n.norm();
-    const bool degenerate = !(area > kDegenerateArea * longest2) || (p[1] - p[0]).squaredNorm() == 0 ||
-                            (p[2] - p[1]).squaredNorm() == 0 || (p[0] - p[2]).squaredNorm() == 0;
+    const bool degenerate = !(area > kDegenerateArea * longest2) || (p[1] - p[0]).squaredNorm() == 0 || (p[2] - p[1]).squaredNorm() == 0 ||
+                            (p[0] - p[2]).squaredNorm() == 0;
     g.degenerate_face[f] = degenerate;
     degenerate_faces += degenerate;
     zero_area_faces += n.squaredNorm() == 0;

@@ -34,8 +34,7 @@ std::string gunzip(const std::string& compressed, const std::string& path) {
     in_pos += in_chunk - stream.avail_in;
     out_pos += out_chunk - stream.avail_out;
     if (status == Z_STREAM_END) {
-      const bool only_padding = std::all_of(compressed.begin() + in_pos, compressed.end(),
-                                            [](char c) { return c == '\0'; });
+      const bool only_padding = std::all_of(compressed.begin() + in_pos, compressed.end(), [](char c) { return c == '\0'; });
       if (only_padding) break;
       inflateReset(&stream);  // another member follows
     } else if (status == Z_BUF_ERROR || status == Z_OK) {

@@ -26,8 +26,7 @@ bool parse_long(const std::string& s, long long& value) {
 
 int parse_id(const std::string& text, const std::string& what, const std::string& where) {
   long long id;
-  if (!parse_long(trim(text), id) || id < 0 || id > 2147483647LL)
-    throw Error(where + ": malformed " + what + " id '" + trim(text) + "'");
+  if (!parse_long(trim(text), id) || id < 0 || id > 2147483647LL) throw Error(where + ": malformed " + what + " id '" + trim(text) + "'");
   return static_cast<int>(id);
 }
 
@@ -48,8 +47,8 @@ int parse_index(const std::string& text_in, int N, const std::string& where) {
   const std::string text = trim(text_in);
   const size_t slash = text.find('/');
   long long p, q = 1;
-  const bool ok = slash == std::string::npos ? parse_long(text, p)
-                                             : parse_long(text.substr(0, slash), p) && parse_long(text.substr(slash + 1), q);
+  const bool ok =
+      slash == std::string::npos ? parse_long(text, p) : parse_long(text.substr(0, slash), p) && parse_long(text.substr(slash + 1), q);
   if (!ok || q <= 0) throw Error(where + ": malformed index '" + text + "' (expected an integer or a fraction p/q, q > 0)");
   if (std::llabs(p) > 1000000000LL || q > 1000000000LL) throw Error(where + ": index '" + text + "' is too large");
   // n = p N / q must be an integer.

@@ -62,6 +62,4 @@ Eigen::VectorXi nearest_lattice_point(const SolverEngine& engine, const Eigen::V
   return t;
 }
 
-
-
 }  // namespace trivcon::detail

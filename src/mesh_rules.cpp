@@ -7,20 +7,21 @@
 namespace trivcon::detail {
 
 std::string out_of_range_message(long long index, long long vertex_count) {
-  return "face index " + std::to_string(index) + " out of range (file has " +
-         std::to_string(vertex_count) + " vertices)";
+  return "face index " + std::to_string(index) + " out of range (file has " + std::to_string(vertex_count) + " vertices)";
 }
 
 std::string non_finite_message(long long vertex, double value) {
   return "non-finite coordinate in vertex " + std::to_string(vertex) + " (" +
-         (std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf") + ")";
+         (std::isnan(value) ? "nan"
+          : value > 0       ? "inf"
+                            : "-inf") +
+         ")";
 }
 
 std::string polygon_problem(const std::vector<int>& corners, long long face) {
   const std::size_t k = corners.size();
   if (k < 3) {
-    return "face " + std::to_string(face) + " has " + std::to_string(k) + " corner" + (k == 1 ? "" : "s") +
-           " (at least 3 needed)";
+    return "face " + std::to_string(face) + " has " + std::to_string(k) + " corner" + (k == 1 ? "" : "s") + " (at least 3 needed)";
   }
   bool repeated = false;
   if (k <= 16) {  // the common case: no allocation

@@ -66,8 +66,8 @@ class QREngine : public SolverEngine {
     qr = SuiteSparseQR_factorize<double>(SPQR_ORDERING_DEFAULT, SPQR_DEFAULT_TOL, &A, &cc());
     if (!qr || cc().status != CHOLMOD_OK) throw Error("SuiteSparseQR could not factor the constraint matrix");
     if (cc().SPQR_istat[4] < nD + nC)
-      throw Error("the constraint matrix is rank deficient (rank " + std::to_string(cc().SPQR_istat[4]) + " of " +
-                  std::to_string(nD + nC) + "); try --weights unit");
+      throw Error("the constraint matrix is rank deficient (rank " + std::to_string(cc().SPQR_istat[4]) + " of " + std::to_string(nD + nC) +
+                  "); try --weights unit");
     timings.factor += seconds_since(t0);
     t0 = Clock::now();
     responses.resize(m, nC);
@@ -112,7 +112,8 @@ class QREngine : public SolverEngine {
 
 }  // namespace
 
-std::unique_ptr<SolverEngine> make_qr_engine(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w, SetupTimings& timings) {
+std::unique_ptr<SolverEngine> make_qr_engine(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w,
+                                             SetupTimings& timings) {
   return std::make_unique<QREngine>(Dt, Ct, w, timings);
 }
 

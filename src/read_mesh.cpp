@@ -55,8 +55,7 @@ MeshData read_mesh(const std::string& path) {
   if (ends_with_ignoring_case(stem, ".obj")) return read_obj(read_file_bytes(path), path);
   if (ends_with_ignoring_case(stem, ".off")) return read_off(read_file_bytes(path), path);
   if (ends_with_ignoring_case(stem, ".ply")) return read_ply(read_file_bytes(path), path);
-  throw Error("cannot read '" + path +
-              "': unknown mesh format (supported: .obj, .off, .ply, each optionally followed by .gz)");
+  throw Error("cannot read '" + path + "': unknown mesh format (supported: .obj, .off, .ply, each optionally followed by .gz)");
 }
 
 }  // namespace trivcon

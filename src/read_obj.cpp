@@ -60,8 +60,7 @@ MeshData read_obj(const std::string& buffer, const std::string& name) {
         } else if (index < 0) {  // relative: -1 is the last vertex defined so far
           id = vertex_count + index;
           if (id < 0) {
-            in.fail("face index " + std::to_string(index) + " out of range (" + std::to_string(vertex_count) +
-                    " vertices defined so far)");
+            in.fail("face index " + std::to_string(index) + " out of range (" + std::to_string(vertex_count) + " vertices defined so far)");
           }
         } else {
           in.fail("face index 0 is invalid (OBJ indices start at 1)");

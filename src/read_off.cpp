@@ -50,8 +50,8 @@ MeshData read_off(const std::string& buffer, const std::string& name) {
   const unsigned long long bytes_left = in.bytes_left() + 1;  // the last line may lack its newline
   const auto check_count = [&](long long count, unsigned long long min_bytes, const char* what) {
     if (static_cast<unsigned long long>(count) > bytes_left / min_bytes) {
-      in.fail("header announces " + std::to_string(count) + " " + what + " but the file has only " +
-              std::to_string(buffer.size()) + " bytes (truncated file?)");
+      in.fail("header announces " + std::to_string(count) + " " + what + " but the file has only " + std::to_string(buffer.size()) +
+              " bytes (truncated file?)");
     }
   };
   check_count(vertex_count, 6, "vertices");
@@ -88,8 +88,7 @@ MeshData read_off(const std::string& buffer, const std::string& name) {
     corners.clear();
     for (long long c = 0; c < corner_count; ++c) {  // a bogus count runs out of tokens, no allocation
       if (!in.next_token(token)) {
-        in.fail("face " + std::to_string(f) + " announces " + std::to_string(corner_count) + " corners but lists " +
-                std::to_string(c));
+        in.fail("face " + std::to_string(f) + " announces " + std::to_string(corner_count) + " corners but lists " + std::to_string(c));
       }
       const long long index = in.integer(token);
       if (index < 0 || index >= vertex_count) in.fail(out_of_range_message(index, vertex_count));

@@ -29,9 +29,8 @@ bool parse_ply_type(std::string_view name, PlyType& type) {
     PlyType type;
   };
   static const Entry kTypes[] = {
-      {"char", "int8", PlyType::kInt8},        {"uchar", "uint8", PlyType::kUInt8},
-      {"short", "int16", PlyType::kInt16},     {"ushort", "uint16", PlyType::kUInt16},
-      {"int", "int32", PlyType::kInt32},       {"uint", "uint32", PlyType::kUInt32},
+      {"char", "int8", PlyType::kInt8},        {"uchar", "uint8", PlyType::kUInt8},      {"short", "int16", PlyType::kInt16},
+      {"ushort", "uint16", PlyType::kUInt16},  {"int", "int32", PlyType::kInt32},        {"uint", "uint32", PlyType::kUInt32},
       {"float", "float32", PlyType::kFloat32}, {"double", "float64", PlyType::kFloat64},
   };
   for (const Entry& entry : kTypes) {
@@ -45,10 +44,18 @@ bool parse_ply_type(std::string_view name, PlyType& type) {
 
 std::size_t ply_type_size(PlyType type) {
   switch (type) {
-    case PlyType::kInt8: case PlyType::kUInt8: return 1;
-    case PlyType::kInt16: case PlyType::kUInt16: return 2;
-    case PlyType::kInt32: case PlyType::kUInt32: case PlyType::kFloat32: return 4;
-    case PlyType::kFloat64: return 8;
+    case PlyType::kInt8:
+    case PlyType::kUInt8:
+      return 1;
+    case PlyType::kInt16:
+    case PlyType::kUInt16:
+      return 2;
+    case PlyType::kInt32:
+    case PlyType::kUInt32:
+    case PlyType::kFloat32:
+      return 4;
+    case PlyType::kFloat64:
+      return 8;
   }
   return 0;
 }
@@ -58,8 +65,8 @@ bool is_integer_type(PlyType type) { return type != PlyType::kFloat32 && type !=
 struct PlyProperty {
   std::string name;
   bool is_list = false;
-  PlyType type = PlyType::kFloat32;        // the value type (list items for a list)
-  PlyType count_type = PlyType::kUInt8;    // lists only
+  PlyType type = PlyType::kFloat32;      // the value type (list items for a list)
+  PlyType count_type = PlyType::kUInt8;  // lists only
 };
 
 struct PlyElement {
@@ -88,8 +95,8 @@ class PlyAsciiSource {
     element_ = &element;
     index_ = index;
     if (!in_.next_content_line()) {
-      in_.fail("file ends after " + std::to_string(index) + " of " + std::to_string(element.count) +
-               " '" + element.name + "' elements (truncated?)");
+      in_.fail("file ends after " + std::to_string(index) + " of " + std::to_string(element.count) + " '" + element.name +
+               "' elements (truncated?)");
     }
   }
   void end() {
@@ -136,21 +143,31 @@ class PlyBinarySource {
 
   double read_double(PlyType type) {
     switch (type) {
-      case PlyType::kFloat32: return bit_cast_from<float>(load<std::uint32_t>());
-      case PlyType::kFloat64: return bit_cast_from<double>(load<std::uint64_t>());
-      default: return static_cast<double>(read_integer(type));
+      case PlyType::kFloat32:
+        return bit_cast_from<float>(load<std::uint32_t>());
+      case PlyType::kFloat64:
+        return bit_cast_from<double>(load<std::uint64_t>());
+      default:
+        return static_cast<double>(read_integer(type));
     }
   }
 
   long long read_integer(PlyType type) {
     switch (type) {
-      case PlyType::kInt8: return static_cast<std::int8_t>(load<std::uint8_t>());
-      case PlyType::kUInt8: return load<std::uint8_t>();
-      case PlyType::kInt16: return static_cast<std::int16_t>(load<std::uint16_t>());
-      case PlyType::kUInt16: return load<std::uint16_t>();
-      case PlyType::kInt32: return static_cast<std::int32_t>(load<std::uint32_t>());
-      case PlyType::kUInt32: return load<std::uint32_t>();
-      default: return 0;  // the header check allows only integer types here
+      case PlyType::kInt8:
+        return static_cast<std::int8_t>(load<std::uint8_t>());
+      case PlyType::kUInt8:
+        return load<std::uint8_t>();
+      case PlyType::kInt16:
+        return static_cast<std::int16_t>(load<std::uint16_t>());
+      case PlyType::kUInt16:
+        return load<std::uint16_t>();
+      case PlyType::kInt32:
+        return static_cast<std::int32_t>(load<std::uint32_t>());
+      case PlyType::kUInt32:
+        return load<std::uint32_t>();
+      default:
+        return 0;  // the header check allows only integer types here
     }
   }
 
@@ -162,9 +179,7 @@ class PlyBinarySource {
     pos_ += static_cast<std::size_t>(count) * item;
   }
 
-  [[noreturn]] void fail(const std::string& message) const {
-    detail::fail(name_, message + " (at byte " + std::to_string(start_) + ")");
-  }
+  [[noreturn]] void fail(const std::string& message) const { detail::fail(name_, message + " (at byte " + std::to_string(start_) + ")"); }
   std::string where() const { return element_->name + " " + std::to_string(index_); }
 
  private:
@@ -203,8 +218,8 @@ class PlyBinarySource {
   }
 
   [[noreturn]] void truncated() const {
-    detail::fail(name_, "truncated binary data at byte " + std::to_string(pos_) + " (" + element_->name +
-                            " " + std::to_string(index_) + " of " + std::to_string(element_->count) + ")");
+    detail::fail(name_, "truncated binary data at byte " + std::to_string(pos_) + " (" + element_->name + " " + std::to_string(index_) +
+                            " of " + std::to_string(element_->count) + ")");
   }
 
   const unsigned char* data_;
@@ -219,8 +234,7 @@ class PlyBinarySource {
 
 // One loop over all elements for both encodings; `Source` hides how values are stored.
 template <class Source>
-void read_ply_body(Source& source, const std::vector<PlyElement>& elements, const PlyLayout& layout,
-                   MeshData& mesh, FaceCollector& faces) {
+void read_ply_body(Source& source, const std::vector<PlyElement>& elements, const PlyLayout& layout, MeshData& mesh, FaceCollector& faces) {
   const long long vertex_count = mesh.V.rows();
   std::vector<int> corners;
   for (std::size_t e = 0; e < elements.size(); ++e) {
@@ -384,22 +398,20 @@ MeshData read_ply(const std::string& buffer, const std::string& name) {
     for (std::size_t p = 0; p < element.properties.size(); ++p) {
       const PlyProperty& property = element.properties[p];
       const unsigned long long items = e == layout.face_element && p == layout.index_property ? 3 : 0;
-      minimum += ascii ? 2 * (1 + items)
-                       : property.is_list ? ply_type_size(property.count_type) + items * ply_type_size(property.type)
-                                          : ply_type_size(property.type);
+      minimum += ascii              ? 2 * (1 + items)
+                 : property.is_list ? ply_type_size(property.count_type) + items * ply_type_size(property.type)
+                                    : ply_type_size(property.type);
     }
     if (minimum == 0) fail_at_line(name, element.line, "element '" + element.name + "' has no properties");
     if (element.count > data_bytes / minimum) {
-      fail_at_line(name, element.line, "header announces " + std::to_string(element.count) + " '" + element.name +
-                                           "' elements but the file has only " +
-                                           std::to_string(buffer.size() - data_offset) +
-                                           " bytes after the header (truncated file?)");
+      fail_at_line(name, element.line,
+                   "header announces " + std::to_string(element.count) + " '" + element.name + "' elements but the file has only " +
+                       std::to_string(buffer.size() - data_offset) + " bytes after the header (truncated file?)");
     }
   }
   if (vertex_element.count > static_cast<unsigned long long>(kMaxCount) ||
       face_element.count > static_cast<unsigned long long>(kMaxCount)) {
-    fail(name, "too many vertices or faces (" + std::to_string(vertex_element.count) + ", " +
-                   std::to_string(face_element.count) + ")");
+    fail(name, "too many vertices or faces (" + std::to_string(vertex_element.count) + ", " + std::to_string(face_element.count) + ")");
   }
 
   MeshData mesh;

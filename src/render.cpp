@@ -51,7 +51,7 @@ namespace {
 constexpr double kReferencePixels = 900;  // sizes in RenderOptions and below are for a 900-pixel image side
 constexpr double kMargin = 0.04;          // fraction of the image left free on each side
 constexpr double kHalfFieldOfView = 12 * kPi / 180;
-constexpr double kGlyphLength = 0.4;      // hedgehog spoke length / glyph spacing
+constexpr double kGlyphLength = 0.4;  // hedgehog spoke length / glyph spacing
 
 using Vector3d = Eigen::Vector3d;
 
@@ -59,10 +59,14 @@ Vector3d vertex(const MatrixX3d& V, int v) { return V.row(v).transpose(); }
 
 Vector3d axis(char name) {
   switch (name) {
-    case 'x': return Vector3d::UnitX();
-    case 'y': return Vector3d::UnitY();
-    case 'z': return Vector3d::UnitZ();
-    default: throw Error(std::string("render: up axis must be x, y or z, not '") + name + "'");
+    case 'x':
+      return Vector3d::UnitX();
+    case 'y':
+      return Vector3d::UnitY();
+    case 'z':
+      return Vector3d::UnitZ();
+    default:
+      throw Error(std::string("render: up axis must be x, y or z, not '") + name + "'");
   }
 }
 
@@ -103,7 +107,10 @@ Rgb scaled(const Rgb& c, double intensity) {
 // The supersampled picture: colour and inverse depth (1/depth, 0 where nothing was drawn) per sample.
 struct Canvas {
   Canvas(int pixels_x, int pixels_y, int ss, const Rgb& background)
-      : width(pixels_x * ss), height(pixels_y * ss), ss(ss), rgb(3 * static_cast<size_t>(width) * height),
+      : width(pixels_x * ss),
+        height(pixels_y * ss),
+        ss(ss),
+        rgb(3 * static_cast<size_t>(width) * height),
         inverse_depth(static_cast<size_t>(width) * height, 0.0f) {
     for (size_t i = 0; i < inverse_depth.size(); ++i) set(i, background);
   }
@@ -151,7 +158,12 @@ struct ScreenPoint {
 class Renderer {
  public:
   Renderer(const MatrixX3d& V, const Topology& t, const Geometry& g, const Field& field, const RenderOptions& o)
-      : V_(V), t_(t), g_(g), field_(field), o_(o), camera_(fit_camera(V, t, o)),
+      : V_(V),
+        t_(t),
+        g_(g),
+        field_(field),
+        o_(o),
+        camera_(fit_camera(V, t, o)),
         canvas_(o.width, o.height, o.supersampling, o.palette.background),
         scale_(std::min(o.width, o.height) / kReferencePixels * o.supersampling),
         mean_edge_(mean_edge_length(V, t)) {
@@ -181,9 +193,7 @@ class Renderer {
 
   // How far toward the viewer lines are moved before the depth test (world units at `depth`): a couple of
   // pixels, plus a little of the edge length for glyphs that leave their (flat) face.
-  double depth_offset(double depth, double pixels) const {
-    return pixels * camera_.pixel_size(depth) + 0.1 * mean_edge_;
-  }
+  double depth_offset(double depth, double pixels) const { return pixels * camera_.pixel_size(depth) + 0.1 * mean_edge_; }
 
   // Light intensity of a unit normal facing the viewer: ambient + Lambert from above-left of the camera.
   double intensity(const Vector3d& n) const {
@@ -267,7 +277,8 @@ class Renderer {
     const ScreenPoint a = to_screen(p), b = to_screen(q);
     if (!(a.inverse_depth > 0 && b.inverse_depth > 0)) return;  // behind the eye (cannot happen for a fitted view)
     // At least about a pixel wide, so that small pictures still show every line.
-    const double r0 = std::max(w0 * scale_, 0.5 * o_.supersampling), r1 = std::max(w1 * scale_, 0.5 * o_.supersampling), r = std::max(r0, r1);
+    const double r0 = std::max(w0 * scale_, 0.5 * o_.supersampling), r1 = std::max(w1 * scale_, 0.5 * o_.supersampling),
+                 r = std::max(r0, r1);
     const double dx = b.x - a.x, dy = b.y - a.y, length2 = dx * dx + dy * dy;
     const double offset_pixels = 1.5 + 2 * std::max(w0, w1);
     canvas_.for_samples(std::min(a.x, b.x) - r, std::min(a.y, b.y) - r, std::max(a.x, b.x) + r, std::max(a.y, b.y) + r,
@@ -344,8 +355,10 @@ class Renderer {
     const double outline = radius + 1.5 * scale_;
     canvas_.for_samples(cx - outline, cy - outline, cx + outline, cy + outline, [&](size_t i, double x, double y) {
       const double d2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
-      if (d2 <= radius * radius) canvas_.set(i, fill);
-      else if (d2 <= outline * outline) canvas_.set(i, o_.palette.text);
+      if (d2 <= radius * radius)
+        canvas_.set(i, fill);
+      else if (d2 <= outline * outline)
+        canvas_.set(i, o_.palette.text);
     });
   }
 
@@ -398,8 +411,12 @@ class Renderer {
     for (auto [v, n] : singularities)
       if (n != 0) ++count[n];
     const int N = field_.N;
-    std::vector<LegendRow> rows{
-        {LegendRow::None, 0, "N = " + std::to_string(N) + (N == 1 ? " (vectors)" : N == 2 ? " (lines)" : N == 4 ? " (crosses)" : "")}};
+    std::vector<LegendRow> rows{{LegendRow::None, 0,
+                                 "N = " + std::to_string(N) +
+                                     (N == 1   ? " (vectors)"
+                                      : N == 2 ? " (lines)"
+                                      : N == 4 ? " (crosses)"
+                                               : "")}};
     for (auto [n, vertices] : count)
       rows.push_back({LegendRow::Disc, n,
                       "index " + std::string(n > 0 ? "+" : "") + format_index(n, N) + ":  " + std::to_string(vertices) +
@@ -425,7 +442,8 @@ class Renderer {
     const double box_width = key + text_width + 16 * scale_, box_height = line * rows.size() + 10 * scale_;
     double best_x = pad, best_y = canvas_.height - pad - box_height;
     long best = covered(best_x, best_y, best_x + box_width, best_y + box_height);
-    for (auto [x, y] : {std::pair{canvas_.width - pad - box_width, canvas_.height - pad - box_height}, {pad, pad},
+    for (auto [x, y] : {std::pair{canvas_.width - pad - box_width, canvas_.height - pad - box_height},
+                        {pad, pad},
                         {canvas_.width - pad - box_width, pad}}) {
       const long c = covered(x, y, x + box_width, y + box_height);
       if (c < best) best = c, best_x = x, best_y = y;
@@ -453,7 +471,7 @@ class Renderer {
   const RenderOptions& o_;
   const Camera camera_;
   Canvas canvas_;
-  const double scale_;       // samples per reference pixel
+  const double scale_;  // samples per reference pixel
   const double mean_edge_;
   std::vector<ScreenPoint> screen_;  // projected vertices
 };
@@ -562,7 +580,9 @@ void write_png(const std::string& path, const Image& image) {
   std::string best;
   for (int filter : {-1, 0}) {
     std::string png;
-    auto append = [](void* context, void* data, int size) { static_cast<std::string*>(context)->append(static_cast<const char*>(data), size); };
+    auto append = [](void* context, void* data, int size) {
+      static_cast<std::string*>(context)->append(static_cast<const char*>(data), size);
+    };
     std::lock_guard<std::mutex> lock(encoder);
     stbi_write_force_png_filter = filter;
     if (!stbi_write_png_to_func(append, &png, image.width, image.height, 3, image.rgb.data(), 3 * image.width))

@@ -87,7 +87,9 @@ struct ConnectionSolver::Impl {
   int num_generators() const { return static_cast<int>(cycles.generators.size()); }
   const DualCycle& cycle_of_row(int r) const {
     const Row& row = rows[r];
-    return row.kind == RowKind::Loop ? cycles.loops[row.id] : row.kind == RowKind::Generator ? cycles.generators[row.id] : paths[row.id].path;
+    return row.kind == RowKind::Loop        ? cycles.loops[row.id]
+           : row.kind == RowKind::Generator ? cycles.generators[row.id]
+                                            : paths[row.id].path;
   }
   int component_of_row(int r) const {
     const Row& row = rows[r];
@@ -326,8 +328,9 @@ struct ConnectionSolver::Impl::CycleRhs {
 void ConnectionSolver::Impl::check_fixed_angles(const IndexPrescription& prescription) const {
   if (prescription.fixed.size() != fixed_faces.size() ||
       !std::equal(fixed_faces.begin(), fixed_faces.end(), prescription.fixed.begin(), [](int f, const auto& kv) { return f == kv.first; }))
-    throw Error("the fixed faces of the prescription (" + std::to_string(prescription.fixed.size()) + ") are not those the solver was set up with (" +
-                std::to_string(fixed_faces.size()) + "): fixing other faces changes the matrix, set up a new solver");
+    throw Error("the fixed faces of the prescription (" + std::to_string(prescription.fixed.size()) +
+                ") are not those the solver was set up with (" + std::to_string(fixed_faces.size()) +
+                "): fixing other faces changes the matrix, set up a new solver");
   for (auto [f, angle] : prescription.fixed)
     if (!std::isfinite(angle)) throw Error("fixed angle of face " + std::to_string(f) + " is not finite");
 }
@@ -368,8 +371,10 @@ ConnectionSolver::Impl::CycleRhs ConnectionSolver::Impl::cycle_rhs(const IndexPr
       c.H(r) = path_target(row.id, prescription);
     }
     auto it = given ? given->find(row.id) : prescription.loop.end();
-    if (given && it != given->end()) c.n0(r) = it->second;
-    else free_rows.push_back(r);
+    if (given && it != given->end())
+      c.n0(r) = it->second;
+    else
+      free_rows.push_back(r);
   }
   std::vector<int> pivot_of_component(t.components.size(), -1);
   for (size_t k = 0; k < t.components.size(); ++k) {
@@ -378,8 +383,10 @@ ConnectionSolver::Impl::CycleRhs ConnectionSolver::Impl::cycle_rhs(const IndexPr
     int sum = prescription.N * t.components[k].euler_characteristic - c.component_vertex_sum[k] - prescription.loop.at(dl);
     for (int l : t.components[k].boundary_loops) {
       if (l == dl) continue;
-      if (!prescription.loop.count(l) && pivot_of_component[k] < 0) pivot_of_component[k] = loop_row_of[l];
-      else if (prescription.loop.count(l)) sum -= prescription.loop.at(l);
+      if (!prescription.loop.count(l) && pivot_of_component[k] < 0)
+        pivot_of_component[k] = loop_row_of[l];
+      else if (prescription.loop.count(l))
+        sum -= prescription.loop.at(l);
     }
     if (pivot_of_component[k] >= 0) c.n0(pivot_of_component[k]) = sum;
   }

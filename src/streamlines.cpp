@@ -40,7 +40,7 @@ struct GridEntry {
   Vector3d position;
   Vector3d tangent;  // unit; zero for plain points
   int line = -1;
-  double arc = 0;    // signed arc length from the line's seed
+  double arc = 0;  // signed arc length from the line's seed
 };
 
 class PointGrid {
@@ -136,7 +136,10 @@ class Tracer {
  public:
   Tracer(const MatrixX3d& V, const Topology& t, const Geometry& g, const Field& field,
          const std::vector<std::pair<int, int>>& singularities, const StreamlineOptions& o)
-      : V_(V), t_(t), g_(g), field_(field),
+      : V_(V),
+        t_(t),
+        g_(g),
+        field_(field),
         separation_(o.separation > 0 ? o.separation : bounding_diagonal(V, t) / 50),
         max_length_(o.max_length > 0 ? o.max_length : 10 * bounding_diagonal(V, t)),
         sample_step_(separation_ / 4),
@@ -190,8 +193,7 @@ class Tracer {
     if (near_other_line(seed.position, tangent, id, 0, separation_)) return false;
     std::vector<std::uint64_t> inserted{grid_.insert({seed.position, tangent, id, 0})};
     const Vector3d d = seed.position - vertex(V_, t_.F(seed.face, 0));
-    const Cursor start{seed.face, Vector2d(d.dot(g_.frame_x.row(seed.face)), d.dot(g_.frame_y.row(seed.face))), seed.position, -1,
-                       beta};
+    const Cursor start{seed.face, Vector2d(d.dot(g_.frame_x.row(seed.face)), d.dot(g_.frame_y.row(seed.face))), seed.position, -1, beta};
     HalfLine forward, backward;
     trace_half(start, +1, id, forward, inserted);
     trace_half(start, -1, id, backward, inserted);

@@ -141,7 +141,7 @@ class Numeric {
       w.update_size = size;
     }
     const double* Ld = x_ + L_.px[d] + first;  // rows first … ndrow − 1 of d, leading dimension ndrow
-    double* C = w.update.get();             // ndrow2 × ndrow1, leading dimension ndrow2
+    double* C = w.update.get();                // ndrow2 × ndrow1, leading dimension ndrow2
     if (static_cast<double>(ndrow2) * ndrow1 * ndcol < kBlasUpdateFlops) {
       const ConstBlock below(Ld, ndrow2, ndcol, Eigen::OuterStride<>(ndrow));
       Block(C, ndrow2, ndrow1, Eigen::OuterStride<>(ndrow2)).noalias() = below * below.topRows(ndrow1).transpose();
@@ -203,7 +203,7 @@ class Numeric {
   const PermutedLower& A_;
   const Supernodes& L_;
   const std::vector<int>& owner_;
-  double* x_;  // L_.x, written
+  double* x_;                     // L_.x, written
   std::vector<int> next_, lpos_;  // a linked list's next, and where each supernode's next update starts
 };
 
@@ -215,8 +215,10 @@ TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& 
   std::vector<std::vector<int>> children(count);
   std::vector<int> roots;
   for (int s = 0; s < count; ++s) {
-    if (parent[s] >= 0) work[parent[s]] += work[s], children[parent[s]].push_back(s);
-    else roots.push_back(s);
+    if (parent[s] >= 0)
+      work[parent[s]] += work[s], children[parent[s]].push_back(s);
+    else
+      roots.push_back(s);
   }
   TreeSplit split;
   auto lighter = [&](int a, int b) { return work[a] < work[b]; };

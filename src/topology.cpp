@@ -44,8 +44,8 @@ void check_face_indices(const MatrixX3i& F, int num_vertices) {
   for (int f = 0; f < F.rows(); ++f) {
     for (int k = 0; k < 3; ++k) {
       if (F(f, k) < 0 || F(f, k) >= num_vertices)
-        throw Error("vertex index " + std::to_string(F(f, k)) + " out of range in face " + std::to_string(f) +
-                    " (mesh has " + std::to_string(num_vertices) + " vertices)");
+        throw Error("vertex index " + std::to_string(F(f, k)) + " out of range in face " + std::to_string(f) + " (mesh has " +
+                    std::to_string(num_vertices) + " vertices)");
     }
     if (F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 2) == F(f, 0))
       throw Error("face " + std::to_string(f) + " has a repeated vertex " + face_string(F, f));
@@ -81,7 +81,8 @@ std::vector<int> match_half_edges(const MatrixX3i& F, int num_vertices, int& num
       for (auto i = begin + 1; i < end; ++i)
         for (auto j = i; j > begin && (j - 1)->first > j->first; --j) std::iter_swap(j - 1, j);
     }
-    for (auto i = begin; i < end; ++i) first_of[i->second] = i > begin && (i - 1)->first == i->first ? first_of[(i - 1)->second] : i->second;
+    for (auto i = begin; i < end; ++i)
+      first_of[i->second] = i > begin && (i - 1)->first == i->first ? first_of[(i - 1)->second] : i->second;
   }
   std::vector<int> edge_of(H);
   num_edges = 0;
@@ -113,8 +114,7 @@ void check_manifold_vertices(const MatrixX3i& F_in, int num_vertices, const std:
     if (corners.find(c) == c) ++fans[F_in(c / 3, c % 3)];
   for (int v = 0; v < num_vertices; ++v)
     if (fans[v] > 1)
-      throw Error("non-manifold vertex " + std::to_string(v) + ": its faces form " + std::to_string(fans[v]) +
-                  " separate fans");
+      throw Error("non-manifold vertex " + std::to_string(v) + ": its faces form " + std::to_string(fans[v]) + " separate fans");
 }
 
 // Components and orientation: breadth-first over faces; flip[g] says whether g must be reversed to agree
@@ -156,8 +156,8 @@ void orient_components(const MatrixX3i& F_in, const std::vector<int>& edge_count
           queue.push_back(g);
         } else if (flip[g] != want) {
           const int a = F_in(f, k), b = F_in(f, (k + 1) % 3);
-          throw Error("non-orientable component " + std::to_string(c) + " (containing face " + std::to_string(root) +
-                      "): faces " + std::to_string(std::min(f, g)) + " and " + std::to_string(std::max(f, g)) +
+          throw Error("non-orientable component " + std::to_string(c) + " (containing face " + std::to_string(root) + "): faces " +
+                      std::to_string(std::min(f, g)) + " and " + std::to_string(std::max(f, g)) +
                       " cannot be oriented consistently across edge (" + std::to_string(std::min(a, b)) + ", " +
                       std::to_string(std::max(a, b)) + ")");
         }

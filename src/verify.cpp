@@ -10,7 +10,8 @@ namespace trivcon {
 using detail::kParallelMinEditElements;
 
 void verify_connection(const Topology& t, const Geometry& geometry, const Cycles& cycles, const IndexPrescription& prescription,
-                       Connection& connection, const std::vector<double>* loop_curvatures, const std::vector<double>* generator_holonomies) {
+                       Connection& connection, const std::vector<double>* loop_curvatures,
+                       const std::vector<double>* generator_holonomies) {
   const double step = 2 * kPi / prescription.N;
   const Eigen::VectorXd& x = connection.x;
   connection.max_vertex_residual = connection.max_cycle_residual = 0;
@@ -43,7 +44,8 @@ void verify_connection(const Topology& t, const Geometry& geometry, const Cycles
     check_cycle(cycles.loops[l], loop_curvatures ? (*loop_curvatures)[l] : loop_curvature(t, geometry, static_cast<int>(l)),
                 prescription.loop.at(static_cast<int>(l)));
   for (size_t g = 0; g < cycles.generators.size(); ++g)
-    check_cycle(cycles.generators[g], generator_holonomies ? (*generator_holonomies)[g] : levi_civita_holonomy(cycles.generators[g], geometry),
+    check_cycle(cycles.generators[g],
+                generator_holonomies ? (*generator_holonomies)[g] : levi_civita_holonomy(cycles.generators[g], geometry),
                 prescription.generator.at(static_cast<int>(g)));
 }
 

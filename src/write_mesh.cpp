@@ -37,8 +37,8 @@ void check_writable(const std::string& path, const MatrixX3d& V, const MatrixX3i
     for (int c = 0; c < 3; ++c) {
       corners[c] = F(f, c);
       if (corners[c] < 0 || corners[c] >= V.rows()) {
-        refuse("face " + std::to_string(f) + " has vertex index " + std::to_string(corners[c]) +
-               " out of range (mesh has " + std::to_string(V.rows()) + " vertices)");
+        refuse("face " + std::to_string(f) + " has vertex index " + std::to_string(corners[c]) + " out of range (mesh has " +
+               std::to_string(V.rows()) + " vertices)");
       }
     }
     const std::string problem = polygon_problem(corners, f);
@@ -99,10 +99,9 @@ void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) 
 
 void write_ply(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
   check_writable(path, V, F);
-  std::string data =
-      "ply\nformat binary_little_endian 1.0\ncomment written by trivcon\nelement vertex " + std::to_string(V.rows()) +
-      "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(F.rows()) +
-      "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string data = "ply\nformat binary_little_endian 1.0\ncomment written by trivcon\nelement vertex " + std::to_string(V.rows()) +
+                     "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(F.rows()) +
+                     "\nproperty list uchar int vertex_indices\nend_header\n";
   data.reserve(data.size() + 24 * V.rows() + 13 * F.rows());
   for (Eigen::Index v = 0; v < V.rows(); ++v) {
     for (int axis = 0; axis < 3; ++axis) append_little_endian(data, V(v, axis));

@@ -18,9 +18,7 @@ namespace trivcon::test {
 
 namespace {
 
-std::uint64_t key(int a, int b) {
-  return static_cast<std::uint64_t>(std::min(a, b)) << 32 | static_cast<std::uint32_t>(std::max(a, b));
-}
+std::uint64_t key(int a, int b) { return static_cast<std::uint64_t>(std::min(a, b)) << 32 | static_cast<std::uint32_t>(std::max(a, b)); }
 
 int brute_force_edges(const MatrixX3i& F) {
   std::set<std::uint64_t> edges;
@@ -148,8 +146,8 @@ void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const s
   }
   int bad_rows = 0;
   for (int f = 0; f < nF; ++f) {
-    const bool ok = flipped[f] ? (t.F(f, 0) == F_in(f, 0) && t.F(f, 1) == F_in(f, 2) && t.F(f, 2) == F_in(f, 1))
-                               : (t.F.row(f) == F_in.row(f));
+    const bool ok =
+        flipped[f] ? (t.F(f, 0) == F_in(f, 0) && t.F(f, 1) == F_in(f, 2) && t.F(f, 2) == F_in(f, 1)) : (t.F.row(f) == F_in.row(f));
     bad_rows += !ok;
   }
   EXPECT_EQ(bad_rows, 0) << "rows of F that are not the input (flipped where listed)";
@@ -182,8 +180,7 @@ void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const s
 
   // Components: numbered by smallest face id, counts.
   ASSERT_EQ(static_cast<int>(t.face_component.size()), nF);
-  std::vector<int> first(t.components.size(), -1), cf(t.components.size(), 0), cv(t.components.size(), 0),
-      ce(t.components.size(), 0);
+  std::vector<int> first(t.components.size(), -1), cf(t.components.size(), 0), cv(t.components.size(), 0), ce(t.components.size(), 0);
   for (int f = 0; f < nF; ++f) {
     const int c = t.face_component[f];
     ASSERT_TRUE(c >= 0 && c < static_cast<int>(t.components.size()));

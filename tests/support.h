@@ -16,8 +16,8 @@ namespace trivcon::test {
 // Absolute path of ../shared/data/meshes/NAME, or "" when the shared folder is absent.
 std::string shared_mesh(const std::string& name);
 // GTEST_SKIP()s the calling test with a message when the shared meshes are absent.
-#define TRIVCON_REQUIRE_SHARED()                                                                        \
-  if (::trivcon::test::shared_mesh("SOURCES.md").empty())                                               \
+#define TRIVCON_REQUIRE_SHARED()                          \
+  if (::trivcon::test::shared_mesh("SOURCES.md").empty()) \
   GTEST_SKIP() << "../shared/data/meshes not found next to the repository: skipping real-mesh test"
 
 // A fresh directory for this test's files (under the build tree).

@@ -76,7 +76,9 @@ TEST(CholeskyEngine, CholmodFactorizationGivesTheSameResults) {
     std::vector<int> fixed;
     const Design ours = solve(c, Factorization::Parallel, &fixed);
     const Design theirs = solve(c, Factorization::Cholmod);
-    if (c.align_boundary) EXPECT_GT(fixed.size(), 0u);
+    if (c.align_boundary) {
+      EXPECT_GT(fixed.size(), 0u);
+    }
     const double scale = std::max(1.0, ours.connection.x.cwiseAbs().maxCoeff());
     EXPECT_LE((ours.connection.x - theirs.connection.x).cwiseAbs().maxCoeff(), 1e-10 * scale);
     EXPECT_NEAR(ours.connection.energy, theirs.connection.energy, 1e-10 * std::max(1.0, ours.connection.energy));

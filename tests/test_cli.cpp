@@ -233,7 +233,7 @@ TEST(CliInfo, JsonMatchesTheLibraryAndTheFormulas) {
 TEST(CliInfo, CyclesListGeneratorsAndLoops) {
   const std::string dir = test::temp_dir("cli_info_cycles");
   // Components: genus 2, torus, disk, annulus, genus 3, holed grid with 2 holes.
-  const std::vector<Mesh> parts = {make_genus_surface(2, 1), make_torus(9, 5), make_disk(3, 5),
+  const std::vector<Mesh> parts = {make_genus_surface(2, 1), make_torus(9, 5),         make_disk(3, 5),
                                    make_annulus(2, 10),      make_genus_surface(3, 1), make_holed_grid(9, 2)};
   const std::vector<int> genus = {2, 1, 0, 0, 3, 0};
   const Mesh m = concatenate(parts);
@@ -282,9 +282,12 @@ TEST(CliInfo, CyclesListGeneratorsAndLoops) {
     EXPECT_EQ(loops[l]["length"], t.boundary_loops[l].size());
     EXPECT_EQ(loops[l]["component"], t.vertex_component[t.boundary_loops[l][0]]);
     const double k = loops[l]["curvature"];
-    if (std::abs(k - 2 * kPi) < 1e-9) ++outer;
-    else if (std::abs(k + 2 * kPi) < 1e-9) ++holes;
-    else ADD_FAILURE() << "loop " << l << " curvature " << k << " is neither 2π nor −2π on a flat mesh";
+    if (std::abs(k - 2 * kPi) < 1e-9)
+      ++outer;
+    else if (std::abs(k + 2 * kPi) < 1e-9)
+      ++holes;
+    else
+      ADD_FAILURE() << "loop " << l << " curvature " << k << " is neither 2π nor −2π on a flat mesh";
   }
   EXPECT_EQ(outer, 3);  // disk, annulus outer, holed grid outer
   EXPECT_EQ(holes, 3);  // annulus inner, two holes
@@ -657,7 +660,8 @@ TEST(CliSolve, CrossFieldOnACubeFromASingularityFile) {
   for (int v : corners) sings += std::to_string(v) + " 1/4\n";
   write_text(dir + "/corners.txt", sings);
   const std::string field = dir + "/cross.txt", report = dir + "/report.json";
-  CommandResult r = run_cli("solve " + q(mesh) + " -N 4 -s " + q(dir + "/corners.txt") + " -q --field-out " + q(field) + " --report " + q(report));
+  CommandResult r =
+      run_cli("solve " + q(mesh) + " -N 4 -s " + q(dir + "/corners.txt") + " -q --field-out " + q(field) + " --report " + q(report));
   ASSERT_EQ(r.status, 0) << r.err;
   const json rep = json::parse(slurp(report));
   EXPECT_EQ(rep["N"], 4);
@@ -681,8 +685,10 @@ TEST(CliSolve, FactorizationCholmodGivesTheSameConnection) {
   int k = 0;
   for (const char* f : {"own", "cholmod"}) {
     const std::string path = dir + "/conn_" + f + ".txt";
-    const CommandResult r = run_cli("solve " + q(mesh) + " -N 4 --sing 0:-1/4 --sing 40:-1/4 --sing 80:-1/4 --sing 120:-1/4 --sing 160:-1/4"
-                                    " --sing 200:-1/4 --sing 240:-1/4 --sing 280:-1/4 --factorization " + f + " --connection-out " + q(path));
+    const CommandResult r = run_cli("solve " + q(mesh) +
+                                    " -N 4 --sing 0:-1/4 --sing 40:-1/4 --sing 80:-1/4 --sing 120:-1/4 --sing 160:-1/4"
+                                    " --sing 200:-1/4 --sing 240:-1/4 --sing 280:-1/4 --factorization " +
+                                    f + " --connection-out " + q(path));
     ASSERT_EQ(r.status, 0) << r.err;
     conn[k] = slurp(path);
     energy[k] = r.out.substr(r.out.find("energy "), r.out.find('\n', r.out.find("energy ")) - r.out.find("energy "));
@@ -734,12 +740,11 @@ TEST(CliSolve, TorusWithoutSingularities) {
 // Runs a solve that must fail with exactly `message` and leave none of its outputs behind.
 void expect_solve_error(const std::string& dir, const std::string& args, const std::string& message) {
   SCOPED_TRACE("trivcon solve " + args);
-  const std::vector<std::string> outputs = {dir + "/out.txt", dir + "/out.rawfield", dir + "/out.ply", dir + "/conn.txt", dir + "/lines.obj",
-                                            dir + "/report.json"};
+  const std::vector<std::string> outputs = {dir + "/out.txt",  dir + "/out.rawfield", dir + "/out.ply",
+                                            dir + "/conn.txt", dir + "/lines.obj",    dir + "/report.json"};
   for (const auto& o : outputs) fs::remove(o);
-  const CommandResult r =
-      run_cli("solve " + args + " --field-out " + q(outputs[0]) + " --connection-out " + q(outputs[3]) + " --lines-out " + q(outputs[4]) +
-              " --report " + q(outputs[5]));
+  const CommandResult r = run_cli("solve " + args + " --field-out " + q(outputs[0]) + " --connection-out " + q(outputs[3]) +
+                                  " --lines-out " + q(outputs[4]) + " --report " + q(outputs[5]));
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.err, kError + message + "\n");  // (stdout may hold the mesh summary printed before the solve)
   for (const auto& o : {outputs[0], outputs[3], outputs[4], outputs[5]}) EXPECT_FALSE(fs::exists(o)) << o << " left behind";
@@ -752,16 +757,15 @@ void expect_solve_error(const std::string& dir, const std::string& args, const s
   // No temporary files either.
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
-    EXPECT_TRUE(name == "sphere.obj" || name == "disk.obj" || name == "extra.obj" || name == "torus.obj" ||
-                name.find("sing") == 0)
+    EXPECT_TRUE(name == "sphere.obj" || name == "disk.obj" || name == "extra.obj" || name == "torus.obj" || name.find("sing") == 0)
         << "unexpected file " << name;
   }
 }
 
 TEST(CliSolve, ErrorsWithExactMessagesAndNoOutputs) {
   const std::string dir = test::temp_dir("cli_solve_errors");
-  const std::string sphere = save(dir, "sphere", make_uv_sphere(8, 12));    // 86 vertices, χ = 2
-  const std::string disk = save(dir, "disk", make_disk(3, 6));              // 37 vertices; 19..36 on the boundary
+  const std::string sphere = save(dir, "sphere", make_uv_sphere(8, 12));                        // 86 vertices, χ = 2
+  const std::string disk = save(dir, "disk", make_disk(3, 6));                                  // 37 vertices; 19..36 on the boundary
   const std::string extra = save(dir, "extra", with_extra_vertices(make_uv_sphere(8, 12), 2));  // 86, 87 unreferenced
   const std::string torus = save(dir, "torus", make_torus(8, 6));
   const std::string S = q(sphere);
@@ -773,10 +777,13 @@ TEST(CliSolve, ErrorsWithExactMessagesAndNoOutputs) {
   expect_solve_error(dir, q(disk) + " --sing 36:1",
                      "singular vertex 36 is on boundary loop 0: a boundary vertex has no dual cycle (set the loop's index with "
                      "--boundary instead)");
-  expect_solve_error(dir, S + " -N 4 --sing 0:1/3 --sing 85:5/3", "--sing 0:1/3: index 1/3 is not a multiple of 1/4 (use -N to change the symmetry)");
-  expect_solve_error(dir, S + " --sing 0:1/2 --sing 85:3/2", "--sing 0:1/2: index 1/2 is not a multiple of 1/1 (use -N to change the symmetry)");
+  expect_solve_error(dir, S + " -N 4 --sing 0:1/3 --sing 85:5/3",
+                     "--sing 0:1/3: index 1/3 is not a multiple of 1/4 (use -N to change the symmetry)");
+  expect_solve_error(dir, S + " --sing 0:1/2 --sing 85:3/2",
+                     "--sing 0:1/2: index 1/2 is not a multiple of 1/1 (use -N to change the symmetry)");
   expect_solve_error(dir, S + " --sing 0:1", "the indices on component 0 sum to 1, but Gauss-Bonnet needs its Euler characteristic 2");
-  expect_solve_error(dir, S + " -N 4 --sing 0:1/4", "the indices on component 0 sum to 1/4, but Gauss-Bonnet needs its Euler characteristic 2");
+  expect_solve_error(dir, S + " -N 4 --sing 0:1/4",
+                     "the indices on component 0 sum to 1/4, but Gauss-Bonnet needs its Euler characteristic 2");
   expect_solve_error(dir, S, "the indices on component 0 sum to 0, but Gauss-Bonnet needs its Euler characteristic 2");
   expect_solve_error(dir, S + " --sing 0:1 --sing 0:1", "--sing 0:1: vertex 0 is given twice");
   expect_solve_error(dir, S + " --sing 0", "--sing '0': expected ID:INDEX, e.g. 12:1/4");
@@ -796,7 +803,8 @@ TEST(CliSolve, ErrorsWithExactMessagesAndNoOutputs) {
   expect_solve_error(dir, S + " -s " + q(s2), s2 + ":2: expected two fields, got '85 1 extra'");
   expect_solve_error(dir, S + " -s " + q(s3), s3 + ":2: vertex 0 is given twice");
   expect_solve_error(dir, S + " -s " + q(s4), s4 + ": the header announces 3 singularities but the file lists 2");
-  expect_solve_error(dir, S + " -s " + q(dir + "/sing_missing.txt"), "cannot open '" + dir + "/sing_missing.txt': No such file or directory");
+  expect_solve_error(dir, S + " -s " + q(dir + "/sing_missing.txt"),
+                     "cannot open '" + dir + "/sing_missing.txt': No such file or directory");
   // A vertex both in a file and on the command line.
   write_text(dir + "/sing5.txt", "0 1\n");
   expect_solve_error(dir, S + " -s " + q(dir + "/sing5.txt") + " --sing 0:1", "--sing 0:1: vertex 0 is given twice");
@@ -813,8 +821,8 @@ TEST(CliSolve, ErrorsWithExactMessagesAndNoOutputs) {
 // (All outputs are staged and renamed into place together, apps/cmd_solve.cpp.)
 TEST(CliSolve, NoPartialOutputsWhenALaterWriteFails) {
   const SolveFiles s = sphere_files("cli_solve_partial");
-  const CommandResult r = run_cli("solve " + q(s.mesh) + " -q --sing 0:1 --sing 85:1 --field-out " + q(s.field_txt) +
-                                  " --lines-out " + q(s.dir + "/no/such/dir/lines.obj"));
+  const CommandResult r = run_cli("solve " + q(s.mesh) + " -q --sing 0:1 --sing 85:1 --field-out " + q(s.field_txt) + " --lines-out " +
+                                  q(s.dir + "/no/such/dir/lines.obj"));
   EXPECT_EQ(r.status, 1);
   EXPECT_TRUE(contains(r.err, "cannot write")) << r.err;
   EXPECT_FALSE(fs::exists(s.field_txt)) << "field written although the solve failed";

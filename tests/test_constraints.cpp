@@ -15,7 +15,6 @@ using namespace trivcon;
 
 namespace {
 
-
 std::vector<int> keys(const std::map<int, double>& m) {
   std::vector<int> k;
   for (auto [f, a] : m) k.push_back(f);
@@ -53,7 +52,7 @@ TEST(Constraints, AlignBoundaryDiskAnnulusHoles) {
   std::vector<Case> cases;
   for (int N : {1, 2, 4}) {
     cases.push_back({"disk", disk, N, {{0, N}}, WeightKind::Cotan});  // a tangent field on a disk: +1 at the centre
-    cases.push_back({"annulus", annulus, N, {}, WeightKind::Cotan});   // concentric: no singularity
+    cases.push_back({"annulus", annulus, N, {}, WeightKind::Cotan});  // concentric: no singularity
   }
   // A square with two square holes: the tangent cross field needs no singularity.
   cases.push_back({"holes", holes, 4, {}, WeightKind::Cotan});
@@ -223,8 +222,9 @@ TEST(Constraints, Errors) {
     d.design(p);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "the fixed faces of the prescription (1) are not those the solver was set up with (0): fixing other faces changes the "
-                           "matrix, set up a new solver");
+    EXPECT_STREQ(e.what(),
+                 "the fixed faces of the prescription (1) are not those the solver was set up with (0): fixing other faces changes the "
+                 "matrix, set up a new solver");
   }
 }
 

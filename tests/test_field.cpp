@@ -97,7 +97,7 @@ TEST(Field, PlanIsABreadthFirstSpanningTreePerComponent) {
       bad += t.face_component[f] != static_cast<int>(c);
       if (q == begin) continue;
       const int p = plan.parent[q], e = plan.edge[q];
-      bad += !(p >= begin && p < q);  // reached from a face earlier in the same component
+      bad += !(p >= begin && p < q);              // reached from a face earlier in the same component
       const int side = plan.sign[q] > 0 ? 0 : 1;  // the parent's side of the edge: L when crossing L → R
       bad += t.edge_faces(e, side) != plan.order[p] || t.edge_faces(e, 1 - side) != f;
     }

@@ -263,8 +263,8 @@ TEST(FieldIo, ConnectionReaderErrorsNameTheLine) {
     return message_of([&] { read_connection(path, t); }, path);
   };
   EXPECT_EQ(error("# N 1\n" + all), "<no error>");
-  EXPECT_EQ(error(all + bi + " " + bj + " 0.1\n"), "FILE:" + std::to_string(lines.size() + 1) + ": (" + bi + ", " + bj +
-                                                       ") is not an interior edge with i < j");
+  EXPECT_EQ(error(all + bi + " " + bj + " 0.1\n"),
+            "FILE:" + std::to_string(lines.size() + 1) + ": (" + bi + ", " + bj + ") is not an interior edge with i < j");
   EXPECT_EQ(error("1 0 0.5\n" + all), "FILE:1: (1, 0) is not an interior edge with i < j");
   EXPECT_EQ(error("# header\n\n0 99 0.5\n" + all), "FILE:3: (0, 99) is not an interior edge with i < j");
   int i3, j3;

@@ -25,23 +25,22 @@
 namespace trivcon {
 namespace {
 
-
 // Everything the tests assert about a mesh, computed by brute force.
 struct MeshReport {
   int vertices = 0, faces = 0, edges = 0;
-  int bad_faces = 0;                 // index out of range or repeated corner
+  int bad_faces = 0;  // index out of range or repeated corner
   int boundary_edges = 0;
-  int nonmanifold_edges = 0;         // > 2 half-edges, or two half-edges in the same direction
-  int inconsistent_edges = 0;        // the two faces of an interior edge traverse it the same way
-  int nonmanifold_vertices = 0;      // faces around the vertex are not one fan
-  int boundary_loops = 0;            // connected components of the boundary edges
+  int nonmanifold_edges = 0;     // > 2 half-edges, or two half-edges in the same direction
+  int inconsistent_edges = 0;    // the two faces of an interior edge traverse it the same way
+  int nonmanifold_vertices = 0;  // faces around the vertex are not one fan
+  int boundary_loops = 0;        // connected components of the boundary edges
   int unreferenced_vertices = 0;
-  int duplicate_vertices = 0;        // pairs of vertices closer than 1e-9 · bounding-box diagonal
-  double min_area = INFINITY;        // smallest face area
-  double min_angle_degrees = 180;    // smallest corner angle
-  double signed_volume = 0;          // Σ det(a, b, c)/6: > 0 when a closed mesh faces outward
+  int duplicate_vertices = 0;                             // pairs of vertices closer than 1e-9 · bounding-box diagonal
+  double min_area = INFINITY;                             // smallest face area
+  double min_angle_degrees = 180;                         // smallest corner angle
+  double signed_volume = 0;                               // Σ det(a, b, c)/6: > 0 when a closed mesh faces outward
   Eigen::Vector3d area_vector = Eigen::Vector3d::Zero();  // Σ (b − a) × (c − a)/2
-  std::vector<int> valence;          // edges at each vertex
+  std::vector<int> valence;                               // edges at each vertex
   int euler_characteristic() const { return vertices - edges + faces; }
 };
 
@@ -59,8 +58,7 @@ int count_close_pairs(const MatrixX3d& V, double tolerance) {
   std::unordered_map<std::uint64_t, std::vector<int>> cells;
   auto cell_of = [&](int v, int axis) { return static_cast<std::int64_t>(std::floor(V(v, axis) / tolerance)); };
   auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
-    return static_cast<std::uint64_t>(x * 73856093) ^ static_cast<std::uint64_t>(y * 19349663) ^
-           static_cast<std::uint64_t>(z * 83492791);
+    return static_cast<std::uint64_t>(x * 73856093) ^ static_cast<std::uint64_t>(y * 19349663) ^ static_cast<std::uint64_t>(z * 83492791);
   };
   int pairs = 0;
   for (int v = 0; v < V.rows(); ++v) {
@@ -199,8 +197,7 @@ MeshReport expect_closed(const Mesh& mesh, int euler_characteristic, double min_
   return r;
 }
 
-MeshReport expect_flat(const Mesh& mesh, int euler_characteristic, int boundary_loops, int boundary_edges,
-                       double min_angle_degrees) {
+MeshReport expect_flat(const Mesh& mesh, int euler_characteristic, int boundary_loops, int boundary_edges, double min_angle_degrees) {
   const MeshReport r = analyse(mesh);
   expect_well_formed(r, min_angle_degrees);
   EXPECT_EQ(r.boundary_edges, boundary_edges);
@@ -247,8 +244,7 @@ void expect_error(const std::function<void()>& make, const std::vector<std::stri
     ADD_FAILURE() << "no trivcon::Error thrown";
   } catch (const Error& error) {
     for (const std::string& word : words) {
-      EXPECT_NE(std::string(error.what()).find(word), std::string::npos)
-          << "message \"" << error.what() << "\" lacks \"" << word << "\"";
+      EXPECT_NE(std::string(error.what()).find(word), std::string::npos) << "message \"" << error.what() << "\" lacks \"" << word << "\"";
     }
   }
 }
@@ -542,8 +538,7 @@ TEST(Permute, MapsVerticesAndFacesAndKeepsOrientation) {
     rotated += k != 0;
   }
   EXPECT_GT(rotated, mesh.F.rows() / 3);  // rotations actually happen (expected 2/3)
-  EXPECT_GT(std::count_if(vertex_perm.begin(), vertex_perm.end(), [n = 0](int p) mutable { return p != n++; }),
-            mesh.V.rows() / 2);
+  EXPECT_GT(std::count_if(vertex_perm.begin(), vertex_perm.end(), [n = 0](int p) mutable { return p != n++; }), mesh.V.rows() / 2);
   // Still a valid outward genus-1 surface.
   const MeshReport r = expect_closed(shuffled, 0, 45 - 1e-9);
   EXPECT_NEAR(r.signed_volume, analyse(mesh).signed_volume, 1e-12);

@@ -72,8 +72,8 @@ TEST(Geometry, WrapAngleIntoMinusPiPi) {
 // conversions between angles and world vectors.
 TEST(Geometry, FramesHalfEdgeAnglesAndConversions) {
   for (const auto& [name, m] : std::vector<std::pair<std::string, Mesh>>{{"icosphere", jittered(make_icosphere(2), 0.03, 1)},
-                                                                          {"torus", jittered(make_torus(9, 7), 0.03, 2)},
-                                                                          {"disk", make_disk(3, 5)}}) {
+                                                                         {"torus", jittered(make_torus(9, 7), 0.03, 2)},
+                                                                         {"disk", make_disk(3, 5)}}) {
     SCOPED_TRACE(name);
     const auto [t, g] = prepare(m);
     double worst = 0;
@@ -238,8 +238,8 @@ TEST(Geometry, FlatDiskHasZeroInteriorCurvature) {
   for (int v = 0; v < t.num_vertices; ++v) {
     if (t.is_interior_vertex(v)) {
       EXPECT_NEAR(g.angle_defect(v), 0, 1e-12) << "vertex " << v;
-    }
-    else boundary += g.angle_defect(v);
+    } else
+      boundary += g.angle_defect(v);
   }
   EXPECT_NEAR(boundary, 2 * kPi, 1e-9);
 }

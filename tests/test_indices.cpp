@@ -189,8 +189,9 @@ TEST(Indices, ValidationErrors) {
   p.loop[1] = 1;
   EXPECT_EQ(validation_error(td, 0, p), "boundary loop 1 out of range (the mesh has 1 boundary loops)");
   p.loop = {{0, 1}};  // every loop prescribed: vertices and loops must sum to χ = 1, i.e. 4/4
-  EXPECT_EQ(validation_error(td, 0, p), "the indices on component 0 (vertices and boundary loops) sum to 1/2, but Gauss-Bonnet needs its "
-                                        "Euler characteristic 1");
+  EXPECT_EQ(validation_error(td, 0, p),
+            "the indices on component 0 (vertices and boundary loops) sum to 1/2, but Gauss-Bonnet needs its "
+            "Euler characteristic 1");
   p.loop = {{0, 3}};
   EXPECT_EQ(validation_error(td, 0, p), "<no error>");
   p.loop.clear();  // the loop free: no sum to check
@@ -234,8 +235,9 @@ TEST(Indices, ValidationErrors) {
   s.loop = {{0, 5}, {1, 5}};
   EXPECT_EQ(validation_error(tg, 0, s), "<no error>");
   s.loop[2] = 5;
-  EXPECT_EQ(validation_error(tg, 0, s), "the indices on component 0 (vertices and boundary loops) sum to 15, but Gauss-Bonnet needs its "
-                                        "Euler characteristic -1");
+  EXPECT_EQ(validation_error(tg, 0, s),
+            "the indices on component 0 (vertices and boundary loops) sum to 15, but Gauss-Bonnet needs its "
+            "Euler characteristic -1");
 }
 
 }  // namespace

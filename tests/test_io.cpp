@@ -93,9 +93,15 @@ std::string error_of(const std::function<void()>& action) {
   return {};
 }
 
-std::string obj_error(const std::string& text) { return error_of([&] { trivcon::read_obj(text, "m.obj"); }); }
-std::string off_error(const std::string& text) { return error_of([&] { trivcon::read_off(text, "m.off"); }); }
-std::string ply_error(const std::string& text) { return error_of([&] { trivcon::read_ply(text, "m.ply"); }); }
+std::string obj_error(const std::string& text) {
+  return error_of([&] { trivcon::read_obj(text, "m.obj"); });
+}
+std::string off_error(const std::string& text) {
+  return error_of([&] { trivcon::read_off(text, "m.off"); });
+}
+std::string ply_error(const std::string& text) {
+  return error_of([&] { trivcon::read_ply(text, "m.ply"); });
+}
 
 std::string to_crlf(const std::string& text) {
   std::string out;
@@ -175,9 +181,7 @@ class PlyBytes {
   std::string bytes_;
 };
 
-bool is_float_type(const std::string& type) {
-  return type == "float" || type == "float32" || type == "double" || type == "float64";
-}
+bool is_float_type(const std::string& type) { return type == "float" || type == "float32" || type == "double" || type == "float64"; }
 
 // What a value of `type` holding `value` reads back as.
 double stored_as(const std::string& type, double value) {
@@ -198,8 +202,8 @@ struct BinaryPlySpec {
 // A binary PLY of the given vertices and polygons written by hand, independently of write_ply.
 std::string make_binary_ply(const BinaryPlySpec& spec, const std::vector<std::array<double, 3>>& vertices,
                             const std::vector<std::vector<int>>& polygons) {
-  std::string header = "ply\nformat " + std::string(spec.big_endian ? "binary_big_endian" : "binary_little_endian") +
-                       " 1.0\ncomment hand-made\n";
+  std::string header =
+      "ply\nformat " + std::string(spec.big_endian ? "binary_big_endian" : "binary_little_endian") + " 1.0\ncomment hand-made\n";
   if (spec.extras) header += "obj_info a test\nelement material 1\nproperty list uchar uchar name\n";
   header += "element vertex " + std::to_string(vertices.size()) + "\n";
   header += "property " + spec.coordinate_type + " x\n";
@@ -292,8 +296,10 @@ TEST(ReadObj, AcceptsAllVariants) {
     const MeshData mesh = trivcon::read_obj(text, "m.obj");
     EXPECT_EQ(mesh.format, "obj");
     EXPECT_TRUE(bitwise_equal(mesh.V, matrix_v({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {1.5, -0.25, 0.5}, {2, 2, 2}})));
-    EXPECT_EQ(mesh.F, matrix_f({{0, 1, 2}, {0, 2, 3}, {0, 1, 4}, {1, 2, 4}, {0, 2, 3}, {0, 1, 2}, {0, 2, 3}, {0, 3, 4},
-                                {3, 2, 1}, {0, 1, 3}, {5, 4, 0}}));
+    EXPECT_EQ(
+        mesh.F,
+        matrix_f(
+            {{0, 1, 2}, {0, 2, 3}, {0, 1, 4}, {1, 2, 4}, {0, 2, 3}, {0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {3, 2, 1}, {0, 1, 3}, {5, 4, 0}}));
     EXPECT_EQ(mesh.polygon_of_triangle, (std::vector<int>{0, 1, 2, 3, 4, 5, 5, 5, 6, 7, 8}));
     EXPECT_EQ(mesh.polygon_count, 9);
   }
@@ -431,8 +437,7 @@ TEST(ReadOff, ReportsErrorsWithFileAndLine) {
   // Fewer lines than announced: the line where the file ends.
   EXPECT_EQ(off_error("OFF\n3 1 0\n0.000000000 0.000000000 0.000000000\n1.000000000 0.000000000 0.000000000\n"),
             "m.off:4: file ends after 2 of 3 vertices (truncated?)");
-  EXPECT_EQ(off_error("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n# the end\n"),
-            "m.off:8: file ends after 1 of 2 faces (truncated?)");
+  EXPECT_EQ(off_error("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n# the end\n"), "m.off:8: file ends after 1 of 2 faces (truncated?)");
   // Counts that cannot fit in the file are rejected before anything is allocated for them.
   EXPECT_EQ(off_error("OFF\n1000000000000 1 0\n0 0 0\n3 0 0 0\n"),
             "m.off:2: header announces 1000000000000 vertices but the file has only 36 bytes (truncated file?)");
@@ -440,8 +445,7 @@ TEST(ReadOff, ReportsErrorsWithFileAndLine) {
             "m.off:2: header announces 2000000000 faces but the file has only 45 bytes (truncated file?)");
   EXPECT_EQ(off_error("OFF\n99999999999999999999 1 0\n"), "m.off:2: malformed integer '99999999999999999999'");
   // A bogus corner count is caught by the line running out, not by allocating for it.
-  EXPECT_EQ(off_error("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n"),
-            "m.off:6: face 0 announces 2000000000 corners but lists 3");
+  EXPECT_EQ(off_error("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n"), "m.off:6: face 0 announces 2000000000 corners but lists 3");
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -449,7 +453,7 @@ TEST(ReadOff, ReportsErrorsWithFileAndLine) {
 
 const std::vector<std::array<double, 3>> kPlyVertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 2}, {2, 1, 0}};
 const std::vector<std::array<double, 3>> kPlyFractionalVertices = {{0.1, -0.2, 0.3}, {1.5, 0, -7.25}, {1, 1e-3, 0},
-                                                                   {-0.0, 1, 1e10},    {0, 0, 2},       {2, 1, 0}};
+                                                                   {-0.0, 1, 1e10},  {0, 0, 2},       {2, 1, 0}};
 
 const char* const kAsciiPly = R"(ply
 format ascii 1.0
@@ -507,8 +511,7 @@ TEST(ReadPly, AcceptsBinaryOfEveryTypeAndByteOrder) {
   const std::vector<std::string> coordinate_types = {"float", "float32", "double", "float64", "int",   "int32",
                                                      "uint",  "short",   "int16",  "ushort",  "uchar", "int8"};
   const std::vector<std::string> count_types = {"uchar", "uint8", "char", "ushort", "short", "int", "uint", "int32", "uint32"};
-  const std::vector<std::string> index_types = {"int",   "uint",   "int32", "uint32", "short",
-                                                "int16", "ushort", "uint16", "uchar", "char"};
+  const std::vector<std::string> index_types = {"int", "uint", "int32", "uint32", "short", "int16", "ushort", "uint16", "uchar", "char"};
   int combination = 0;
   for (bool big_endian : {false, true}) {
     for (const std::string& coordinate_type : coordinate_types) {
@@ -556,8 +559,8 @@ TEST(ReadPly, ReportsHeaderErrors) {
   EXPECT_EQ(ply_error("plyx\n"), "m.ply: not a PLY file (the first line is not 'ply')");
   EXPECT_EQ(ply_error("\x89PNG\r\n\x1a\n"), "m.ply: not a PLY file (the first line is not 'ply')");
   // The example of the header: an unknown format on line 7.
-  EXPECT_EQ(ply_error("ply\ncomment a\ncomment b\ncomment c\ncomment d\nobj_info e\nformat binary_middle_endian 1.0\n" +
-                      vertices + faces + "end_header\n"),
+  EXPECT_EQ(ply_error("ply\ncomment a\ncomment b\ncomment c\ncomment d\nobj_info e\nformat binary_middle_endian 1.0\n" + vertices + faces +
+                      "end_header\n"),
             "m.ply:7: unsupported PLY format 'binary_middle_endian'");
   EXPECT_EQ(ply_error("ply\nformat ascii 1.0\n" + vertices + faces), "m.ply: PLY header has no 'end_header' line");
   EXPECT_EQ(ply_error("ply\n" + vertices + faces + "end_header\n" + data), "m.ply: PLY header has no 'format' line");
@@ -569,14 +572,16 @@ TEST(ReadPly, ReportsHeaderErrors) {
   EXPECT_EQ(ply_error("ply\nformat ascii 1.0\nbogus line\nend_header\n"), "m.ply:3: unexpected PLY header line starting with 'bogus'");
   EXPECT_EQ(ply_error("ply\nformat ascii 1.0\n" + faces + "end_header\n3 0 1 2\n"), "m.ply: PLY header declares no 'vertex' element");
   EXPECT_EQ(ply_error("ply\nformat ascii 1.0\n" + vertices + "end_header\n" + data), "m.ply: no faces");
-  EXPECT_EQ(ply_error("ply\nformat ascii 1.0\n" + vertices + "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"),
+  EXPECT_EQ(ply_error("ply\nformat ascii 1.0\n" + vertices +
+                      "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"),
             "m.ply: no faces");
   EXPECT_EQ(ply_error("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n" + faces + "end_header\n" + data),
             "m.ply:3: vertex element has no scalar property 'z'");
   EXPECT_EQ(ply_error("ply\nformat ascii 1.0\n" + vertices + "element face 1\nproperty list uchar int corners\nend_header\n" + data),
             "m.ply:7: face element has no list property 'vertex_indices'");
-  EXPECT_EQ(ply_error("ply\nformat ascii 1.0\n" + vertices + "element face 1\nproperty list uchar float vertex_indices\nend_header\n" + data),
-            "m.ply:7: face vertex_indices must have an integer item type");
+  EXPECT_EQ(
+      ply_error("ply\nformat ascii 1.0\n" + vertices + "element face 1\nproperty list uchar float vertex_indices\nend_header\n" + data),
+      "m.ply:7: face vertex_indices must have an integer item type");
   EXPECT_EQ(ply_error("ply\nformat ascii 1.0\n" + vertices + faces + "element empty 5\nend_header\n" + data),
             "m.ply:9: element 'empty' has no properties");
 }
@@ -618,14 +623,14 @@ TEST(ReadPly, ReportsBinaryDataErrorsWithByteOffsets) {
   const std::size_t extras_start = with_lists.find("end_header\n") + 11;
   const std::size_t vertex_size = 4 + 1 + 4 + 1 + 8 + 4 + 8;
   const std::string cut = with_lists.substr(0, extras_start + 3 + 5 * vertex_size + 7);  // 3: the material
-  EXPECT_EQ(ply_error(cut), "m.ply: truncated binary data at byte " + std::to_string(extras_start + 3 + 5 * vertex_size + 5) +
-                                " (vertex 5 of 6)");
+  EXPECT_EQ(ply_error(cut),
+            "m.ply: truncated binary data at byte " + std::to_string(extras_start + 3 + 5 * vertex_size + 5) + " (vertex 5 of 6)");
 
   // Values that are wrong rather than missing.
   std::string bad_index = good;
   bad_index[data_start + 72 + 9] = 6;  // the third index (little-endian int) becomes 6
-  EXPECT_EQ(ply_error(bad_index), "m.ply: face index 6 out of range (file has 6 vertices) in face 0 (at byte " +
-                                      std::to_string(data_start + 72) + ")");
+  EXPECT_EQ(ply_error(bad_index),
+            "m.ply: face index 6 out of range (file has 6 vertices) in face 0 (at byte " + std::to_string(data_start + 72) + ")");
   std::string repeated = good;
   repeated[data_start + 72 + 9] = 1;
   EXPECT_EQ(ply_error(repeated), "m.ply: face 0 has a repeated vertex (0, 1, 1) (at byte " + std::to_string(data_start + 72) + ")");
@@ -639,8 +644,7 @@ TEST(ReadPly, ReportsBinaryDataErrorsWithByteOffsets) {
   const std::size_t int_count_start = negative.find("end_header\n") + 11;
   const std::int32_t minus_one = -1;
   std::memcpy(&negative[int_count_start + 72], &minus_one, 4);
-  EXPECT_EQ(ply_error(negative),
-            "m.ply: negative list length -1 in face 0 (at byte " + std::to_string(int_count_start + 72) + ")");
+  EXPECT_EQ(ply_error(negative), "m.ply: negative list length -1 in face 0 (at byte " + std::to_string(int_count_start + 72) + ")");
   // A list count of four billion runs into the end of the data instead of allocating.
   spec.count_type = "uint";
   std::string huge_list = make_binary_ply(spec, kPlyVertices, {{0, 1, 2}});
@@ -652,8 +656,9 @@ TEST(ReadPly, ReportsBinaryDataErrorsWithByteOffsets) {
   // Counts beyond what the data can hold are rejected before anything is allocated.
   std::string huge = good;
   huge.replace(huge.find("element vertex 6"), 16, "element vertex 1000000000000");
-  EXPECT_EQ(ply_error(huge), "m.ply:4: header announces 1000000000000 'vertex' elements but the file has only 85 bytes after "
-                             "the header (truncated file?)");
+  EXPECT_EQ(ply_error(huge),
+            "m.ply:4: header announces 1000000000000 'vertex' elements but the file has only 85 bytes after "
+            "the header (truncated file?)");
   huge = good;
   huge.replace(huge.find("element face 1"), 14, "element face 4000000000");
   EXPECT_THAT(ply_error(huge), HasSubstr("m.ply:8: header announces 4000000000 'face' elements"));
@@ -726,9 +731,15 @@ TEST(Malformed, RandomMutations) {
         const std::size_t at = random() % bytes.size();
         const char c = random() % 3 ? interesting[random() % interesting.size()] : static_cast<char>(random() % 256);
         switch (random() % 3) {
-          case 0: bytes[at] = c; break;
-          case 1: bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(at), c); break;
-          default: bytes.erase(at, 1 + random() % 8); break;
+          case 0:
+            bytes[at] = c;
+            break;
+          case 1:
+            bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(at), c);
+            break;
+          default:
+            bytes.erase(at, 1 + random() % 8);
+            break;
         }
       }
       SCOPED_TRACE(sample.name + " trial " + std::to_string(trial));
@@ -890,8 +901,8 @@ TEST(Writers, RoundTripExactly) {
   char expected_line[128];
   std::snprintf(expected_line, sizeof expected_line, "\nv %.17g %.17g %.17g\n", V(1, 0), V(1, 1), V(1, 2));
   EXPECT_THAT(obj, HasSubstr(expected_line));
-  EXPECT_THAT(obj, HasSubstr("\nf " + std::to_string(F(0, 0) + 1) + " " + std::to_string(F(0, 1) + 1) + " " +
-                             std::to_string(F(0, 2) + 1) + "\n"));
+  EXPECT_THAT(
+      obj, HasSubstr("\nf " + std::to_string(F(0, 0) + 1) + " " + std::to_string(F(0, 1) + 1) + " " + std::to_string(F(0, 2) + 1) + "\n"));
 
   // Gzip of what was written reads back the same.
   write_gzip(dir / "round.obj.gz", {read_bytes(dir / "round.obj")});
@@ -903,14 +914,17 @@ TEST(Writers, RefuseWhatCannotBeReadBack) {
   const std::string path = (dir / "bad.obj").string();
   MatrixX3d V = matrix_v({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
   const MatrixX3i F = matrix_f({{0, 1, 2}});
-  EXPECT_EQ(error_of([&] { trivcon::write_obj(path, V, matrix_f({{0, 1, 3}})); }),
+  EXPECT_EQ(error_of([&] {
+              trivcon::write_obj(path, V, matrix_f({{0, 1, 3}}));
+            }),
             "cannot write '" + path + "': face 0 has vertex index 3 out of range (mesh has 3 vertices)");
-  EXPECT_EQ(error_of([&] { trivcon::write_ply(path, V, matrix_f({{0, 1, 1}})); }),
+  EXPECT_EQ(error_of([&] {
+              trivcon::write_ply(path, V, matrix_f({{0, 1, 1}}));
+            }),
             "cannot write '" + path + "': face 0 has a repeated vertex (0, 1, 1)");
   EXPECT_EQ(error_of([&] { trivcon::write_obj(path, V, MatrixX3i(0, 3)); }), "cannot write '" + path + "': mesh has no faces");
   V(1, 2) = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(error_of([&] { trivcon::write_ply(path, V, F); }),
-            "cannot write '" + path + "': non-finite coordinate in vertex 1 (nan)");
+  EXPECT_EQ(error_of([&] { trivcon::write_ply(path, V, F); }), "cannot write '" + path + "': non-finite coordinate in vertex 1 (nan)");
   EXPECT_FALSE(fs::exists(path));
 }
 
@@ -931,9 +945,7 @@ TEST(Writers, WriteAtomically) {
                std::runtime_error);
   EXPECT_EQ(read_bytes(path), "second");
   // A failing stream is an error too.
-  EXPECT_EQ(error_of([&] {
-              trivcon::write_file_atomically(path, [](std::ostream& out) { out.setstate(std::ios::badbit); });
-            }),
+  EXPECT_EQ(error_of([&] { trivcon::write_file_atomically(path, [](std::ostream& out) { out.setstate(std::ios::badbit); }); }),
             "cannot write '" + path + "': write failed");
   EXPECT_EQ(read_bytes(path), "second");
   std::vector<std::string> names;
@@ -972,21 +984,38 @@ fs::path shared_meshes_or_skip() {
 
 TEST(SharedMeshes, CountsMatchTheTable) {
   const fs::path dir = shared_meshes_or_skip();
-  if (dir.empty()) GTEST_SKIP() << "shared meshes not found (TRIVCON_SHARED_MESHES = " << (kSharedMeshes ? kSharedMeshes : "undefined") << ")";
+  if (dir.empty())
+    GTEST_SKIP() << "shared meshes not found (TRIVCON_SHARED_MESHES = " << (kSharedMeshes ? kSharedMeshes : "undefined") << ")";
   struct Expected {
     const char* file;
     int vertices;
     int faces;
   };
   const std::vector<Expected> table = {
-      {"spot.obj", 2930, 5856},          {"bunny_closed.obj", 1839, 3674},    {"armadillo.obj", 43243, 86482},
-      {"torus.obj", 2304, 4608},         {"kitten.off", 2500, 5000},          {"bob_small.ply", 250, 500},
-      {"rocker-arm.obj", 10044, 20088},  {"eight.off", 5544, 11092},          {"fertility.off", 4494, 9000},
-      {"Input_wheel.off", 27925, 55890}, {"cheese.off", 8629, 17786},         {"bun_zipper.ply", 35947, 69451},
-      {"face.obj", 25905, 51712},        {"camelhead.off", 11381, 22704},     {"half-torus.obj", 300, 576},
-      {"circle.obj", 5201, 10240},       {"dragon_vrip.ply", 437645, 871414}, {"truck.obj", 2956, 4770},
-      {"mobius.obj", 9900, 19602},       {"capsule.obj", 5252, 10200},        {"teapot.obj", 3644, 6320},
-      {"bones.off", 2154, 4204},         {"dragon_vrip_res3.ply", 22998, 47794}, {"blobby-shuffled.off", 2027, 4050},
+      {"spot.obj", 2930, 5856},
+      {"bunny_closed.obj", 1839, 3674},
+      {"armadillo.obj", 43243, 86482},
+      {"torus.obj", 2304, 4608},
+      {"kitten.off", 2500, 5000},
+      {"bob_small.ply", 250, 500},
+      {"rocker-arm.obj", 10044, 20088},
+      {"eight.off", 5544, 11092},
+      {"fertility.off", 4494, 9000},
+      {"Input_wheel.off", 27925, 55890},
+      {"cheese.off", 8629, 17786},
+      {"bun_zipper.ply", 35947, 69451},
+      {"face.obj", 25905, 51712},
+      {"camelhead.off", 11381, 22704},
+      {"half-torus.obj", 300, 576},
+      {"circle.obj", 5201, 10240},
+      {"dragon_vrip.ply", 437645, 871414},
+      {"truck.obj", 2956, 4770},
+      {"mobius.obj", 9900, 19602},
+      {"capsule.obj", 5252, 10200},
+      {"teapot.obj", 3644, 6320},
+      {"bones.off", 2154, 4204},
+      {"dragon_vrip_res3.ply", 22998, 47794},
+      {"blobby-shuffled.off", 2027, 4050},
       {"hourglass_ico.obj", 23, 40},
   };
   std::size_t checked = 0;
@@ -1021,7 +1050,8 @@ TEST(SharedMeshes, CountsMatchTheTable) {
 
 TEST(SharedMeshes, DragonConvertsToBinaryPlyIdentically) {
   const fs::path shared = shared_meshes_or_skip();
-  if (shared.empty()) GTEST_SKIP() << "shared meshes not found (TRIVCON_SHARED_MESHES = " << (kSharedMeshes ? kSharedMeshes : "undefined") << ")";
+  if (shared.empty())
+    GTEST_SKIP() << "shared meshes not found (TRIVCON_SHARED_MESHES = " << (kSharedMeshes ? kSharedMeshes : "undefined") << ")";
   const fs::path dir = test_dir();
   const MeshData ascii = trivcon::read_mesh((shared / "dragon_vrip.ply").string());
   const std::string binary_path = (dir / "dragon_binary.ply").string();
@@ -1036,7 +1066,8 @@ TEST(SharedMeshes, DragonConvertsToBinaryPlyIdentically) {
 
 TEST(SharedMeshes, GzippedCopyReadsIdentically) {
   const fs::path shared = shared_meshes_or_skip();
-  if (shared.empty()) GTEST_SKIP() << "shared meshes not found (TRIVCON_SHARED_MESHES = " << (kSharedMeshes ? kSharedMeshes : "undefined") << ")";
+  if (shared.empty())
+    GTEST_SKIP() << "shared meshes not found (TRIVCON_SHARED_MESHES = " << (kSharedMeshes ? kSharedMeshes : "undefined") << ")";
   const fs::path dir = test_dir();
   for (const char* file : {"kitten.off", "bob_small.ply", "spot.obj"}) {
     const std::string original = read_bytes(shared / file);

@@ -320,7 +320,8 @@ void check_streamlines(const Scene& s, const std::vector<Streamline>& lines) {
       }
       worst_angle = std::max(worst_angle, best);
       for (auto [v, n] : s.prescription.vertex)
-        nearest_singularity = std::min(nearest_singularity, distance_to_segment(s.mesh.V.row(v).transpose(), line.points[i], line.points[i + 1]));
+        nearest_singularity =
+            std::min(nearest_singularity, distance_to_segment(s.mesh.V.row(v).transpose(), line.points[i], line.points[i + 1]));
     }
   }
   EXPECT_LE(worst_bary, 1e-9);
@@ -421,9 +422,9 @@ TEST(RenderCli, WritesAPngOfTheRequestedSize) {
   const test::CommandResult solved = test::run_cli("solve '" + dir + "/cube.obj' -N 4" + sings + " --field-out '" + dir + "/f.txt' -q");
   ASSERT_EQ(solved.status, 0) << solved.err;
 
-  const test::CommandResult r = test::run_cli("render '" + dir + "/cube.obj' --field '" + dir + "/f.txt' -o '" + dir +
-                                              "/a.png' --size 320x240 --view 45,30 --style streamlines --streamlines-out '" + dir +
-                                              "/lines.obj'");
+  const test::CommandResult r =
+      test::run_cli("render '" + dir + "/cube.obj' --field '" + dir + "/f.txt' -o '" + dir +
+                    "/a.png' --size 320x240 --view 45,30 --style streamlines --streamlines-out '" + dir + "/lines.obj'");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(png_size(slurp(dir + "/a.png")), std::make_pair(320, 240));
   const std::string obj = slurp(dir + "/lines.obj");

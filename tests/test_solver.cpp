@@ -19,14 +19,14 @@ using test::vertices_of_valence;
 
 namespace {
 
-
 // Interior vertices spread over the mesh, deterministic.
 std::vector<int> spread_interior_vertices(const Topology& t, int count, int component = -1) {
   std::vector<int> candidates;
   for (int v = 0; v < t.num_vertices; ++v)
     if (t.is_interior_vertex(v) && (component < 0 || t.vertex_component[v] == component)) candidates.push_back(v);
   std::vector<int> out;
-  for (int i = 0; i < count; ++i) out.push_back(candidates[(static_cast<size_t>(i) * candidates.size()) / count + candidates.size() / (2 * count)]);
+  for (int i = 0; i < count; ++i)
+    out.push_back(candidates[(static_cast<size_t>(i) * candidates.size()) / count + candidates.size() / (2 * count)]);
   return out;
 }
 
@@ -190,9 +190,8 @@ TEST(Solver, SparseAndFullForwardSubstitutionsAgreeWithQr) {
     std::string name;
     Mesh mesh;
   };
-  const std::vector<Mesh_> meshes = {{"cube_sphere", make_cube_sphere(24, true)},
-                                     {"torus", make_torus(96, 40)},
-                                     {"grid_two_holes", make_holed_grid(60, 2)}};
+  const std::vector<Mesh_> meshes = {
+      {"cube_sphere", make_cube_sphere(24, true)}, {"torus", make_torus(96, 40)}, {"grid_two_holes", make_holed_grid(60, 2)}};
   for (const Mesh_& m : meshes) {
     SCOPED_TRACE(m.name);
     FieldDesigner chol(m.mesh.V, m.mesh.F);
@@ -200,7 +199,7 @@ TEST(Solver, SparseAndFullForwardSubstitutionsAgreeWithQr) {
     const Topology& t = chol.topology();
     int interior = 0;
     for (int v = 0; v < t.num_vertices; ++v) interior += t.is_interior_vertex(v);
-    ASSERT_GE(interior, 64 * 8);  // so that 8 singularities take the sparse route, interior / 50 the full one
+    ASSERT_GE(interior, 64 * 8);                // so that 8 singularities take the sparse route, interior / 50 the full one
     for (int count : {1, 4, interior / 100}) {  // the last one changes too many rows: full substitution
       SCOPED_TRACE(count);
       IndexPrescription p = gauss_bonnet_prescription(t, 4);  // the sphere's eight +1/4
@@ -409,7 +408,8 @@ TEST(Solver, PrescribedLoopIndices) {
     d.design(all);
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "the indices on component 0 (vertices and boundary loops) sum to 0, but Gauss-Bonnet needs its Euler characteristic -1");
+    EXPECT_STREQ(e.what(),
+                 "the indices on component 0 (vertices and boundary loops) sum to 0, but Gauss-Bonnet needs its Euler characteristic -1");
   }
 }
 
@@ -588,10 +588,10 @@ TEST(Solver, PrescriptionErrors) {
 // Every valid shared mesh: N = 4 with singularities summing to χ on closed components.
 TEST(Solver, SharedMeshes) {
   TRIVCON_REQUIRE_SHARED();
-  for (const std::string name : {"spot.obj", "bunny_closed.obj", "torus.obj", "kitten.off", "bob_small.ply", "rocker-arm.obj",
-                                 "eight.off", "fertility.off", "Input_wheel.off", "cheese.off", "bun_zipper.ply", "face.obj",
-                                 "camelhead.off", "half-torus.obj", "circle.obj", "capsule.obj", "bones.off", "blobby-shuffled.off",
-                                 "armadillo.obj", "dragon_vrip.ply"}) {
+  for (const std::string name :
+       {"spot.obj",      "bunny_closed.obj", "torus.obj",  "kitten.off",          "bob_small.ply", "rocker-arm.obj", "eight.off",
+        "fertility.off", "Input_wheel.off",  "cheese.off", "bun_zipper.ply",      "face.obj",      "camelhead.off",  "half-torus.obj",
+        "circle.obj",    "capsule.obj",      "bones.off",  "blobby-shuffled.off", "armadillo.obj", "dragon_vrip.ply"}) {
     SCOPED_TRACE(name);
     const MeshData mesh = read_mesh(test::shared_mesh(name));
     FieldDesigner d(mesh.V, mesh.F);

@@ -152,8 +152,10 @@ TEST(Supernodal, SameBitsEveryTime) {
     cholmod_factor* L = cholmod_copy_factor(symbolic, &cm.c);
     ASSERT_EQ(supernodal::factorize(*L, M.outer, M.inner, M.values, cm.c), M.n);
     const double* x = static_cast<const double*>(L->x);
-    if (run == 0) first.assign(x, x + L->xsize);
-    else EXPECT_TRUE(std::equal(first.begin(), first.end(), x)) << "run " << run;
+    if (run == 0)
+      first.assign(x, x + L->xsize);
+    else
+      EXPECT_TRUE(std::equal(first.begin(), first.end(), x)) << "run " << run;
     cholmod_free_factor(&L, &cm.c);
   }
   cholmod_free_factor(&symbolic, &cm.c);

@@ -77,8 +77,8 @@ Mesh mobius_strip(int n) {
   m.V.resize(2 * n, 3);
   for (int i = 0; i < n; ++i) {
     const double u = 2 * kPi * i / n;
-    const Eigen::Vector3d c(std::cos(u), std::sin(u), 0), d(0.3 * std::cos(u / 2) * std::cos(u), 0.3 * std::cos(u / 2) * std::sin(u),
-                                                           0.3 * std::sin(u / 2));
+    const Eigen::Vector3d c(std::cos(u), std::sin(u), 0),
+        d(0.3 * std::cos(u / 2) * std::cos(u), 0.3 * std::cos(u / 2) * std::sin(u), 0.3 * std::sin(u / 2));
     m.V.row(2 * i) = c + d;
     m.V.row(2 * i + 1) = c - d;
   }
@@ -178,7 +178,7 @@ TEST(TopologyCounts, SurfacesWithBoundary) {
 }
 
 TEST(TopologyCounts, ConcatenationGivesComponentsNumberedBySmallestFace) {
-  const std::vector<Mesh> parts = {make_icosphere(1), make_torus(6, 5), make_disk(2, 5), make_genus_surface(2, 1),
+  const std::vector<Mesh> parts = {make_icosphere(1),  make_torus(6, 5),      make_disk(2, 5),         make_genus_surface(2, 1),
                                    make_annulus(2, 8), make_holed_grid(7, 2), make_genus_surface(3, 1)};
   const std::vector<int> chi = {2, 0, 1, -2, 0, -1, -4}, genus = {0, 1, 0, 2, 0, 0, 3}, loops = {0, 0, 1, 0, 2, 3, 0};
   const Mesh all = concatenate(parts);
@@ -306,8 +306,10 @@ TEST(TopologyEdges, NumberedInOrderOfFirstAppearance) {
     for (int f = 0; f < t.num_faces; ++f)
       for (int k = 0; k < 3; ++k) {
         const int e = t.face_edges(f, k);
-        if (e == next) ++next;
-        else bad += e > next;
+        if (e == next)
+          ++next;
+        else
+          bad += e > next;
       }
     EXPECT_EQ(bad, 0);
     EXPECT_EQ(next, t.num_edges);
@@ -446,8 +448,15 @@ struct Signature {
 };
 
 Signature signature(const Topology& t) {
-  Signature s{t.num_vertices, t.num_faces, t.num_edges, static_cast<int>(t.components.size()), static_cast<int>(t.boundary_loops.size()),
-              t.euler_characteristic(), static_cast<int>(t.unreferenced_vertices.size()), {}, {}};
+  Signature s{t.num_vertices,
+              t.num_faces,
+              t.num_edges,
+              static_cast<int>(t.components.size()),
+              static_cast<int>(t.boundary_loops.size()),
+              t.euler_characteristic(),
+              static_cast<int>(t.unreferenced_vertices.size()),
+              {},
+              {}};
   for (const auto& c : t.components)
     s.components.insert({c.faces, c.vertices, c.edges, c.euler_characteristic, c.genus, static_cast<int>(c.boundary_loops.size())});
   for (const auto& l : t.boundary_loops) s.loop_lengths.insert(l.size());
@@ -456,7 +465,12 @@ Signature signature(const Topology& t) {
 
 TEST(TopologyPermutation, ChangesNoCount) {
   const std::vector<Mesh> meshes = {
-      make_icosphere(2), make_torus(8, 6), make_genus_surface(2, 1), make_disk(4, 4), make_annulus(2, 9), make_holed_grid(10, 3),
+      make_icosphere(2),
+      make_torus(8, 6),
+      make_genus_surface(2, 1),
+      make_disk(4, 4),
+      make_annulus(2, 9),
+      make_holed_grid(10, 3),
       concatenate({make_icosphere(0), make_genus_surface(1, 1), make_disk(2, 3), make_holed_grid(7, 3), make_annulus(1, 5)}),
   };
   for (size_t i = 0; i < meshes.size(); ++i) {
@@ -512,8 +526,8 @@ TEST(TopologyErrors, NonManifoldEdge) {
   F << m.F, faces({{a, b, nv}});
   const int lo = std::min(10, neighbour), hi = std::max(10, neighbour);
   EXPECT_EQ(topology_error(F, nv + 1), "non-manifold edge (" + std::to_string(std::min(a, b)) + ", " + std::to_string(std::max(a, b)) +
-                                            ") shared by 3 faces (" + std::to_string(lo) + ", " + std::to_string(hi) + ", " +
-                                            std::to_string(m.F.rows()) + ")");
+                                           ") shared by 3 faces (" + std::to_string(lo) + ", " + std::to_string(hi) + ", " +
+                                           std::to_string(m.F.rows()) + ")");
   // Duplicate faces are three... no: two copies of a face are a manifold pair; three copies are not.
   EXPECT_EQ(topology_error(faces({{0, 1, 2}, {0, 1, 2}, {0, 1, 2}}), 3), "non-manifold edge (0, 1) shared by 3 faces (0, 1, 2)");
 }
@@ -542,7 +556,8 @@ TEST(TopologyErrors, NonManifoldVertex) {
 // faces contain the edge.
 void expect_orientation_witness(const std::string& message, const MatrixX3i& F) {
   std::smatch mt;
-  ASSERT_TRUE(std::regex_search(message, mt, std::regex(R"(faces (\d+) and (\d+) cannot be oriented consistently across edge \((\d+), (\d+)\)$)")))
+  ASSERT_TRUE(
+      std::regex_search(message, mt, std::regex(R"(faces (\d+) and (\d+) cannot be oriented consistently across edge \((\d+), (\d+)\)$)")))
       << message;
   const int f = std::stoi(mt[1]), g = std::stoi(mt[2]), a = std::stoi(mt[3]), b = std::stoi(mt[4]);
   EXPECT_LT(f, g);
@@ -610,8 +625,9 @@ TEST(TopologyErrors, NonOrientableMessageMatchesTheHeader) {
   const Mesh m = concatenate({make_icosphere(0), mobius_strip(8)});  // the strip: faces 20..35, vertices 12..27
   const std::string e = topology_error(m.F, static_cast<int>(m.V.rows()));
   std::smatch mt;
-  ASSERT_TRUE(std::regex_match(e, mt, std::regex(R"(non-orientable component 1 \(containing face 20\): faces (\d+) and (\d+) )"
-                                                 R"(cannot be oriented consistently across edge \((\d+), (\d+)\))")))
+  ASSERT_TRUE(std::regex_match(e, mt,
+                               std::regex(R"(non-orientable component 1 \(containing face 20\): faces (\d+) and (\d+) )"
+                                          R"(cannot be oriented consistently across edge \((\d+), (\d+)\))")))
       << e;
   for (int k : {1, 2}) {
     EXPECT_GE(std::stoi(mt[k]), 20) << e;
@@ -823,8 +839,9 @@ TEST(TopologySharedMeshes, BrokenMeshesReportTheFirstProblem) {
       {"teapot.obj", "non-manifold vertex 66: its faces form 2 separate fans"},
       {"dragon_vrip_res3.ply", "non-manifold edge (6, 7) shared by 4 faces (6, 11, 12, 15)"},
       {"hourglass_ico.obj", "non-manifold vertex 22: its faces form 2 separate fans"},
-      {"mobius.obj", "non-orientable component 0 (containing face 0): faces 8209 and 8212 cannot be oriented consistently across edge "
-                     "(4650, 4750)"},
+      {"mobius.obj",
+       "non-orientable component 0 (containing face 0): faces 8209 and 8212 cannot be oriented consistently across edge "
+       "(4650, 4750)"},
   };
   for (const auto& b : broken) {
     SCOPED_TRACE(b.file);

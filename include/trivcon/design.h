@@ -39,10 +39,10 @@ namespace trivcon {
 struct Design {
   Connection connection;
   Field field;
-  FieldIndices indices;                  // read back from the field
-  double transport_mismatch = 0;         // max over dual edges, radians (mod 2π/N)
+  FieldIndices indices;                      // read back from the field
+  double transport_mismatch = 0;             // max over dual edges, radians (mod 2π/N)
   std::vector<int> index_mismatch_vertices;  // interior vertices whose field index differs from the prescription
-  int large_turn_edges = 0;              // edges with |x_e| ≥ π/N (where a field cannot show the index)
+  int large_turn_edges = 0;                  // edges with |x_e| ≥ π/N (where a field cannot show the index)
   // Mismatches at vertices none of whose edges turns by π/N or more (less 1e-9): these would be real errors.
   std::vector<int> unexplained_mismatch_vertices;
   double max_fixed_error = 0;            // largest |field − fixed direction| modulo 2π/N over fixed faces
@@ -73,7 +73,7 @@ class FieldDesigner {
   const Geometry& geometry() const { return geometry_; }
   const Cycles& cycles() const { return cycles_; }
   const PropagationPlan& plan() const { return plan_; }  // the field's spanning trees (trivcon/field.h)
-  const ConnectionSolver& solver() const;  // set up on first use
+  const ConnectionSolver& solver() const;                // set up on first use
   const PrepareTimings& timings() const { return timings_; }
 
  private:

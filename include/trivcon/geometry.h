@@ -30,17 +30,17 @@
 namespace trivcon {
 
 struct Geometry {
-  MatrixX3d corner_angles;     // F × 3
-  MatrixX3d half_edge_angle;   // F × 3
-  Eigen::VectorXd face_area;   // extrinsic area, 0 for degenerate faces
+  MatrixX3d corner_angles;    // F × 3
+  MatrixX3d half_edge_angle;  // F × 3
+  Eigen::VectorXd face_area;  // extrinsic area, 0 for degenerate faces
   std::vector<char> degenerate_face;
   MatrixX3d frame_x, frame_y, normal;  // unit vectors; for a degenerate face the normal is borrowed from its neighbours
   Eigen::VectorXd angle_defect;        // per vertex
   Eigen::VectorXd rho;                 // per edge
   Eigen::VectorXd cotan_weight;        // per edge
   int negative_cotan_edges = 0;        // interior edges with ½(cot α + cot β) < 0 before clamping
-  int degenerate_faces = 0;           // faces treated as degenerate (see above)
-  int zero_area_faces = 0;            // faces whose extrinsic area is exactly 0
+  int degenerate_faces = 0;            // faces treated as degenerate (see above)
+  int zero_area_faces = 0;             // faces whose extrinsic area is exactly 0
 
   // Angle of the world vector `d` in face f's frame (its projection onto the face's plane).
   double angle_in_face(int f, const Eigen::Vector3d& d) const;

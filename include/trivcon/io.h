@@ -27,9 +27,9 @@ namespace trivcon {
 // A mesh as read from a file: V (vertex positions, file order) and F (triangles, file order after fan
 // triangulation) of trivcon::Mesh, plus where each triangle came from.
 struct MeshData : Mesh {
-  std::vector<int> polygon_of_triangle; // file polygon of each triangle
-  int polygon_count = 0;                // polygons in the file
-  std::string format;                   // "obj", "off", "ply-ascii", "ply-binary-le", "ply-binary-be"
+  std::vector<int> polygon_of_triangle;  // file polygon of each triangle
+  int polygon_count = 0;                 // polygons in the file
+  std::string format;                    // "obj", "off", "ply-ascii", "ply-binary-le", "ply-binary-be"
 };
 
 // Reads by extension: .obj .off .ply, each optionally followed by .gz (case-insensitive).

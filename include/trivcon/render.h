@@ -72,9 +72,9 @@ enum class FieldStyle { Hedgehog, Streamlines };
 // The colours the renderer uses (exposed so callers and tests can recognise them).
 struct Palette {
   Rgb background{255, 255, 255};
-  Rgb front{196, 206, 222};   // surface seen from the front, before shading
-  Rgb back{240, 170, 90};     // surface seen from behind, before shading
-  Rgb field{22, 28, 48};      // hedgehog glyphs and streamlines
+  Rgb front{196, 206, 222};  // surface seen from the front, before shading
+  Rgb back{240, 170, 90};    // surface seen from behind, before shading
+  Rgb field{22, 28, 48};     // hedgehog glyphs and streamlines
   Rgb boundary{30, 150, 60};
   Rgb positive{215, 35, 35};  // singularity with index > 0
   Rgb negative{30, 80, 215};  // index < 0
@@ -89,14 +89,14 @@ struct RenderOptions {
   double glyph_spacing = 11;  // pixels between glyphs or streamlines (at 900 pixels; scaled with the image)
   bool smooth_shading = true;
   bool legend = true;
-  int supersampling = 3;      // samples per pixel along each axis (anti-aliasing)
+  int supersampling = 3;  // samples per pixel along each axis (anti-aliasing)
   Palette palette;
 };
 
 struct Camera {
   Eigen::Vector3d eye, right, up, forward;  // orthonormal; forward points from the eye into the scene
-  double focal = 1;                          // pixels
-  double cx = 0, cy = 0;                     // image position of the optical axis
+  double focal = 1;                         // pixels
+  double cx = 0, cy = 0;                    // image position of the optical axis
   // (x, y, depth): image coordinates in pixels and the distance along `forward`.
   Eigen::Vector3d project(const Eigen::Vector3d& p) const;
   // World size of one pixel at `depth`.

@@ -17,12 +17,11 @@
 // interior vertices; on a closed component one vertex row is dropped (Gauss–Bonnet makes it redundant),
 // and on a component with boundary one loop row is (its index follows from the others). A W Aᵀ is
 // factored once (supernodal LLᵀ: CHOLMOD's symbolic analysis, our numeric factorization into CHOLMOD's
-// factor on two threads, src/detail/supernodal.h, or CHOLMOD's own with Factorization::Cholmod; OpenBLAS), the vertex rows in a fill-reducing order and the
-// cycle rows last, so that the trailing block of the factor is the Cholesky factor of the Schur complement S = CWCᵀ −
-// CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is minimum degree: CAMD with the cycle rows constrained last, or
-// AMD without cycle rows. A new prescription only changes b: nothing is refactored. The forward substitution
-// of the prescription without singularities is stored, so an edit that places a few singularities
-// updates it along their paths in the elimination tree only, then does one full backward substitution,
+// factor on two threads, src/detail/supernodal.h, or CHOLMOD's own with Factorization::Cholmod; OpenBLAS), the vertex rows in a
+// fill-reducing order and the cycle rows last, so that the trailing block of the factor is the Cholesky factor of the Schur complement S =
+// CWCᵀ − CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is minimum degree: CAMD with the cycle rows constrained last, or AMD without cycle rows. A new
+// prescription only changes b: nothing is refactored. The forward substitution of the prescription without singularities is stored, so an
+// edit that places a few singularities updates it along their paths in the elimination tree only, then does one full backward substitution,
 // on two threads (OpenMP; the top of the elimination tree first, then two sets of independent subtrees).
 // Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
 // system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
@@ -74,8 +73,8 @@ struct Connection {
   std::vector<int> loop_index;         // n per boundary loop, as used
   std::vector<char> generator_chosen;  // 1 where the solver chose the index
   std::vector<char> loop_chosen;
-  std::vector<int> path_turn;          // per fixed-face path, the whole number j of 1/N turns chosen
-  double energy = 0;                   // Σ x_e² / w_e
+  std::vector<int> path_turn;  // per fixed-face path, the whole number j of 1/N turns chosen
+  double energy = 0;           // Σ x_e² / w_e
   // Verification: largest |Σ coefficient · x − right-hand side| over all interior vertices (including
   // the dropped ones), all loops and all generators, and the scale of the right-hand sides.
   double max_vertex_residual = 0, max_cycle_residual = 0, rhs_scale = 0;

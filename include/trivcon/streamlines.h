@@ -36,9 +36,9 @@
 namespace trivcon {
 
 struct StreamlineOptions {
-  double separation = 0;  // distance between neighbouring lines, world units; 0: 1/50 of the bounding-box diagonal
-  double max_length = 0;  // per line and direction, world units; 0: 10 × the bounding-box diagonal
-  int max_steps = 200000; // faces crossed per line and direction
+  double separation = 0;     // distance between neighbouring lines, world units; 0: 1/50 of the bounding-box diagonal
+  double max_length = 0;     // per line and direction, world units; 0: 10 × the bounding-box diagonal
+  int max_steps = 200000;    // faces crossed per line and direction
   bool all_families = true;  // false: one line per seed (direction 0 of the seed's face) even for N ≥ 2
 };
 
@@ -50,9 +50,8 @@ struct Streamline {
 
 // Traces evenly spaced streamlines. `singularities` are (vertex, n) pairs (index n/N, as in
 // trivcon/indices.h); only the vertices matter here (lines stop next to them).
-std::vector<Streamline> trace_streamlines(const MatrixX3d& V, const Topology& topology, const Geometry& geometry,
-                                          const Field& field, const std::vector<std::pair<int, int>>& singularities,
-                                          const StreamlineOptions& options = {});
+std::vector<Streamline> trace_streamlines(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const Field& field,
+                                          const std::vector<std::pair<int, int>>& singularities, const StreamlineOptions& options = {});
 
 // Writes the lines as an OBJ: all points as "v x y z" (17 significant digits), then one "l i j k ..."
 // (1-based) per line. Atomic (trivcon/io.h); errors name the path.
@@ -65,7 +64,7 @@ struct SurfacePoint {
 // Points on the surface with pairwise distances ≥ `spacing` (a Poisson-disk-like set, about one per
 // spacing² of area), chosen in a fixed pseudo-random order among candidates spread by area;
 // `usable[f]` == 0 excludes face f (pass an empty vector to use all faces). Deterministic.
-std::vector<SurfacePoint> sample_surface(const MatrixX3d& V, const Topology& topology, const Geometry& geometry,
-                                         double spacing, const std::vector<char>& usable = {});
+std::vector<SurfacePoint> sample_surface(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, double spacing,
+                                         const std::vector<char>& usable = {});
 
 }  // namespace trivcon

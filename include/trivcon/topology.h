@@ -45,17 +45,17 @@ struct Topology {
   int num_vertices = 0;
   int num_faces = 0;
   int num_edges = 0;
-  MatrixX3i F;                 // consistently oriented faces (equal to the input where no flip was needed)
-  MatrixX2i edge_vertices;     // (i, j), i < j
-  MatrixX2i edge_faces;        // (L, R) as above, −1 for none
-  MatrixX3i face_edges;        // edge from corner k to k+1
+  MatrixX3i F;              // consistently oriented faces (equal to the input where no flip was needed)
+  MatrixX2i edge_vertices;  // (i, j), i < j
+  MatrixX2i edge_faces;     // (L, R) as above, −1 for none
+  MatrixX3i face_edges;     // edge from corner k to k+1
   std::vector<int> face_component;
-  std::vector<int> vertex_component;         // −1 for unreferenced vertices
-  std::vector<int> vertex_boundary_loop;     // loop id for boundary vertices, −1 otherwise
+  std::vector<int> vertex_component;      // −1 for unreferenced vertices
+  std::vector<int> vertex_boundary_loop;  // loop id for boundary vertices, −1 otherwise
   std::vector<std::vector<int>> boundary_loops;
   std::vector<ComponentInfo> components;
   std::vector<int> unreferenced_vertices;
-  std::vector<int> flipped_faces;            // faces whose orientation was reversed
+  std::vector<int> flipped_faces;  // faces whose orientation was reversed
   // CSR adjacency: the faces around each vertex, and the edges at each vertex (unordered).
   std::vector<int> vertex_face_offsets, vertex_faces;
   std::vector<int> vertex_edge_offsets, vertex_edges;

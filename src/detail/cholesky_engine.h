@@ -50,8 +50,9 @@ void analyse(const Csc& M, int nD, int nC, AnalysisState& state);
 // factorization once A W Aᵀ is assembled; it is used if it was made for this pattern.
 // Throws trivcon::Error when the system is not positive definite (naming the cycle rows when they are
 // the cause) or the Schur complement is too ill-conditioned to choose free indices.
-std::unique_ptr<SolverEngine> make_cholesky_engine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et, const SparseMatrix& Ct,
-                                                   const Eigen::VectorXd& w, Factorization factorization, SetupTimings& timings,
+std::unique_ptr<SolverEngine> make_cholesky_engine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et,
+                                                   const SparseMatrix& Ct, const Eigen::VectorXd& w, Factorization factorization,
+                                                   SetupTimings& timings,
                                                    const std::function<std::unique_ptr<AnalysisState>()>& analysis = {});
 
 }  // namespace trivcon::detail

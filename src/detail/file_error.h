@@ -8,9 +8,7 @@
 
 namespace trivcon::detail {
 
-[[noreturn]] inline void fail(const std::string& name, const std::string& message) {
-  throw Error(name + ": " + message);
-}
+[[noreturn]] inline void fail(const std::string& name, const std::string& message) { throw Error(name + ": " + message); }
 
 [[noreturn]] inline void fail_at_line(const std::string& name, std::size_t line, const std::string& message) {
   throw Error(name + ":" + std::to_string(line) + ": " + message);

@@ -21,7 +21,7 @@ Eigen::VectorXi babai_round(const Eigen::MatrixXd& T, bool lower, const Eigen::V
 // Minimises (u − n₀ − M t)ᵀ P (u − n₀ − M t) over integer t. `identity`: M = I (every cycle row free,
 // the usual case of editing singularities), which costs O(|C|²) per step through the engine's P products;
 // otherwise P is formed.
-Eigen::VectorXi nearest_lattice_point(const SolverEngine& engine, const Eigen::VectorXd& u, const Eigen::VectorXd& n0, const Eigen::MatrixXd& M,
-                                      bool identity);
+Eigen::VectorXi nearest_lattice_point(const SolverEngine& engine, const Eigen::VectorXd& u, const Eigen::VectorXd& n0,
+                                      const Eigen::MatrixXd& M, bool identity);
 
 }  // namespace trivcon::detail

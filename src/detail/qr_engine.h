@@ -12,6 +12,7 @@ namespace trivcon::detail {
 
 // Dt (m × nD) and Ct (m × nC): the transposed vertex and cycle rows over the system edges, w their weights.
 // Throws trivcon::Error when the system is rank deficient.
-std::unique_ptr<SolverEngine> make_qr_engine(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w, SetupTimings& timings);
+std::unique_ptr<SolverEngine> make_qr_engine(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w,
+                                             SetupTimings& timings);
 
 }  // namespace trivcon::detail

@@ -38,8 +38,12 @@ struct Supernodes {
   const double* x;
   int count;
   explicit Supernodes(const cholmod_factor* L)
-      : super(static_cast<const int*>(L->super)), pi(static_cast<const int*>(L->pi)), px(static_cast<const int*>(L->px)),
-        rows(static_cast<const int*>(L->s)), x(static_cast<const double*>(L->x)), count(static_cast<int>(L->nsuper)) {}
+      : super(static_cast<const int*>(L->super)),
+        pi(static_cast<const int*>(L->pi)),
+        px(static_cast<const int*>(L->px)),
+        rows(static_cast<const int*>(L->s)),
+        x(static_cast<const double*>(L->x)),
+        count(static_cast<int>(L->nsuper)) {}
   int first(int s) const { return super[s]; }
   int cols(int s) const { return super[s + 1] - super[s]; }
   int height(int s) const { return pi[s + 1] - pi[s]; }

@@ -131,11 +131,11 @@ class TextScanner {
   bool hash_comments_;
   bool continuation_;
   std::string_view line_;
-  std::size_t pos_ = 0;           // cursor in line_
-  std::size_t next_ = 0;          // offset of the next physical line in text_
+  std::size_t pos_ = 0;   // cursor in line_
+  std::size_t next_ = 0;  // offset of the next physical line in text_
   std::size_t physical_lines_ = 0;
-  std::size_t line_number_ = 0;   // first physical line of the current logical line
-  std::string joined_;            // storage for a line joined from backslash continuations
+  std::size_t line_number_ = 0;  // first physical line of the current logical line
+  std::string joined_;           // storage for a line joined from backslash continuations
 };
 
 }  // namespace trivcon::detail
