@@ -33,7 +33,11 @@ std::vector<fs::path> directory_files(const std::string& path) {
 std::vector<BatchItem> read_directory(const std::string& path, const IndexPrescription& base) {
   std::vector<BatchItem> items;
   for (const fs::path& f : directory_files(path)) {
-    BatchItem item{f.stem().string(), base};
+    BatchItem item{f.stem().string(), base, f.filename().string()};
+    for (const BatchItem& other : items)  // outputs are named by the item: two of a name would overwrite each other
+      if (other.name == item.name)
+        throw Error("--sing-batch " + path + ": files '" + other.source + "' and '" + f.filename().string() + "' have the same name '" +
+                    item.name + "'");
     item.prescription.vertex.clear();
     read_singularities(f.string(), item.prescription);
     items.push_back(std::move(item));
@@ -57,8 +61,10 @@ std::vector<BatchItem> read_json_lines(const std::string& path, const IndexPresc
     }
     if (!j.is_object() || !j.contains("name") || !j["name"].is_string() || !j.contains("sing") || !j["sing"].is_object())
       throw Error(where + ": expected {\"name\": \"...\", \"sing\": {\"VERTEX\": \"INDEX\", ...}}");
-    BatchItem item{j["name"].get<std::string>(), base};
+    BatchItem item{j["name"].get<std::string>(), base, "line " + std::to_string(line_no)};
     if (item.name.empty() || item.name.find('/') != std::string::npos) throw Error(where + ": the name must be non-empty without '/'");
+    for (const BatchItem& other : items)  // outputs are named by the item: two of a name would overwrite each other
+      if (other.name == item.name) throw Error(where + ": the name '" + item.name + "' is already used on " + other.source);
     item.prescription.vertex.clear();
     auto add = [&](const char* key, void (*adder)(const std::string&, IndexPrescription&)) {
       if (!j.contains(key)) return;

@@ -63,7 +63,8 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   const ReportRun run{o.mesh, name, o.weights, o.solver, o.align_boundary, read_seconds, seconds_since(t1), ok};
   if (!o.out.report.empty()) {
     const nlohmann::ordered_json report = solve_report(run, mesh, designer, prescription, d);
-    write_file_atomically(staged.path(output_path(o.out.report, name)), [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+    staged.write(output_path(o.out.report, name),
+                 [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& out) { out << report.dump(2) << "\n"; }); });
   }
   staged.commit();
 

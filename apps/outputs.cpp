@@ -1,6 +1,7 @@
 #include "outputs.h"
 
 #include <filesystem>
+#include <functional>
 #include <system_error>
 
 #include "trivcon/error.h"
@@ -19,11 +20,19 @@ std::string output_path(const std::string& path, const std::string& name) {
   return path.substr(0, dot) + "." + name + path.substr(dot);
 }
 
-std::string StagedOutputs::path(const std::string& final_path) {
+void StagedOutputs::write(const std::string& final_path, const std::function<void(const std::string&)>& writer) {
   // Same folder (so the rename is atomic) and same ending (writers choose the format by extension).
   const std::filesystem::path p(final_path);
-  staged_.emplace_back((p.parent_path() / (".trivcon-partial." + p.filename().string())).string(), final_path);
-  return staged_.back().first;
+  const std::string temp = (p.parent_path() / (".trivcon-partial." + p.filename().string())).string();
+  staged_.emplace_back(temp, final_path);
+  try {
+    writer(temp);
+  } catch (const Error& e) {  // the user named final_path, not our temporary
+    std::string message = e.what();
+    for (size_t at = message.find(temp); at != std::string::npos; at = message.find(temp, at + final_path.size()))
+      message.replace(at, temp.size(), final_path);
+    throw Error(message);
+  }
 }
 
 void StagedOutputs::commit() {
@@ -45,13 +54,17 @@ StagedOutputs::~StagedOutputs() {
 void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const std::string& name, const MeshData& mesh,
                           const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d) {
   const Geometry& g = designer.geometry();
-  if (!paths.field.empty()) write_field(staged.path(output_path(paths.field, name)), mesh.V, mesh.F, g, d.field);
+  if (!paths.field.empty())
+    staged.write(output_path(paths.field, name), [&](const std::string& path) { write_field(path, mesh.V, mesh.F, g, d.field); });
   if (!paths.connection.empty())
-    write_connection(staged.path(output_path(paths.connection, name)), designer.topology(), d.connection.x, prescription.N);
-  if (!paths.lines.empty()) write_field_lines(staged.path(output_path(paths.lines, name)), mesh.V, mesh.F, g, d.field);
+    staged.write(output_path(paths.connection, name),
+                 [&](const std::string& path) { write_connection(path, designer.topology(), d.connection.x, prescription.N); });
+  if (!paths.lines.empty())
+    staged.write(output_path(paths.lines, name), [&](const std::string& path) { write_field_lines(path, mesh.V, mesh.F, g, d.field); });
   if (!paths.png.empty()) {  // the prescription's singularities, drawn with the default view of `trivcon render`
     std::vector<std::pair<int, int>> singular(prescription.vertex.begin(), prescription.vertex.end());
-    write_png(staged.path(output_path(paths.png, name)), render_field(mesh.V, designer.topology(), g, d.field, singular));
+    staged.write(output_path(paths.png, name),
+                 [&](const std::string& path) { write_png(path, render_field(mesh.V, designer.topology(), g, d.field, singular)); });
   }
 }
 

@@ -2,6 +2,7 @@
 // (atomically) beside its final path under a temporary name, and all are renamed into place once every
 // one was written.
 #pragma once
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,8 +23,8 @@ std::string output_path(const std::string& path, const std::string& name);
 
 class StagedOutputs {
  public:
-  // The temporary name to write `final_path` under.
-  std::string path(const std::string& final_path);
+  // Calls writer(temporary) for `final_path`; an error it throws names final_path, not the temporary.
+  void write(const std::string& final_path, const std::function<void(const std::string&)>& writer);
   // Renames every staged file into place; throws trivcon::Error naming a file that cannot be.
   void commit();
   // Removes the staged files not committed.

@@ -102,6 +102,9 @@ void read_singularities(const std::string& path, IndexPrescription& p) {
       continue;
     }
     const int v = parse_id(a, "vertex", where);
+    long long whole = 0;
+    if (directional && !parse_long(b, whole))
+      throw Error(where + ": malformed index '" + b + "' (a .sings file gives a whole number n for the index n/N)");
     const int n = directional ? parse_index(b + "/" + std::to_string(file_N), p.N, where) : parse_index(b, p.N, where);
     insert_once(p.vertex, v, n, "vertex", where);
     ++seen;
