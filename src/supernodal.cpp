@@ -269,6 +269,8 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
               cholmod_common& c) {
   const int n = static_cast<int>(L.n);
   if (!L.is_super) throw Error("internal: the numeric factorization needs a supernodal symbolic factor");
+  // The super, pi, px and s arrays are read as int (CHOLMOD's int API; src/detail/cholmod.h checks the version).
+  if (L.itype != CHOLMOD_INT) throw Error("internal: the numeric factorization needs a factor of CHOLMOD's int API");
   // Allocates the values (L.xsize) and marks L numeric LLᵀ, as cholmod_super_numeric does.
   if (!cholmod_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, &L, &c) || L.x == nullptr)
     throw Error("CHOLMOD could not allocate the factor (status " + std::to_string(c.status) + ")");

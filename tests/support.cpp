@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include "trivcon/io.h"
 #include "trivcon/error.h"
 
 namespace trivcon::test {
@@ -47,6 +49,54 @@ std::string temp_file(const std::string& name) {
   const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
   const std::string owner = test ? std::string(test->test_suite_name()) + "." + test->name() : "no-test";
   return temp_dir(owner + "-" + std::to_string(counter++)) + "/" + name;
+}
+
+Mesh mobius_strip(int n) {
+  Mesh m;
+  m.V.resize(2 * n, 3);
+  for (int i = 0; i < n; ++i) {
+    const double u = 2 * kPi * i / n;
+    const Eigen::Vector3d c(std::cos(u), std::sin(u), 0),
+        d(0.3 * std::cos(u / 2) * std::cos(u), 0.3 * std::cos(u / 2) * std::sin(u), 0.3 * std::sin(u / 2));
+    m.V.row(2 * i) = c + d;
+    m.V.row(2 * i + 1) = c - d;
+  }
+  std::vector<std::array<int, 3>> f;
+  for (int i = 0; i < n; ++i) {
+    const int a = 2 * i, b = 2 * i + 1;
+    const int c = i + 1 < n ? 2 * (i + 1) + 1 : 0, d = i + 1 < n ? 2 * (i + 1) : 1;
+    f.push_back({a, b, c});
+    f.push_back({a, c, d});
+  }
+  m.F = faces(f);
+  return m;
+}
+
+std::string q(const std::string& s) { return "'" + s + "'"; }
+std::string test_name_of(const std::string& file) {
+  std::string name = file;
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return name;
+}
+bool starts_with(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::string save(const std::string& dir, const std::string& name, const Mesh& m, bool ply) {
+  const std::string path = dir + "/" + name + (ply ? ".ply" : ".obj");
+  if (ply) {
+    write_ply(path, m.V, m.F);
+  } else {
+    write_obj(path, m.V, m.F);
+  }
+  return path;
 }
 
 std::string slurp(const std::string& path) {

@@ -25,6 +25,19 @@ std::string temp_dir(const std::string& name);
 // A path ending in `name` in a fresh directory of its own, named after the running test (ctest runs the
 // tests of one program in parallel processes, so fixed directory names would collide).
 std::string temp_file(const std::string& name);
+// A Möbius strip of `n` quads (2n triangles, 2n vertices): rails top_i = 2i, bottom_i = 2i + 1; the
+// last quad joins (top, bottom) of step n − 1 to (bottom, top) of step 0.
+Mesh mobius_strip(int n);
+
+// For the command-line tests: a shell-quoted argument ('…'), string tests, the lines of a text, and a
+// mesh written into `dir` as OBJ (or binary PLY when `ply`), returning its path.
+std::string q(const std::string& s);
+// A GoogleTest parameter name for a file name: letters and digits kept, everything else '_'.
+std::string test_name_of(const std::string& file);
+bool starts_with(const std::string& s, const std::string& prefix);
+bool contains(const std::string& s, const std::string& part);
+std::vector<std::string> lines_of(const std::string& text);
+std::string save(const std::string& dir, const std::string& name, const Mesh& m, bool ply = false);
 // The bytes of a file ("" when it cannot be read), and a file written with exactly `text`.
 std::string slurp(const std::string& path);
 void write_text(const std::string& path, const std::string& text);

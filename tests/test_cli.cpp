@@ -28,36 +28,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using test::CommandResult;
-using test::run_cli;
-using test::slurp;
-using test::write_text;
+using namespace test;  // run_cli, q, save, slurp, … (tests/support.h)
 
 const std::string kError = "trivcon: error: ";
-
-std::string q(const std::string& s) { return "'" + s + "'"; }
-
-bool starts_with(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  std::string line;
-  while (std::getline(in, line)) lines.push_back(line);
-  return lines;
-}
-
-// Writes `m` as OBJ (or binary PLY when `ply`) into `dir`.
-std::string save(const std::string& dir, const std::string& name, const Mesh& m, bool ply = false) {
-  const std::string path = dir + "/" + name + (ply ? ".ply" : ".obj");
-  if (ply) {
-    write_ply(path, m.V, m.F);
-  } else {
-    write_obj(path, m.V, m.F);
-  }
-  return path;
-}
 
 // Runs `trivcon info PATH --json [--cycles]`, expecting success, and parses stdout.
 json info_json(const std::string& path, bool cycles = false) {
@@ -99,23 +72,6 @@ Mesh with_extra_vertices(const Mesh& m, int extra) {
   out.V.conservativeResize(m.V.rows() + extra, 3);
   for (int i = 0; i < extra; ++i) out.V.row(m.V.rows() + i) << 5.0 + i, 5.0, 5.0;
   return out;
-}
-
-Mesh mobius_strip(int n) {
-  Mesh m;
-  m.V.resize(2 * n, 3);
-  m.F.resize(2 * n, 3);
-  for (int i = 0; i < n; ++i) {
-    const double u = 2 * kPi * i / n;
-    const Eigen::Vector3d c(std::cos(u), std::sin(u), 0),
-        d(0.3 * std::cos(u / 2) * std::cos(u), 0.3 * std::cos(u / 2) * std::sin(u), 0.3 * std::sin(u / 2));
-    m.V.row(2 * i) = c + d;
-    m.V.row(2 * i + 1) = c - d;
-    const int a = 2 * i, b = 2 * i + 1, cc = i + 1 < n ? 2 * (i + 1) + 1 : 0, dd = i + 1 < n ? 2 * (i + 1) : 1;
-    m.F.row(2 * i) << a, b, cc;
-    m.F.row(2 * i + 1) << a, cc, dd;
-  }
-  return m;
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -364,12 +320,8 @@ TEST_P(CliSharedInfo, JsonCountsMatchSources) {
   EXPECT_EQ(chi, x.chi);
 }
 
-INSTANTIATE_TEST_SUITE_P(CliShared, CliSharedInfo, ::testing::ValuesIn(kValid), [](const auto& info) {
-  std::string name = info.param.file;
-  for (char& c : name)
-    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-  return name;
-});
+INSTANTIATE_TEST_SUITE_P(CliShared, CliSharedInfo, ::testing::ValuesIn(kValid),
+                         [](const auto& info) { return test::test_name_of(info.param.file); });
 
 TEST(CliSharedMeshes, BrokenMeshesFailCleanly) {
   TRIVCON_REQUIRE_SHARED();

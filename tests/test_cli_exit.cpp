@@ -19,21 +19,10 @@ namespace trivcon {
 namespace {
 
 namespace fs = std::filesystem;
-using test::CommandResult;
-using test::run_cli;
+using namespace test;  // run_cli, q, save, slurp, … (tests/support.h)
 
 const std::string kError = "trivcon: error: ";
 const std::string kRunWithHelp = "Run with --help for more information.\n";
-
-std::string q(const std::string& s) { return "'" + s + "'"; }
-
-bool starts_with(const std::string& s, const std::string& prefix) { return s.rfind(prefix, 0) == 0; }
-
-std::string save(const std::string& dir, const std::string& name, const Mesh& m) {
-  const std::string path = dir + "/" + name + ".obj";
-  write_obj(path, m.V, m.F);
-  return path;
-}
 
 // The UV sphere of test_cli.cpp: vertex 0 is the north pole, 85 the south pole.
 std::string save_sphere(const std::string& dir) { return save(dir, "sphere", make_uv_sphere(8, 12)); }

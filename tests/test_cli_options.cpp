@@ -28,36 +28,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using test::CommandResult;
-using test::run_cli;
+using namespace test;  // run_cli, q, save, slurp, … (tests/support.h)
 using Edge = std::pair<int, int>;
 
 const std::string kError = "trivcon: error: ";
 
-std::string q(const std::string& s) { return "'" + s + "'"; }
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
-}
-std::string save(const std::string& dir, const std::string& name, const Mesh& m) {
-  const std::string path = dir + "/" + name + ".obj";
-  write_obj(path, m.V, m.F);
-  return path;
-}
 json read_json(const std::string& path) {
   try {
     return json::parse(slurp(path));
@@ -104,16 +79,6 @@ std::vector<Eigen::Vector3d> read_field_txt(const std::string& path) {
     EXPECT_TRUE(s >> d.x() >> d.y() >> d.z()) << line;
     out.push_back(d);
   }
-  return out;
-}
-
-std::vector<int> vertices_of_valence(const Mesh& m, int valence) {
-  std::vector<int> count(m.V.rows(), 0);
-  for (int f = 0; f < m.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) ++count[m.F(f, k)];
-  std::vector<int> out;
-  for (int v = 0; v < m.V.rows(); ++v)
-    if (count[v] == valence) out.push_back(v);
   return out;
 }
 
@@ -311,12 +276,6 @@ TEST(CliOptions, SingBatchJsonLinesErrors) {
   EXPECT_EQ(r.err.substr(r.err.size() - 2), ")\n") << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
   EXPECT_FALSE(fs::exists(s.dir + "/f.a.txt"));
-  // Two files of one name (a.txt and a.sings) would write the same outputs.
-  fs::create_directories(s.dir + "/twice");
-  write_text(s.dir + "/twice/a.txt", "0 1\n85 1\n");
-  write_text(s.dir + "/twice/a.sings", "1 2\n0 1\n85 1\n");
-  expect_error(run_cli("solve " + q(s.mesh) + " --sing-batch " + q(s.dir + "/twice") + " --field-out " + q(s.dir + "/f.txt")),
-               "--sing-batch " + s.dir + "/twice: files 'a.sings' and 'a.txt' have the same name 'a'");
 }
 
 // ---------------------------------------------------------------------------------------------

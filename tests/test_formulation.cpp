@@ -27,6 +27,7 @@ namespace trivcon {
 namespace {
 
 using Edge = std::pair<int, int>;  // (i, j), i < j
+using test::vertices_of_valence;
 Edge edge_of(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
 
 Eigen::Vector3d pos(const MatrixX3d& V, int v) { return V.row(v).transpose(); }
@@ -133,17 +134,6 @@ Mesh jittered_grid(int n, double jitter, unsigned seed) {
       }
     }
   return m;
-}
-
-// Vertices of a given valence (from F only).
-std::vector<int> vertices_of_valence(const Mesh& m, int valence) {
-  std::vector<int> count(m.V.rows(), 0);
-  for (int f = 0; f < m.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) ++count[m.F(f, k)];
-  std::vector<int> out;
-  for (int v = 0; v < m.V.rows(); ++v)
-    if (count[v] == valence) out.push_back(v);
-  return out;
 }
 
 // Reduces an angle into (−π/N, π/N] (the test's own).

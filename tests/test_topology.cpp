@@ -30,6 +30,7 @@ namespace trivcon {
 namespace {
 
 using test::error_of;
+using test::mobius_strip;
 using test::expect_consistent;
 using test::expect_geometry_sane;
 using test::faces;
@@ -68,29 +69,6 @@ Mesh flip_faces(const Mesh& m, const std::vector<int>& which) {
   Mesh out = m;
   for (int f : which) std::swap(out.F(f, 1), out.F(f, 2));
   return out;
-}
-
-// A Möbius strip of `n` quads (2n triangles, 2n vertices): rails top_i = 2i, bottom_i = 2i + 1; the
-// last quad joins (top, bottom) of step n − 1 to (bottom, top) of step 0.
-Mesh mobius_strip(int n) {
-  Mesh m;
-  m.V.resize(2 * n, 3);
-  for (int i = 0; i < n; ++i) {
-    const double u = 2 * kPi * i / n;
-    const Eigen::Vector3d c(std::cos(u), std::sin(u), 0),
-        d(0.3 * std::cos(u / 2) * std::cos(u), 0.3 * std::cos(u / 2) * std::sin(u), 0.3 * std::sin(u / 2));
-    m.V.row(2 * i) = c + d;
-    m.V.row(2 * i + 1) = c - d;
-  }
-  std::vector<std::array<int, 3>> f;
-  for (int i = 0; i < n; ++i) {
-    const int a = 2 * i, b = 2 * i + 1;
-    const int c = i + 1 < n ? 2 * (i + 1) + 1 : 0, d = i + 1 < n ? 2 * (i + 1) : 1;
-    f.push_back({a, b, c});
-    f.push_back({a, c, d});
-  }
-  m.F = faces(f);
-  return m;
 }
 
 // A Klein bottle: an n × m grid of quads whose rows wrap normally (j mod m) and whose columns wrap with
@@ -804,12 +782,8 @@ TEST_P(TopologySharedValid, CountsMatchSources) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(TopologyShared, TopologySharedValid, ::testing::ValuesIn(kValid), [](const auto& info) {
-  std::string name = info.param.file;
-  for (char& c : name)
-    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-  return name;
-});
+INSTANTIATE_TEST_SUITE_P(TopologyShared, TopologySharedValid, ::testing::ValuesIn(kValid),
+                         [](const auto& info) { return test::test_name_of(info.param.file); });
 
 TEST(TopologySharedMeshes, PermutedCopiesKeepTheirCounts) {
   TRIVCON_REQUIRE_SHARED();
