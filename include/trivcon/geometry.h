@@ -6,9 +6,10 @@
 //   normal n = (p1 − p0) × (p2 − p0) pointing at the viewer. A direction at angle β in face f is the
 //   world vector cos β · frame_x(f) + sin β · frame_y(f), with frame_y = n̂ × frame_x.
 // - Corner angles are intrinsic (from the three edge vectors via atan2(|a × b|, a · b)) and sum to π in
-//   every face. Degenerate faces get a fixed convention so that this still holds: three collinear
-//   distinct points give (0, 0, π); a zero-length edge gives 0 opposite it and π/2 at its endpoints;
-//   a face whose corners coincide gives π/3 each.
+//   every face. Three distinct points get their true angles, so collinear ones give (0, 0, π) and a
+//   face that is degenerate by the area threshold below but not exactly flat gets angles within about
+//   1e-14 of that; a zero-length edge gives 0 opposite it and π/2 at its endpoints; a face whose
+//   corners coincide gives π/3 each.
 // - half_edge_angle(f, k): the angle, in f's frame, of the half-edge from corner k to corner k+1:
 //   0, π − α1, π + α0 for k = 0, 1, 2 (αk is the corner angle at corner k).
 // - rho(e), for an interior edge e = (i, j), i < j, L = edge_faces(e, 0) and R = edge_faces(e, 1):
