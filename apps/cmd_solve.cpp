@@ -11,9 +11,11 @@
 #include "prescription_options.h"
 #include "report.h"
 #include "summary.h"
+#include "trivcon/auto.h"
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
+#include "trivcon/field_io.h"
 
 namespace trivcon::cli {
 
@@ -28,6 +30,9 @@ struct SolveOptions {
   std::vector<std::string> fixes;
   bool align_boundary = false;
   std::string sing_batch;
+  bool auto_place = false;  // --auto
+  double auto_cancel = 0;   // --auto-cancel, in mean edge lengths
+  std::string sing_from_field;
   OutputPaths out;
   bool quiet = false;
 };
@@ -46,8 +51,10 @@ std::string fmt(double v) {
 
 // Solves one prescription on the prepared designer, writes its outputs, prints its summary; returns
 // whether verification passed.
+// `extra` holds report entries of the whole run (the "auto" or "sing_from_field" object), added to the report.
 bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& designer, const IndexPrescription& prescription,
-               const std::vector<std::pair<int, double>>& roots, const std::string& name, double read_seconds) {
+               const std::vector<std::pair<int, double>>& roots, const std::string& name, double read_seconds,
+               const nlohmann::ordered_json& extra) {
   const Design d = designer.design(prescription, roots);
   const Connection& c = d.connection;
 
@@ -62,7 +69,8 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   stage_design_outputs(staged, o.out, name, mesh, designer, prescription, d);
   const ReportRun run{o.mesh, name, o.weights, o.solver, o.align_boundary, read_seconds, seconds_since(t1), ok};
   if (!o.out.report.empty()) {
-    const nlohmann::ordered_json report = solve_report(run, mesh, designer, prescription, d);
+    nlohmann::ordered_json report = solve_report(run, mesh, designer, prescription, d);
+    for (const auto& [key, value] : extra.items()) report[key] = value;
     staged.write(output_path(o.out.report, name),
                  [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& out) { out << report.dump(2) << "\n"; }); });
   }
@@ -130,9 +138,46 @@ void run_solve(const SolveOptions& o) {
               << "time: read " << fmt(read_seconds) << " s, prepared in " << fmt(pt.prepare) << " s (topology " << fmt(pt.topology)
               << " s, geometry " << fmt(pt.geometry) << " s, cycles " << fmt(pt.cycles) << " s, plan " << fmt(pt.plan) << " s, setup "
               << fmt(pt.setup) << " s)\n";
+  // Singularities found for the user: from the smoothest field (--auto), or from another field's indices.
+  nlohmann::ordered_json extra = nlohmann::ordered_json::object();
+  if (o.auto_place) {
+    AutoOptions ao;
+    ao.N = prescription.N;
+    ao.cancel_distance = o.auto_cancel;
+    ao.fixed = prescription.fixed;  // --align-boundary and --fix: Dirichlet values of the smoothest field
+    const AutoResult r = auto_singularities(designer, ao);
+    prescription.vertex = r.vertex;
+    const AutoTimings& s = r.seconds;
+    extra["auto"] = {
+        {"found", r.found.size()},
+        {"cancelled_pairs", r.pairs.size()},
+        {"used", r.vertex.size()},
+        {"cancel_distance", o.auto_cancel},
+        {"vanishing_faces", r.vanishing_faces},
+        {"seconds",
+         {{"assemble", s.assemble}, {"factor", s.factor}, {"iterate", s.iterate}, {"indices", s.indices}, {"cancel", s.cancel}}}};
+    if (!o.quiet)
+      std::cout << "auto: smoothest field found " << r.found.size() << " singularities, cancelled " << r.pairs.size() << " pairs, using "
+                << r.vertex.size() << "\n";
+  }
+  if (!o.sing_from_field.empty()) {
+    int file_N = 0;
+    const MatrixX3d directions = read_field(o.sing_from_field, designer.topology().num_faces, &file_N);
+    if (o.prescription.N_given() && file_N > 0 && file_N != prescription.N)
+      throw Error("the field file " + o.sing_from_field + " holds an N = " + std::to_string(file_N) + " field but -N " +
+                  std::to_string(prescription.N) + " was given");
+    if (file_N > 0) prescription.N = file_N;
+    const Field field = field_from_directions(designer.geometry(), directions, prescription.N);
+    const FieldIndices idx = field_indices(designer.topology(), designer.geometry(), designer.cycles(), field);
+    for (int v = 0; v < designer.topology().num_vertices; ++v)
+      if (idx.vertex[v] != 0) prescription.vertex[v] = idx.vertex[v];
+    extra["sing_from_field"] = {{"file", o.sing_from_field}, {"singularities", prescription.vertex.size()}};
+    if (!o.quiet) std::cout << "sing-from-field: " << o.sing_from_field << " has " << prescription.vertex.size() << " singularities\n";
+  }
+
   bool ok = true;
   if (batch.empty()) {
-    ok = solve_one(o, mesh, designer, prescription, roots, "", read_seconds);
+    ok = solve_one(o, mesh, designer, prescription, roots, "", read_seconds, extra);
   } else {
     for (BatchItem& item : batch) {  // check every item before writing anything
       item.prescription.fixed = prescription.fixed;
@@ -142,7 +187,7 @@ void run_solve(const SolveOptions& o) {
         throw Error("batch item '" + item.name + "': " + e.what());
       }
     }
-    for (const BatchItem& item : batch) ok &= solve_one(o, mesh, designer, item.prescription, roots, item.name, read_seconds);
+    for (const BatchItem& item : batch) ok &= solve_one(o, mesh, designer, item.prescription, roots, item.name, read_seconds, extra);
   }
   if (!ok) exit_code = kVerificationFailed;
 }
@@ -164,14 +209,28 @@ void register_solve(CLI::App& app) {
                   "Fixed direction: F:x,y,z (world, projected to the face), F:angle=A (radians, face frame), or a file with "
                   "'FACE x y z' / 'FACE angle=A' lines; repeatable");
   cmd->add_flag("--align-boundary", o.align_boundary, "Fix every face with a boundary edge to that edge's direction");
-  cmd->add_option("--sing-batch", o.sing_batch,
-                  "Solve many singularity sets with one factorization: a directory of singularity files, or a JSON-lines file; "
-                  "outputs get the item's name ({name} in a path, or before the extension)");
+  auto* batch =
+      cmd->add_option("--sing-batch", o.sing_batch,
+                      "Solve many singularity sets with one factorization: a directory of singularity files, or a JSON-lines file; "
+                      "outputs get the item's name ({name} in a path, or before the extension)");
+  auto* auto_flag = cmd->add_flag("--auto", o.auto_place,
+                                  "Find the singularities automatically: those of the globally smoothest field (Knoppel et al. 2013), "
+                                  "then solve exactly with them");
+  cmd->add_option("--auto-cancel", o.auto_cancel,
+                  "With --auto: cancel pairs of opposite singularities at most D mean edge lengths apart (geodesic, along edges), "
+                  "closest first")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(auto_flag);
+  auto* from_field = cmd->add_option("--sing-from-field", o.sing_from_field,
+                                     "Use the singularities of a per-face field (.txt, .ply or Directional's .rawfield, as `check` reads)");
+  auto_flag->excludes(o.prescription.files_option)->excludes(o.prescription.sing_option)->excludes(batch)->excludes(from_field);
+  from_field->excludes(o.prescription.files_option)->excludes(o.prescription.sing_option)->excludes(batch);
   cmd->add_option("--root-face", o.root_faces, "Face where propagation starts (one per component at most; repeatable)");
   cmd->add_option("--root-angle", o.root_angles, "Angle (radians, in the root face's frame) of the field at the matching --root-face");
   cmd->add_option("--field-out", o.out.field, "Field file: .txt (x y z per face), .rawfield (Directional) or .ply");
   cmd->add_option("--connection-out", o.out.connection, "Connection file: 'i j x' per interior edge");
   cmd->add_option("--lines-out", o.out.lines, "OBJ with a short segment per face and direction");
+  cmd->add_option("--sing-out", o.out.singularities, "Singularity file of the singularities used ('VERTEX INDEX' lines, readable by -s)");
   cmd->add_option("--png", o.out.png, "Picture of the field (as `trivcon render` with its defaults)");
   cmd->add_option("--report", o.out.report, "JSON report: sizes, topology, indices used, energy, residuals, timings");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");

@@ -61,6 +61,9 @@ void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const
                  [&](const std::string& path) { write_connection(path, designer.topology(), d.connection.x, prescription.N); });
   if (!paths.lines.empty())
     staged.write(output_path(paths.lines, name), [&](const std::string& path) { write_field_lines(path, mesh.V, mesh.F, g, d.field); });
+  if (!paths.singularities.empty())
+    staged.write(output_path(paths.singularities, name),
+                 [&](const std::string& path) { write_singularities(path, prescription.vertex, prescription.N); });
   if (!paths.png.empty()) {  // the prescription's singularities, drawn with the default view of `trivcon render`
     std::vector<std::pair<int, int>> singular(prescription.vertex.begin(), prescription.vertex.end());
     staged.write(output_path(paths.png, name),

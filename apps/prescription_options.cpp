@@ -4,9 +4,9 @@ namespace trivcon::cli {
 
 void PrescriptionOptions::add_to(CLI::App* cmd, bool with_cycles) {
   N_option = cmd->add_option("-N,--symmetry", N, "Symmetry: 1 vectors, 2 lines, 4 crosses, any N >= 1")->check(CLI::Range(1, 1000));
-  cmd->add_option("-s,--singularities", sing_files,
-                  "Singularity file: 'VERTEX INDEX' per line (INDEX integer or p/q), or Directional's .sings");
-  cmd->add_option("--sing", sings, "A singular vertex, V:INDEX (e.g. 12:1/4); repeatable");
+  files_option = cmd->add_option("-s,--singularities", sing_files,
+                                 "Singularity file: 'VERTEX INDEX' per line (INDEX integer or p/q), or Directional's .sings");
+  sing_option = cmd->add_option("--sing", sings, "A singular vertex, V:INDEX (e.g. 12:1/4); repeatable");
   if (with_cycles) {
     cmd->add_option("--generator", generators, "Index of generator G (see info --cycles), G:INDEX; repeatable");
     cmd->add_option("--boundary", loops, "Index of boundary loop L (see info --cycles), L:INDEX; repeatable");

@@ -13,6 +13,8 @@ struct PrescriptionOptions {
   int N = 1;
   std::vector<std::string> sing_files, sings, generators, loops;
   CLI::Option* N_option = nullptr;
+  CLI::Option* files_option = nullptr;  // -s
+  CLI::Option* sing_option = nullptr;   // --sing
   bool N_given() const { return N_option && N_option->count() > 0; }
   bool empty() const { return sing_files.empty() && sings.empty() && generators.empty() && loops.empty(); }
   // Adds the options to `cmd`; --generator and --boundary only `with_cycles`.

@@ -38,6 +38,19 @@ cholmod_sparse upper_view(const std::vector<int>& outer, const std::vector<int>&
   return s;
 }
 
+cholmod_sparse upper_view_complex(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values, int n) {
+  cholmod_sparse s = upper_view(outer, inner, values, n);
+  s.xtype = CHOLMOD_COMPLEX;
+  return s;
+}
+
+cholmod_dense dense_view_complex(const Eigen::VectorXd& b) {
+  cholmod_dense B = dense_view(b);
+  B.nrow = B.nzmax = B.d = static_cast<size_t>(b.size() / 2);
+  B.xtype = CHOLMOD_COMPLEX;
+  return B;
+}
+
 cholmod_dense dense_view(const Eigen::VectorXd& b) {
   cholmod_dense B{};
   B.nrow = static_cast<size_t>(b.size()), B.ncol = 1, B.nzmax = B.nrow, B.d = B.nrow;

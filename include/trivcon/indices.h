@@ -43,8 +43,12 @@ void add_vertex_index(const std::string& spec, IndexPrescription& prescription);
 void add_generator_index(const std::string& spec, IndexPrescription& prescription);
 void add_loop_index(const std::string& spec, IndexPrescription& prescription);
 
-// Writes singularities (vertex, n) in the plain format above, indices as reduced fractions.
+// An index n/N as a reduced fraction ("1/4", "-1/2") or an integer ("1", "0").
 std::string format_index(int n, int N);
+// Writes singularities (vertex → n) in the plain format above, atomically (trivcon/io.h): a '#' header
+// comment ("# trivcon singularities", "# N <N>", "# <count> singular vertices"), then one
+// "VERTEX INDEX" line per vertex in increasing id, INDEX from format_index. read_singularities reads it back.
+void write_singularities(const std::string& path, const std::map<int, int>& vertex, int N);
 
 // Checks the prescription against the mesh: vertex out of range, unreferenced or on the boundary;
 // generator or loop id out of range; on each closed component, vertex indices summing to χ; on a

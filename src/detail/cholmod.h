@@ -59,6 +59,10 @@ class CholmodLongContext {
 // column, sorted): outer has at least n + 1 entries.
 cholmod_sparse upper_view(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values, int n);
 
+// The same for a complex Hermitian matrix (CHOLMOD_COMPLEX): `values` holds (real, imaginary) per entry,
+// 2 × outer[n] numbers; CHOLMOD takes the lower triangle as the conjugate of the upper.
+cholmod_sparse upper_view_complex(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values, int n);
+
 // A general (unsymmetric) view of a compressed Eigen matrix.
 template <class Index>
 cholmod_sparse sparse_view(const Eigen::SparseMatrix<double, Eigen::ColMajor, Index>& M) {
@@ -73,6 +77,8 @@ cholmod_sparse sparse_view(const Eigen::SparseMatrix<double, Eigen::ColMajor, In
 
 // A single dense column over b's memory.
 cholmod_dense dense_view(const Eigen::VectorXd& b);
+// A single dense complex column over b's memory: (real, imaginary) per row, b.size() / 2 rows.
+cholmod_dense dense_view_complex(const Eigen::VectorXd& b);
 
 // See the top of this file. Cheap after the first call (the result is remembered).
 void check_numeric_libraries();

@@ -1,0 +1,309 @@
+// Automatic singularities from the globally smoothest field (trivcon/auto.h).
+#include "trivcon/auto.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <memory>
+#include <queue>
+#include <random>
+#include <string>
+
+#include "detail/cholmod.h"
+#include "detail/timing.h"
+#include "trivcon/design.h"
+#include "trivcon/error.h"
+
+namespace trivcon {
+
+namespace {
+
+using detail::Clock;
+using detail::seconds_since;
+using Complex = std::complex<double>;
+
+double edge_length(const MatrixX3d& V, const Topology& t, int e) {
+  return (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).norm();
+}
+
+// The per-face mass and per-edge weight of trivcon/auto.h.
+struct Weights {
+  Eigen::VectorXd mass, w;
+};
+
+Weights face_weights(const MatrixX3d& V, const Topology& t, const Geometry& g) {
+  Weights k;
+  double total = 0;
+  for (int f = 0; f < t.num_faces; ++f) total += g.face_area[f];
+  if (!(total > 0) || !std::isfinite(total))
+    throw Error("automatic singularities: every face of the mesh has zero area, so no field can be measured on it");
+  const double floor = 1e-12 * total / t.num_faces;
+  k.mass = g.face_area.cwiseMax(floor);
+  k.w = Eigen::VectorXd::Zero(t.num_edges);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const double len = edge_length(V, t, e);
+    k.w[e] = len * len / (k.mass[t.edge_faces(e, 0)] + k.mass[t.edge_faces(e, 1)]);
+  }
+  return k;
+}
+
+// A_gf for neighbouring faces g ≠ f across interior edge e: −w e^{iNρ} from L to R, its conjugate back.
+Complex off_diagonal(const Topology& t, const Geometry& g, const Weights& k, int N, int e, int row_face) {
+  const double a = N * g.rho[e];
+  const Complex r(std::cos(a), std::sin(a));
+  return -k.w[e] * (row_face == t.edge_faces(e, 1) ? r : std::conj(r));
+}
+
+struct FactorDeleter {
+  cholmod_common* c;
+  void operator()(cholmod_factor* L) const { cholmod_free_factor(&L, c); }
+};
+
+// The smoothest field's complex values per face (see trivcon/auto.h).
+std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o, AutoTimings& time) {
+  auto t0 = Clock::now();
+  const int N = o.N;
+  std::vector<Complex> u(t.num_faces, Complex(0, 0));
+  std::vector<int> unknown(t.num_faces, -1), face_of;
+  std::vector<char> dirichlet_component(t.components.size(), 0);
+  for (auto [f, angle] : o.fixed) {
+    if (f < 0 || f >= t.num_faces) throw Error("automatic singularities: fixed face " + std::to_string(f) + " out of range");
+    if (!std::isfinite(angle)) throw Error("automatic singularities: fixed face " + std::to_string(f) + " has a non-finite angle");
+    u[f] = std::polar(1.0, N * angle);
+    dirichlet_component[t.face_component[f]] = 1;
+  }
+  for (int f = 0; f < t.num_faces; ++f)
+    if (!o.fixed.count(f)) unknown[f] = static_cast<int>(face_of.size()), face_of.push_back(f);
+  const int n = static_cast<int>(face_of.size());
+  if (n == 0) return u;
+
+  // The shift ε of trivcon/auto.h and the upper triangle of the Hermitian A + εM in compressed columns
+  // (n × n complex, values as (real, imaginary) pairs).
+  Eigen::VectorXd diag = Eigen::VectorXd::Zero(t.num_faces);
+  for (int e = 0; e < t.num_edges; ++e)
+    if (!t.is_boundary_edge(e)) diag[t.edge_faces(e, 0)] += k.w[e], diag[t.edge_faces(e, 1)] += k.w[e];
+  const double eps = 1e-8 * (diag.array() / k.mass.array()).mean();
+  std::vector<int> outer(n + 1, 0), inner;
+  std::vector<double> values;
+  inner.reserve(static_cast<size_t>(n) * 3), values.reserve(static_cast<size_t>(n) * 6);
+  std::vector<std::pair<int, Complex>> column;
+  for (int j = 0; j < n; ++j) {
+    const int f = face_of[j];
+    column.clear();
+    for (int c = 0; c < 3; ++c) {
+      const int e = t.face_edges(f, c);
+      if (t.is_boundary_edge(e)) continue;
+      const int h = t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
+      if (h != f && unknown[h] >= 0 && unknown[h] < j) column.emplace_back(unknown[h], off_diagonal(t, g, k, N, e, h));
+    }
+    std::sort(column.begin(), column.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (auto [i, a] : column) inner.push_back(i), values.push_back(a.real()), values.push_back(a.imag());
+    inner.push_back(j), values.push_back(diag[f] + eps * k.mass[f]), values.push_back(0.0);
+    outer[j + 1] = static_cast<int>(inner.size());
+  }
+  // Right-hand side from the fixed faces: b_g = −Σ A_gf u_f over fixed neighbours f.
+  Eigen::VectorXd dirichlet = Eigen::VectorXd::Zero(2 * n);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    for (int s = 0; s < 2; ++s) {
+      const int row = t.edge_faces(e, s), col = t.edge_faces(e, 1 - s);
+      if (unknown[row] < 0 || unknown[col] >= 0) continue;
+      const Complex b = -off_diagonal(t, g, k, N, e, row) * u[col];
+      dirichlet[2 * unknown[row]] += b.real(), dirichlet[2 * unknown[row] + 1] += b.imag();
+    }
+  }
+  time.assemble = seconds_since(t0);
+
+  t0 = Clock::now();
+  detail::CholmodContext context;
+  cholmod_common& c = *context;
+  c.nmethods = 1;
+  c.method[0].ordering = CHOLMOD_AMD;
+  c.postorder = 1;
+  cholmod_sparse A = detail::upper_view_complex(outer, inner, values, n);
+  std::unique_ptr<cholmod_factor, FactorDeleter> L(cholmod_analyze(&A, &c), FactorDeleter{&c});
+  detail::require(L != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix", c);
+  const int ok = cholmod_factorize(&A, L.get(), &c);
+  detail::require(ok && c.status == CHOLMOD_OK, "automatic singularities: CHOLMOD could not factor the smoothest-field matrix", c);
+  time.factor = seconds_since(t0);
+
+  t0 = Clock::now();
+  const int components = static_cast<int>(t.components.size());
+  auto normalise = [&](Eigen::VectorXd& x) {  // ‖x‖_M = 1 on every component without fixed faces
+    std::vector<double> norm(components, 0);
+    for (int j = 0; j < n; ++j)
+      norm[t.face_component[face_of[j]]] += k.mass[face_of[j]] * (x[2 * j] * x[2 * j] + x[2 * j + 1] * x[2 * j + 1]);
+    for (int j = 0; j < n; ++j) {
+      const int comp = t.face_component[face_of[j]];
+      if (dirichlet_component[comp]) continue;
+      if (!(norm[comp] > 0) || !std::isfinite(norm[comp]))
+        throw Error("automatic singularities: the inverse iteration lost the field on component " + std::to_string(comp) + " (norm " +
+                    std::to_string(norm[comp]) + ")");
+      x.segment<2>(2 * j) /= std::sqrt(norm[comp]);
+    }
+  };
+  Eigen::VectorXd x(2 * n);
+  std::mt19937 random(20131);  // a fixed start: the result is deterministic
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int i = 0; i < 2 * n; ++i) x[i] = uniform(random);
+  normalise(x);
+  Eigen::VectorXd b(2 * n);
+  for (int it = 0; it < std::max(1, o.iterations); ++it) {
+    for (int j = 0; j < n; ++j) {
+      const int f = face_of[j];
+      const double m = dirichlet_component[t.face_component[f]] ? 0.0 : k.mass[f];
+      b[2 * j] = m * x[2 * j] + dirichlet[2 * j], b[2 * j + 1] = m * x[2 * j + 1] + dirichlet[2 * j + 1];
+    }
+    cholmod_dense B = detail::dense_view_complex(b);
+    cholmod_dense* X = cholmod_solve(CHOLMOD_A, L.get(), &B, &c);
+    detail::require(X != nullptr, "automatic singularities: CHOLMOD could not solve with the smoothest-field matrix", c);
+    std::copy_n(static_cast<const double*>(X->x), 2 * n, x.data());
+    cholmod_free_dense(&X, &c);
+    normalise(x);
+  }
+  for (int j = 0; j < n; ++j) {
+    if (!std::isfinite(x[2 * j]) || !std::isfinite(x[2 * j + 1]))
+      throw Error("automatic singularities: the smoothest field is not finite at face " + std::to_string(face_of[j]));
+    u[face_of[j]] = Complex(x[2 * j], x[2 * j + 1]);
+  }
+  time.iterate = seconds_since(t0);
+  return u;
+}
+
+}  // namespace
+
+double mean_edge_length(const MatrixX3d& V, const Topology& t) {
+  if (t.num_edges == 0) return 0;
+  double sum = 0;
+  for (int e = 0; e < t.num_edges; ++e) sum += edge_length(V, t, e);
+  return sum / t.num_edges;
+}
+
+std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
+                                            std::vector<std::pair<int, int>>* pairs) {
+  if (!(distance >= 0) || !std::isfinite(distance))
+    throw Error("singularity cancellation: invalid distance " + std::to_string(distance) + " (need a finite number >= 0)");
+  std::map<int, int> left = vertex;
+  if (distance == 0) return left;
+  // Candidate pairs from a Dijkstra search of radius `distance` around each positive singularity.
+  struct Candidate {
+    double d;
+    int plus, minus;
+  };
+  std::vector<Candidate> candidates;
+  std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
+  std::vector<int> touched;
+  using Item = std::pair<double, int>;
+  for (auto [source, n] : vertex) {
+    if (n <= 0) continue;
+    if (source < 0 || source >= t.num_vertices) throw Error("singularity cancellation: vertex " + std::to_string(source) + " out of range");
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+    dist[source] = 0, touched.push_back(source), queue.emplace(0.0, source);
+    while (!queue.empty()) {
+      auto [d, v] = queue.top();
+      queue.pop();
+      if (d > dist[v]) continue;
+      if (v != source) {
+        auto it = vertex.find(v);
+        if (it != vertex.end() && it->second == -n) candidates.push_back({d, source, v});
+      }
+      for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
+        const int e = t.vertex_edges[q];
+        const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+        const double dw = d + edge_length(V, t, e);
+        if (dw <= distance && dw < dist[w]) {
+          if (std::isinf(dist[w])) touched.push_back(w);
+          dist[w] = dw, queue.emplace(dw, w);
+        }
+      }
+    }
+    for (int v : touched) dist[v] = std::numeric_limits<double>::infinity();
+    touched.clear();
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.d != b.d ? a.d < b.d : a.plus != b.plus ? a.plus < b.plus : a.minus < b.minus;
+  });
+  for (const Candidate& k : candidates) {
+    if (!left.count(k.plus) || !left.count(k.minus)) continue;
+    left.erase(k.plus), left.erase(k.minus);
+    if (pairs) pairs->emplace_back(k.plus, k.minus);
+  }
+  return left;
+}
+
+AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geometry& g, const Cycles& cycles, const AutoOptions& o) {
+  if (o.N < 1) throw Error("automatic singularities: invalid N = " + std::to_string(o.N) + " (need N >= 1)");
+  if (o.iterations < 1) throw Error("automatic singularities: invalid iterations = " + std::to_string(o.iterations) + " (need at least 1)");
+  if (V.rows() != t.num_vertices)
+    throw Error("automatic singularities: V has " + std::to_string(V.rows()) + " rows, the mesh " + std::to_string(t.num_vertices) +
+                " vertices");
+  AutoResult r;
+  r.field.N = o.N;
+  r.field.angle = Eigen::VectorXd::Zero(t.num_faces);
+  if (t.num_faces == 0) return r;
+  const Weights k = face_weights(V, t, g);
+  std::vector<Complex> u = smoothest_values(t, g, k, o, r.seconds);
+
+  auto t0 = Clock::now();
+  // Energy (the Rayleigh quotient), then faces where the field vanishes (trivcon/auto.h).
+  double energy = 0, norm = 0;
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    energy += k.w[e] * std::norm(u[R] - std::polar(1.0, o.N * g.rho[e]) * u[L]);
+  }
+  std::vector<double> largest(t.components.size(), 0);
+  for (int f = 0; f < t.num_faces; ++f) {
+    norm += k.mass[f] * std::norm(u[f]);
+    largest[t.face_component[f]] = std::max(largest[t.face_component[f]], std::abs(u[f]));
+  }
+  r.energy = norm > 0 ? energy / norm : 0;
+  std::vector<Complex> filled = u;
+  for (int f = 0; f < t.num_faces; ++f) {
+    const double small = 1e-9 * largest[t.face_component[f]];
+    if (std::abs(u[f]) > small) continue;
+    ++r.vanishing_faces;
+    Complex sum(0, 0);
+    for (int c = 0; c < 3; ++c) {
+      const int e = t.face_edges(f, c);
+      if (t.is_boundary_edge(e)) continue;
+      const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+      const Complex r_e = std::polar(1.0, o.N * g.rho[e]);
+      sum += f == R ? r_e * u[L] : std::conj(r_e) * u[R];
+    }
+    filled[f] = std::abs(sum) > small ? sum : Complex(1, 0);
+  }
+  for (int f = 0; f < t.num_faces; ++f) {
+    double a = std::arg(filled[f]) / o.N;
+    if (a < 0) a += kTwoPi / o.N;
+    r.field.angle[f] = std::min(a, std::nextafter(kTwoPi / o.N, 0.0));
+  }
+  const FieldIndices indices = field_indices(t, g, cycles, r.field);
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (indices.vertex[v] != 0) r.found[v] = indices.vertex[v];
+  r.seconds.indices = seconds_since(t0);
+
+  t0 = Clock::now();
+  if (!(o.cancel_distance >= 0) || !std::isfinite(o.cancel_distance))
+    throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
+  const double distance = o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
+  r.vertex = cancel_singularity_pairs(V, t, r.found, distance, &r.pairs);
+  r.seconds.cancel = seconds_since(t0);
+  return r;
+}
+
+AutoResult auto_singularities(const FieldDesigner& designer, const AutoOptions& options) {
+  return auto_singularities(designer.V(), designer.topology(), designer.geometry(), designer.cycles(), options);
+}
+
+AutoResult auto_singularities(const MatrixX3d& V, const MatrixX3i& F, const AutoOptions& options) {
+  check_finite(V);
+  const Topology t = build_topology(F, static_cast<int>(V.rows()));
+  const Geometry g = compute_geometry(V, t);
+  const Cycles cycles = compute_cycles(t);
+  return auto_singularities(V, t, g, cycles, options);
+}
+
+}  // namespace trivcon

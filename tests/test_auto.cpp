@@ -1,0 +1,257 @@
+// Automatic singularities (trivcon/auto.h): the smoothest field's singularities, cancellation, and the
+// exact solve with them.
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "support.h"
+#include "trivcon/auto.h"
+#include "trivcon/constraints.h"
+#include "trivcon/error.h"
+#include "trivcon/io.h"
+
+namespace trivcon {
+namespace {
+
+using test::error_of;
+
+int index_sum(const std::map<int, int>& vertex) {
+  int s = 0;
+  for (auto [v, n] : vertex) s += n;
+  return s;
+}
+
+bool has_opposite_pair(const std::map<int, int>& vertex) {
+  std::set<int> values;
+  for (auto [v, n] : vertex) values.insert(n);
+  for (int n : values)
+    if (n > 0 && values.count(-n)) return true;
+  return false;
+}
+
+// Solves exactly with the singularities and checks that the field has exactly them (`all`: every read-back
+// index equals the prescription; otherwise only those not explained by a turn of π/N or more, see field.h).
+void expect_exact(const FieldDesigner& designer, const std::map<int, int>& vertex, int N, const std::string& what, bool all = true) {
+  IndexPrescription p;
+  p.N = N;
+  p.vertex = vertex;
+  const Design d = designer.design(p);
+  const double tol = 1e-9 * std::max(1.0, d.connection.rhs_scale);
+  EXPECT_LE(d.connection.max_vertex_residual, tol) << what;
+  EXPECT_LE(d.connection.max_cycle_residual, tol) << what;
+  EXPECT_LE(d.transport_mismatch, tol) << what;
+  EXPECT_TRUE(d.unexplained_mismatch_vertices.empty()) << what;
+  if (!all) return;
+  EXPECT_TRUE(d.index_mismatch_vertices.empty()) << what;
+  std::map<int, int> back;
+  for (int v = 0; v < designer.topology().num_vertices; ++v)
+    if (d.indices.vertex[v] != 0) back[v] = d.indices.vertex[v];
+  EXPECT_EQ(back, vertex) << what;
+}
+
+// A thin round torus (r/R = 0.2). On a fat one (the default r/R = 0.4) the smoothest cross field does have
+// singularities (12 for N = 4, 2 for N = 2: ± pairs where turning with the curvature costs more).
+TEST(Auto, RoundTorusHasNoSingularities) {
+  const Mesh m = make_torus(96, 24, 1.0, 0.2);
+  for (int N : {1, 2, 4}) {
+    AutoOptions o;
+    o.N = N;
+    const AutoResult r = auto_singularities(m.V, m.F, o);
+    EXPECT_TRUE(r.found.empty()) << "N " << N << ": " << r.found.size();
+    EXPECT_EQ(r.vanishing_faces, 0);
+    EXPECT_TRUE(std::isfinite(r.energy));
+    FieldDesigner designer(m.V, m.F);
+    expect_exact(designer, r.vertex, N, "torus N " + std::to_string(N));
+  }
+}
+
+TEST(Auto, SphereCrossFieldSumsToTwoWithoutOppositePairs) {
+  const Mesh m = make_icosphere(4);
+  AutoOptions o;
+  o.N = 4;
+  FieldDesigner designer(m.V, m.F);
+  const AutoResult r = auto_singularities(designer, o);
+  EXPECT_EQ(index_sum(r.found), 2 * 4);
+  EXPECT_FALSE(has_opposite_pair(r.found));
+  for (auto [v, n] : r.found) EXPECT_GT(n, 0) << "vertex " << v;
+  expect_exact(designer, r.vertex, 4, "icosphere");
+}
+
+TEST(Auto, VectorFieldOnASphereHasIndexTwo) {
+  const Mesh m = make_icosphere(3);
+  AutoOptions o;
+  o.N = 1;
+  const AutoResult r = auto_singularities(m.V, m.F, o);
+  EXPECT_EQ(index_sum(r.found), 2);
+}
+
+TEST(Auto, CubeSphereGetsEightQuarterSingularitiesAtTheCorners) {
+  // The cube (flat faces, n = 12 and 13). On the cube-like sphere the smoothest field also has eight +1/4,
+  // but the round sphere's near-symmetry lets them move away from the corners.
+  for (int n : {12, 13}) {
+    const bool spherical = false;
+    const Mesh m = make_cube_sphere(n, spherical);
+    FieldDesigner designer(m.V, m.F);
+    AutoOptions o;
+    o.N = 4;
+    const AutoResult r = auto_singularities(designer, o);
+    ASSERT_EQ(r.found.size(), 8u) << "spherical " << spherical;
+    const std::vector<int> corners = test::vertices_of_valence(m, 3);
+    ASSERT_EQ(corners.size(), 8u);
+    // Vertices within two rings of a corner.
+    const Topology& t = designer.topology();
+    std::set<int> near(corners.begin(), corners.end());
+    for (int ring = 0; ring < 2; ++ring) {
+      std::set<int> next = near;
+      for (int v : near)
+        for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
+          const int e = t.vertex_edges[q];
+          next.insert(t.edge_vertices(e, 0)), next.insert(t.edge_vertices(e, 1));
+        }
+      near = next;
+    }
+    for (auto [v, n] : r.found) {
+      EXPECT_EQ(n, 1) << "vertex " << v;
+      EXPECT_TRUE(near.count(v)) << "vertex " << v << " is not within 2 rings of a cube corner";
+    }
+    expect_exact(designer, r.vertex, 4, "cube " + std::to_string(n));
+  }
+  const Mesh m = make_cube_sphere(12, true);
+  AutoOptions o;
+  o.N = 4;
+  const AutoResult r = auto_singularities(m.V, m.F, o);
+  EXPECT_EQ(r.found.size(), 8u);
+  for (auto [v, n] : r.found) EXPECT_EQ(n, 1) << "vertex " << v;
+}
+
+TEST(Auto, CancellationRemovesACloseOppositePairAndKeepsGaussBonnet) {
+  const Mesh m = make_icosphere(3);
+  const Topology t = test::topo(m);
+  // Eight +1/4 singularities from the smoothest field, plus a planted +1/4, −1/4 pair one edge apart.
+  AutoOptions o;
+  o.N = 4;
+  const AutoResult r = auto_singularities(m.V, m.F, o);
+  std::map<int, int> planted = r.found;
+  int a = -1, b = -1;
+  for (int e = 0; e < t.num_edges && a < 0; ++e) {
+    const int i = t.edge_vertices(e, 0), j = t.edge_vertices(e, 1);
+    bool clear = true;  // both ends away from the found singularities (more than 3 edge lengths)
+    std::vector<std::pair<int, int>> none;
+    for (auto [v, n] : r.found) {
+      std::map<int, int> two{{v, 1}, {i, -1}}, three{{v, 1}, {j, -1}};
+      if (cancel_singularity_pairs(m.V, t, two, 3 * mean_edge_length(m.V, t)).empty() ||
+          cancel_singularity_pairs(m.V, t, three, 3 * mean_edge_length(m.V, t)).empty())
+        clear = false;
+    }
+    if (clear) a = i, b = j;
+  }
+  ASSERT_GE(a, 0);
+  planted[a] = 1, planted[b] = -1;
+  std::vector<std::pair<int, int>> pairs;
+  const std::map<int, int> left = cancel_singularity_pairs(m.V, t, planted, 1.5 * mean_edge_length(m.V, t), &pairs);
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_EQ(pairs[0], std::make_pair(a, b));
+  EXPECT_EQ(left, r.found);
+  EXPECT_EQ(index_sum(left), 8);
+  // Far apart: kept.
+  EXPECT_EQ(cancel_singularity_pairs(m.V, t, planted, 0.5 * mean_edge_length(m.V, t)), planted);
+  // Through the options, on a noisy sphere: everything within the distance goes, the sum stays.
+  Mesh noisy = m;
+  for (int v = 0; v < noisy.V.rows(); ++v) noisy.V.row(v) *= 1.0 + 0.08 * std::sin(37.0 * v);
+  AutoOptions c = o;
+  c.cancel_distance = 4;
+  const AutoResult rn = auto_singularities(noisy.V, noisy.F, c);
+  EXPECT_EQ(index_sum(rn.found), 8);
+  EXPECT_EQ(index_sum(rn.vertex), 8);
+  EXPECT_EQ(rn.found.size(), rn.vertex.size() + 2 * rn.pairs.size());
+}
+
+TEST(Auto, BadInputIsAClearError) {
+  const Mesh m = make_icosphere(1);
+  AutoOptions o;
+  o.N = 0;
+  EXPECT_NE(error_of([&] { auto_singularities(m.V, m.F, o); }).find("invalid N = 0"), std::string::npos);
+  o.N = 4, o.iterations = 0;
+  EXPECT_NE(error_of([&] { auto_singularities(m.V, m.F, o); }).find("invalid iterations"), std::string::npos);
+  o.iterations = 4, o.cancel_distance = -1;
+  EXPECT_NE(error_of([&] { auto_singularities(m.V, m.F, o); }).find("invalid cancel distance"), std::string::npos);
+  o.cancel_distance = 0, o.fixed[1000] = 0.0;
+  EXPECT_NE(error_of([&] { auto_singularities(m.V, m.F, o); }).find("fixed face 1000 out of range"), std::string::npos);
+  // A mesh of zero-area faces only.
+  Mesh flat = m;
+  flat.V.setZero();
+  flat.V.col(0) = Eigen::VectorXd::LinSpaced(flat.V.rows(), 0, 1);
+  AutoOptions ok;
+  EXPECT_NE(error_of([&] { auto_singularities(flat.V, flat.F, ok); }).find("zero area"), std::string::npos);
+}
+
+TEST(Auto, ZeroAreaFacesGiveFiniteAngles) {
+  // A unit-sphere icosphere with one vertex moved onto the midpoint of a neighbouring edge's line makes
+  // zero-area faces; the field stays finite.
+  Mesh m = make_icosphere(2);
+  const Topology t = test::topo(m);
+  const int f = 0;
+  const Eigen::RowVector3d p0 = m.V.row(m.F(f, 0)), p1 = m.V.row(m.F(f, 1));
+  m.V.row(m.F(f, 2)) = 0.5 * (p0 + p1);
+  AutoOptions o;
+  const AutoResult r = auto_singularities(m.V, m.F, o);
+  for (int g = 0; g < r.field.angle.size(); ++g) ASSERT_TRUE(std::isfinite(r.field.angle[g])) << "face " << g;
+  EXPECT_EQ(index_sum(r.found), 8);
+}
+
+TEST(Auto, SeveralComponentsEachGetTheirField) {
+  const Mesh m = concatenate({make_icosphere(3), make_torus(40, 20)});
+  AutoOptions o;
+  const AutoResult r = auto_singularities(m.V, m.F, o);
+  const int sphere_vertices = static_cast<int>(make_icosphere(3).V.rows());
+  int sphere = 0, torus = 0;
+  for (auto [v, n] : r.found) (v < sphere_vertices ? sphere : torus) += n;
+  EXPECT_EQ(sphere, 8);
+  EXPECT_EQ(torus, 0);
+  EXPECT_EQ(r.vanishing_faces, 0);
+}
+
+TEST(Auto, AlignedDiskGetsFourQuarterSingularities) {
+  const Mesh m = make_disk(12, 8);
+  FieldDesigner designer(m.V, m.F);
+  AutoOptions o;
+  o.N = 4;
+  o.fixed = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
+  const AutoResult r = auto_singularities(designer, o);
+  EXPECT_EQ(r.found.size(), 4u);
+  for (auto [v, n] : r.found) EXPECT_EQ(n, 1) << "vertex " << v;
+  // The field holds the fixed faces.
+  for (auto [f, angle] : o.fixed) EXPECT_NEAR(std::abs(reduce_angle(r.field.angle[f] - angle, 4)), 0.0, 1e-9) << "face " << f;
+}
+
+// The shared real meshes: counts of singularities found (printed), Gauss–Bonnet on closed components, and
+// the exact solve with them.
+TEST(Auto, SharedMeshes) {
+  TRIVCON_REQUIRE_SHARED();
+  for (const char* name : {"spot.obj", "bunny_closed.obj", "armadillo.obj", "torus.obj", "kitten.off", "rocker-arm.obj", "eight.off",
+                           "fertility.off", "face.obj", "camelhead.off", "circle.obj", "bun_zipper.ply"}) {
+    const MeshData mesh = read_mesh(test::shared_mesh(name));
+    FieldDesigner designer(mesh.V, mesh.F);
+    AutoOptions o;
+    o.N = 4;
+    const AutoResult r = auto_singularities(designer, o);
+    const Topology& t = designer.topology();
+    std::vector<int> sum(t.components.size(), 0);
+    int negative = 0;
+    for (auto [v, n] : r.found) sum[t.vertex_component[v]] += n, negative += n < 0;
+    for (size_t c = 0; c < t.components.size(); ++c)
+      if (t.components[c].boundary_loops.empty()) {
+        EXPECT_EQ(sum[c], 4 * t.components[c].euler_characteristic) << name;
+      }
+    o.cancel_distance = 2;
+    const AutoResult rc = auto_singularities(designer, o);
+    std::printf("%-18s faces %7d chi %3d: %4zu singularities (%3d negative), %3zu after cancelling pairs within 2 mean edges\n", name,
+                t.num_faces, t.euler_characteristic(), r.found.size(), negative, rc.vertex.size());
+    // The exact solve: residuals, transport, and indices read back (after cancellation, a pair removed on a
+    // sharply curved spot may need a turn of π/N or more across an edge, which a per-face field cannot show).
+    expect_exact(designer, rc.vertex, 4, name, false);
+  }
+}
+
+}  // namespace
+}  // namespace trivcon

@@ -1,0 +1,170 @@
+// `trivcon solve --auto`, `--auto-cancel`, `--sing-out` and `--sing-from-field`, run as a separate process.
+#include <cmath>
+#include <fstream>
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include "support.h"
+#include "trivcon/io.h"
+
+namespace trivcon {
+namespace {
+
+using test::run_cli;
+using test::slurp;
+using test::temp_file;
+
+nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path)); }
+
+// The report's singularities as vertex → index text.
+std::map<int, std::string> report_singularities(const nlohmann::json& report) {
+  std::map<int, std::string> s;
+  for (const auto& item : report["singularities"]) s[item["vertex"].get<int>()] = item["index"].get<std::string>();
+  return s;
+}
+
+std::string mesh_file(const Mesh& m, const std::string& name) {
+  const std::string path = temp_file(name);
+  write_obj(path, m.V, m.F);
+  return path;
+}
+
+TEST(CliAuto, CubeGetsEightCornersAndSolvesExactly) {
+  const std::string mesh = mesh_file(make_cube_sphere(8, false), "cube.obj");
+  const std::string report = temp_file("report.json"), sings = temp_file("auto.sing"), field = temp_file("field.txt");
+  const auto r = run_cli("solve " + mesh + " -N 4 --auto --report " + report + " --sing-out " + sings + " --field-out " + field);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("auto: smoothest field found 8 singularities, cancelled 0 pairs, using 8"), std::string::npos) << r.out;
+  const nlohmann::json j = read_json(report);
+  EXPECT_EQ(j["auto"]["found"], 8);
+  EXPECT_EQ(j["auto"]["cancelled_pairs"], 0);
+  EXPECT_EQ(j["auto"]["used"], 8);
+  EXPECT_TRUE(j["verified"].get<bool>());
+  EXPECT_TRUE(j["indices"]["field_mismatches"].empty());
+  const std::map<int, std::string> used = report_singularities(j);
+  ASSERT_EQ(used.size(), 8u);
+  for (const auto& [v, index] : used) EXPECT_EQ(index, "1/4") << "vertex " << v;
+  // The written singularities are exactly those of the field.
+  const auto c = run_cli("check " + mesh + " " + field + " -N 4 -s " + sings);
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("matches the prescription"), std::string::npos) << c.out;
+}
+
+TEST(CliAuto, SingOutRoundTripsThroughS) {
+  const std::string mesh = mesh_file(make_icosphere(2), "sphere.obj");
+  const std::string sings = temp_file("used.sing"), r1 = temp_file("r1.json"), r2 = temp_file("r2.json");
+  const auto a =
+      run_cli("solve " + mesh + " -N 4 --sing 0:1/2 --sing 3:1 --sing 7:1/4 --sing 9:1/4 --sing-out " + sings + " --report " + r1);
+  ASSERT_EQ(a.status, 0) << a.err;
+  const std::string text = slurp(sings);
+  EXPECT_EQ(text.rfind("# trivcon singularities", 0), 0u) << text;
+  EXPECT_NE(text.find("\n0 1/2\n3 1\n7 1/4\n9 1/4\n"), std::string::npos) << text;
+  const auto b = run_cli("solve " + mesh + " -N 4 -s " + sings + " --report " + r2);
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_EQ(report_singularities(read_json(r1)), report_singularities(read_json(r2)));
+  EXPECT_EQ(read_json(r1)["energy"], read_json(r2)["energy"]);
+}
+
+TEST(CliAuto, SingFromFieldReproducesAnotherFieldsSingularities) {
+  const Mesh m = make_icosphere(3);
+  const std::string mesh = mesh_file(m, "sphere.obj");
+  // A field by another route: unit weights, written as Directional's .rawfield.
+  const std::string raw = temp_file("other.rawfield"), r1 = temp_file("r1.json"), r2 = temp_file("r2.json");
+  const auto a = run_cli(
+      "solve " + mesh +
+      " -N 4 --weights unit --sing 0:1/4 --sing 1:1/4 --sing 2:1/4 --sing 3:1/4 --sing 4:1/4 --sing 5:1/4 --sing 6:1/2 --field-out " + raw +
+      " --report " + r1);
+  ASSERT_EQ(a.status, 0) << a.err;
+  const auto b = run_cli("solve " + mesh + " --sing-from-field " + raw + " --report " + r2);
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_NE(b.out.find("has 7 singularities"), std::string::npos) << b.out;
+  const nlohmann::json j2 = read_json(r2);
+  EXPECT_EQ(j2["N"], 4);  // from the file
+  EXPECT_EQ(report_singularities(read_json(r1)), report_singularities(j2));
+  EXPECT_EQ(j2["sing_from_field"]["singularities"], 7);
+  EXPECT_TRUE(read_json(r1)["indices"]["field_mismatches"].empty());
+  EXPECT_TRUE(j2["verified"].get<bool>());
+
+  // A field built by hand: the constant world direction z projected onto every face (N = 1), in the text
+  // format; its singularities are whatever `check` finds in it.
+  const std::string hand = temp_file("hand.txt"), r3 = temp_file("r3.json");
+  {
+    std::ofstream out(hand);
+    out << "# N 1\n";
+    for (int f = 0; f < m.F.rows(); ++f) {
+      const Eigen::RowVector3d p0 = m.V.row(m.F(f, 0)), p1 = m.V.row(m.F(f, 1)), p2 = m.V.row(m.F(f, 2));
+      const Eigen::RowVector3d n = (p1 - p0).cross(p2 - p0).normalized();
+      const Eigen::RowVector3d z(0.3, 0.2, 1.0);
+      const Eigen::RowVector3d d = z - z.dot(n) * n;
+      out << d(0) << " " << d(1) << " " << d(2) << "\n";
+    }
+  }
+  const auto c = run_cli("check " + mesh + " " + hand + " --json");
+  ASSERT_EQ(c.status, 0) << c.err;
+  std::map<int, std::string> found;
+  const nlohmann::json check = nlohmann::json::parse(c.out);
+  for (const auto& item : check["singularities"]) found[item["vertex"].get<int>()] = item["index"].get<std::string>();
+  const auto s = run_cli("solve " + mesh + " --sing-from-field " + hand + " --report " + r3);
+  ASSERT_EQ(s.status, 0) << s.err;
+  EXPECT_EQ(report_singularities(read_json(r3)), found);
+  EXPECT_FALSE(found.empty());
+}
+
+TEST(CliAuto, CancelOptionReportsFoundCancelledAndUsed) {
+  Mesh m = make_icosphere(3);
+  for (int v = 0; v < m.V.rows(); ++v) m.V.row(v) *= 1.0 + 0.08 * std::sin(37.0 * v);
+  const std::string mesh = mesh_file(m, "noisy.obj"), report = temp_file("report.json");
+  const auto r = run_cli("solve " + mesh + " -N 4 --auto --auto-cancel 4 --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = read_json(report);
+  const int found = j["auto"]["found"], pairs = j["auto"]["cancelled_pairs"], used = j["auto"]["used"];
+  EXPECT_EQ(found, used + 2 * pairs);
+  EXPECT_EQ(static_cast<int>(j["singularities"].size()), used);
+  EXPECT_NE(r.out.find("auto: smoothest field found " + std::to_string(found) + " singularities, cancelled " + std::to_string(pairs) +
+                       " pairs, using " + std::to_string(used)),
+            std::string::npos)
+      << r.out;
+  EXPECT_TRUE(j["verified"].get<bool>());
+}
+
+TEST(CliAuto, AlignedDiskGetsFourQuarterSingularities) {
+  const std::string mesh = mesh_file(make_disk(12, 8), "disk.obj"), report = temp_file("report.json");
+  const auto r = run_cli("solve " + mesh + " -N 4 --align-boundary --auto --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = read_json(report);
+  const std::map<int, std::string> used = report_singularities(j);
+  EXPECT_EQ(used.size(), 4u);
+  for (const auto& [v, index] : used) EXPECT_EQ(index, "1/4") << "vertex " << v;
+  EXPECT_TRUE(j["verified"].get<bool>());
+}
+
+// --fix faces are held by the smoothest field too (Dirichlet values), then by the exact solve.
+TEST(CliAuto, FixedFacesAreHonoured) {
+  const std::string mesh = mesh_file(make_icosphere(3), "sphere.obj"), report = temp_file("report.json");
+  const auto r = run_cli("solve " + mesh + " -N 4 --auto --fix 0:1,0,0 --fix 500:0,1,0 --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = read_json(report);
+  int sum = 0;
+  for (const auto& [v, index] : report_singularities(j)) sum += index == "1/4" ? 1 : index == "-1/4" ? -1 : 100;
+  EXPECT_EQ(sum, 8);
+  EXPECT_EQ(j["fixed"]["faces"], 2);
+  EXPECT_LE(j["fixed"]["max_error"].get<double>(), 1e-9);
+  EXPECT_TRUE(j["verified"].get<bool>());
+}
+
+TEST(CliAuto, UsageErrors) {
+  const std::string mesh = mesh_file(make_icosphere(1), "sphere.obj"), sings = temp_file("s.sing");
+  test::write_text(sings, "0 1\n1 1\n");
+  EXPECT_EQ(run_cli("solve " + mesh + " --auto --sing 0:1 --sing 1:1").status, 2);
+  EXPECT_EQ(run_cli("solve " + mesh + " --auto -s " + sings).status, 2);
+  EXPECT_EQ(run_cli("solve " + mesh + " --auto-cancel 2").status, 2);
+  EXPECT_EQ(run_cli("solve " + mesh + " --auto --auto-cancel -1").status, 2);
+  EXPECT_EQ(run_cli("solve " + mesh + " --sing-from-field f.txt -s " + sings).status, 2);
+  // A field file that does not exist is bad input, named.
+  const auto r = run_cli("solve " + mesh + " --sing-from-field " + temp_file("missing.txt"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("missing.txt"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace trivcon
