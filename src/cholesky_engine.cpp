@@ -96,10 +96,10 @@ class CholeskyEngine : public SolverEngine {
   mutable std::vector<int> super_stamp_;
   mutable Eigen::VectorXd forward_work_;
   mutable int stamp_ = 0;
-  // Backward substitution on two threads (see plan_backward): the supernodes of the top of the tree,
-  // then two sets of disjoint subtrees, all in decreasing order.
+  // Backward substitution on OpenMP's threads (see plan_backward): the supernodes of the top of the tree,
+  // then one set of disjoint subtrees per thread, all in decreasing order.
   std::vector<int> backward_top_;
-  std::array<std::vector<int>, 2> backward_part_;
+  std::vector<std::vector<int>> backward_part_;
 
   // The rows of A (see normal_matrix): vertex rows given per system edge by the rows of its two ends (a
   // boundary or dropped vertex has none), then the extra rows Et (fixed-face paths that are ordered with
@@ -148,7 +148,7 @@ class CholeskyEngine : public SolverEngine {
     analysis_adopted = true;
   }
 
-  // The numeric factorization into the symbolic factor: ours (two threads) or CHOLMOD's own. Returns
+  // The numeric factorization into the symbolic factor: ours (OpenMP's threads) or CHOLMOD's own. Returns
   // the first column not positive definite, or n.
   int numeric(const Csc& M) {
     const int n = nD + nC;
@@ -207,15 +207,16 @@ class CholeskyEngine : public SolverEngine {
     plan_backward();
   }
 
-  // Splits the supernodal elimination tree for a backward substitution on two threads, balanced by
+  // Splits the supernodal elimination tree for a backward substitution on OpenMP's threads, balanced by
   // the factor's entries (see supernodal::split_tree), each list in decreasing order.
   void plan_backward() {
     const Supernodes L(factor);
     std::vector<double> entries(L.count);
     for (int s = 0; s < L.count; ++s) entries[s] = static_cast<double>(L.height(s)) * L.cols(s);
-    supernodal::TreeSplit split = supernodal::split_tree(super_parent_, entries, 1e4);
+    supernodal::TreeSplit split = supernodal::split_tree(super_parent_, entries, 1e4, max_threads());
     backward_top_.assign(split.top.rbegin(), split.top.rend());
-    for (int k = 0; k < 2; ++k) backward_part_[k].assign(split.part[k].rbegin(), split.part[k].rend());
+    backward_part_.resize(split.part.size());
+    for (size_t k = 0; k < split.part.size(); ++k) backward_part_[k].assign(split.part[k].rbegin(), split.part[k].rend());
   }
 
   // z ← L⁻ᵀ z (in factor order): the top supernodes, then the two parts of the tree concurrently.
@@ -238,8 +239,9 @@ class CholeskyEngine : public SolverEngine {
       }
     };
     solve_supernodes(backward_top_);
-#pragma omp parallel for schedule(static, 1) num_threads(threads_for(2)) if (!backward_part_[1].empty())
-    for (int k = 0; k < 2; ++k) solve_supernodes(backward_part_[k]);
+    const int parts = static_cast<int>(backward_part_.size());
+#pragma omp parallel for schedule(static, 1) num_threads(parts) if (parts > 1 && !backward_part_[1].empty())
+    for (int k = 0; k < parts; ++k) solve_supernodes(backward_part_[k]);
   }
 
   // z += L⁻¹ d for d with the few nonzeros `entries` (factor positions, values): only the supernodes on

@@ -209,7 +209,8 @@ class Numeric {
 
 }  // namespace
 
-TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& own_work, double min_split) {
+TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& own_work, double min_split, int parts) {
+  if (parts < 1) parts = 1;
   const int count = static_cast<int>(parent.size());
   std::vector<double> work = own_work;  // of each subtree (a parent comes after its children)
   std::vector<std::vector<int>> children(count);
@@ -221,12 +222,13 @@ TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& 
       roots.push_back(s);
   }
   TreeSplit split;
+  split.part.resize(parts);
   auto lighter = [&](int a, int b) { return work[a] < work[b]; };
   std::vector<int> open = roots;  // a max-heap of subtree roots by work
   std::make_heap(open.begin(), open.end(), lighter);
   double open_work = 0;
   for (int r : roots) open_work += work[r];
-  while (!open.empty() && work[open.front()] > 0.5 * open_work && work[open.front()] > min_split) {
+  while (parts > 1 && !open.empty() && work[open.front()] > open_work / parts && work[open.front()] > min_split) {
     std::pop_heap(open.begin(), open.end(), lighter);
     const int s = open.back();
     open.pop_back();
@@ -235,10 +237,10 @@ TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& 
     for (int c : children[s]) open.push_back(c), std::push_heap(open.begin(), open.end(), lighter), open_work += work[c];
   }
   std::sort(open.begin(), open.end(), [&](int a, int b) { return work[a] > work[b]; });
-  std::array<double, 2> load{0, 0};
+  std::vector<double> load(parts, 0.0);
   std::vector<int> stack;
   for (int r : open) {
-    const int k = load[0] <= load[1] ? 0 : 1;
+    const int k = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());  // the first least loaded
     load[k] += work[r];
     for (stack.assign(1, r); !stack.empty();) {
       const int s = stack.back();
@@ -286,24 +288,25 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
     const double ncol = S.cols(s), nrow = S.height(s);
     work[s] = ncol * nrow * nrow + 64 * nrow;
   }
-  const TreeSplit split = split_tree(supernode_parents(S, owner), work, 1e5);
+  const TreeSplit split = split_tree(supernode_parents(S, owner), work, 1e5, detail::max_threads());
+  const int parts = static_cast<int>(split.part.size());
   Numeric numeric(S, owner, static_cast<double*>(L.x), A);
-  // Below the top, two threads: a subtree needs only its own descendants. Each thread keeps its own
+  // Below the top, one thread per part (OpenMP's thread count): a subtree needs only its own descendants. Each thread keeps its own
   // lists of pending updates (`head`); its lists for the supernodes of the top are handed over when both
   // are done. Then the top, one supernode at a time, with OpenBLAS's threads inside the large dense
   // blocks there. (Gathering each thread's updates to the top in buffers of its own, so that they are
   // computed on both cores too, saved nothing: on the 400k-face sphere it took each thread as long as it
   // saved the top.) The result does not depend on the timing of the threads: each part is computed in
   // its own order and the lists are handed over in a fixed one.
-  const bool two = !split.part[1].empty() && detail::threads_for(2) > 1;
-  std::array<std::vector<int>, 2> head;
-  std::array<int, 2> failed{-1, -1};
-  std::array<std::exception_ptr, 2> error;
+  const bool several = parts > 1 && !split.part[1].empty();
+  std::vector<std::vector<int>> head(parts);
+  std::vector<int> failed(parts, -1);
+  std::vector<std::exception_ptr> error(parts);
   {
     std::optional<SingleThreadedBlas> one_thread_per_call;
-    if (two) one_thread_per_call.emplace();
-#pragma omp parallel for schedule(static, 1) num_threads(detail::threads_for(2)) if (two)
-    for (int k = 0; k < 2; ++k) {
+    if (several) one_thread_per_call.emplace();
+#pragma omp parallel for schedule(static, 1) num_threads(parts) if (several)
+    for (int k = 0; k < parts; ++k) {
       try {
         head[k].assign(L.nsuper, -1);
         Workspace w = numeric.workspace();

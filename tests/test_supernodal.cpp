@@ -131,14 +131,18 @@ TEST(Supernodal, SameFactorWithALargeTop) {
   EXPECT_LT(r.difference, 1e-12);
 }
 
-TEST(Supernodal, SameFactorOnOneThread) {
+TEST(Supernodal, SameFactorOnOneThreeAndFourThreads) {
+  // The subtrees are split into one part per OpenMP thread (more threads than cores is fine here).
   const int threads = omp_get_max_threads();
-  omp_set_num_threads(1);
-  Upper M = shifted_laplacian(make_cube_sphere(50, true), 1e-3, 11);
-  const Comparison r = compare(M);
+  for (int n : {1, 3, 4}) {
+    SCOPED_TRACE(std::to_string(n) + " threads");
+    omp_set_num_threads(n);
+    Upper M = shifted_laplacian(make_cube_sphere(50, true), 1e-3, 11);
+    const Comparison r = compare(M);
+    EXPECT_EQ(r.ours_minor, static_cast<size_t>(M.n));
+    EXPECT_LT(r.difference, 1e-12);
+  }
   omp_set_num_threads(threads);
-  EXPECT_EQ(r.ours_minor, static_cast<size_t>(M.n));
-  EXPECT_LT(r.difference, 1e-12);
 }
 
 TEST(Supernodal, SameBitsEveryTime) {
@@ -180,31 +184,35 @@ TEST(Supernodal, ReportsTheColumnThatIsNotPositiveDefinite) {
   }
 }
 
-// Checks a split against split_tree's contract (src/supernodal.h) and returns what it left below the top:
-// the loads of the two parts (the sum of `work` over each) and the subtree roots there.
+// Checks a split against split_tree's contract (src/detail/supernodal.h) and returns what it left below
+// the top: the loads of the parts (the sum of `work` over each) and the subtree roots there.
 struct BelowTop {
-  std::array<double, 2> load{0, 0};
+  std::vector<double> load;
   std::vector<int> roots;
   double heaviest = 0;  // the largest subtree below the top
 };
 BelowTop expect_valid_split(const std::vector<int>& parent, const std::vector<double>& work, double min_split,
-                            const supernodal::TreeSplit& split) {
+                            const supernodal::TreeSplit& split, int parts = 2) {
   const int count = static_cast<int>(parent.size());
-  std::vector<int> where(count, -2);  // −1: top, 0/1: part
+  EXPECT_EQ(static_cast<int>(split.part.size()), parts);
+  std::vector<int> where(count, -2);  // −1: top, k ≥ 0: part k
   for (int s : split.top) {
     EXPECT_EQ(where[s], -2);
     where[s] = -1;
   }
-  for (int k = 0; k < 2; ++k)
+  EXPECT_TRUE(std::is_sorted(split.top.begin(), split.top.end()));
+  for (int k = 0; k < static_cast<int>(split.part.size()); ++k) {
+    EXPECT_TRUE(std::is_sorted(split.part[k].begin(), split.part[k].end()));
     for (int s : split.part[k]) {
       EXPECT_EQ(where[s], -2);
       where[s] = k;
     }
-  for (const auto* list : {&split.top, &split.part[0], &split.part[1]}) EXPECT_TRUE(std::is_sorted(list->begin(), list->end()));
+  }
   std::vector<double> subtree = work;  // a parent comes after its children
   for (int s = 0; s < count; ++s)
     if (parent[s] >= 0) subtree[parent[s]] += subtree[s];
   BelowTop below;
+  below.load.assign(split.part.size(), 0.0);
   for (int s = 0; s < count; ++s) {
     EXPECT_NE(where[s], -2) << "supernode " << s << " in no list";
     if (where[s] == -2) continue;
@@ -220,16 +228,26 @@ BelowTop expect_valid_split(const std::vector<int>& parent, const std::vector<do
       if (parent[s] < 0 || where[parent[s]] == -1) below.roots.push_back(s), below.heaviest = std::max(below.heaviest, subtree[s]);
     }
   }
-  // Splitting stopped where it should: the largest subtree left holds at most half of the work below the
-  // top, or no more than min_split.
-  const double total = below.load[0] + below.load[1];
-  EXPECT_FALSE(below.heaviest > 0.5 * total && below.heaviest > min_split) << "the largest subtree below the top should have been split";
-  // Both parts get work whenever two subtrees are left; balanced by the work measure: the parts differ by
-  // at most the largest subtree (each subtree goes whole to the lighter part, largest first).
-  if (below.roots.size() >= 2) {
-    EXPECT_FALSE(split.part[0].empty() || split.part[1].empty()) << below.roots.size() << " subtrees below the top, one part empty";
+  // Splitting stopped where it should: the largest subtree left holds at most 1/parts of the work below the
+  // top, or no more than min_split (with one part nothing is split).
+  double total = 0;
+  for (double l : below.load) total += l;
+  if (parts > 1) {
+    EXPECT_FALSE(below.heaviest > total / parts && below.heaviest > min_split)
+        << "the largest subtree below the top should have been split";
+  } else {
+    EXPECT_TRUE(split.top.empty());
   }
-  EXPECT_LE(std::abs(below.load[0] - below.load[1]), below.heaviest + 1e-9);
+  // Every part gets work whenever there are as many subtrees as parts; balanced by the work measure: the
+  // heaviest and lightest parts differ by at most the largest subtree (each subtree goes whole to the
+  // lightest part, largest first).
+  if (static_cast<int>(below.roots.size()) >= parts) {
+    for (const auto& part : split.part) EXPECT_FALSE(part.empty()) << below.roots.size() << " subtrees below the top, a part empty";
+  }
+  if (!below.load.empty()) {
+    const auto [lightest, heaviest] = std::minmax_element(below.load.begin(), below.load.end());
+    EXPECT_LE(*heaviest - *lightest, below.heaviest + 1e-9);
+  }
   return below;
 }
 
@@ -272,6 +290,38 @@ TEST(Supernodal, TreeSplitIsIndependentAndBalanced) {
     split_in_two += expect_valid_split(parent, work, 100, split).roots.size() >= 2;
   }
   EXPECT_GE(split_in_two, 40) << "most random forests leave several subtrees below the top";
+}
+
+// The same contract for 1, 3 and 4 parts (threads): split_tree takes OpenMP's thread count.
+TEST(Supernodal, TreeSplitIntoAnyNumberOfParts) {
+  using supernodal::split_tree;
+  {  // Four equal leaves under a root: with 4 parts one leaf each, with 1 part nothing split.
+    const std::vector<int> parent{4, 4, 4, 4, -1};
+    const std::vector<double> work{10, 10, 10, 10, 1};
+    const supernodal::TreeSplit four = split_tree(parent, work, 5, 4), one = split_tree(parent, work, 5, 1);
+    expect_valid_split(parent, work, 5, four, 4);
+    expect_valid_split(parent, work, 5, one, 1);
+    EXPECT_EQ(four.top, std::vector<int>{4});
+    for (const auto& part : four.part) EXPECT_EQ(part.size(), 1u);
+    EXPECT_EQ(one.part[0].size(), 5u);
+  }
+  std::mt19937 rng(11);
+  for (int parts : {1, 3, 4}) {
+    int all_used = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+      SCOPED_TRACE("parts " + std::to_string(parts) + ", trial " + std::to_string(trial));
+      const int count = 1 + static_cast<int>(rng() % 400);
+      std::vector<int> parent(count, -1);
+      std::vector<double> work(count);
+      for (int s = 0; s < count; ++s) {
+        work[s] = 1 + rng() % 1000;
+        if (s + 1 < count && rng() % 20 != 0) parent[s] = s + 1 + static_cast<int>(rng() % std::min(5, count - s - 1));
+      }
+      const supernodal::TreeSplit split = split_tree(parent, work, 100, parts);
+      all_used += static_cast<int>(expect_valid_split(parent, work, 100, split, parts).roots.size()) >= parts;
+    }
+    EXPECT_GE(all_used, 30) << "most random forests leave a subtree for every part";
+  }
 }
 
 // The elimination trees of mesh Laplacians, with the work measure and threshold supernodal::factorize

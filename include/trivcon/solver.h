@@ -17,12 +17,12 @@
 // interior vertices; on a closed component one vertex row is dropped (Gauss–Bonnet makes it redundant),
 // and on a component with boundary one loop row is (its index follows from the others). A W Aᵀ is
 // factored once (supernodal LLᵀ: CHOLMOD's symbolic analysis, our numeric factorization into CHOLMOD's
-// factor on two threads, src/detail/supernodal.h, or CHOLMOD's own with Factorization::Cholmod; OpenBLAS), the vertex rows in a
+// factor on OpenMP's threads, src/detail/supernodal.h, or CHOLMOD's own with Factorization::Cholmod; OpenBLAS), the vertex rows in a
 // fill-reducing order and the cycle rows last, so that the trailing block of the factor is the Cholesky factor of the Schur complement S =
 // CWCᵀ − CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is minimum degree: CAMD with the cycle rows constrained last, or AMD without cycle rows. A new
 // prescription only changes b: nothing is refactored. The forward substitution of the prescription without singularities is stored, so an
 // edit that places a few singularities updates it along their paths in the elimination tree only, then does one full backward substitution,
-// on two threads (OpenMP; the top of the elimination tree first, then two sets of independent subtrees).
+// on OpenMP's threads (the top of the elimination tree first, then one set of independent subtrees per thread).
 // Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
 // system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
 //

@@ -1,14 +1,13 @@
-// Internal: the numeric supernodal Cholesky factorization behind ConnectionSolver, on two threads.
+// Internal: the numeric supernodal Cholesky factorization behind ConnectionSolver, on several threads.
 //
 // CHOLMOD does the ordering and the symbolic factorization (trivcon/solver.h); this computes the values of
 // CHOLMOD's own supernodal factor object, so that everything else (CHOLMOD's solves, the solver's sparse
 // forward update and backward substitution) reads it unchanged. Why not cholmod_factorize: CHOLMOD 3
 // (Debian 12) visits the supernodes one after another and uses the second core only inside BLAS calls on
 // large supernodes, while on a mesh most of the time goes to the many small supernodes near the leaves of
-// the elimination tree. Here independent subtrees are factored on two threads, then the top of the tree
-// with multithreaded BLAS. Same algorithm as CHOLMOD's (left-looking supernodal: each supernode gathers
-// the updates of its descendants, then a dense Cholesky of its diagonal block and a triangular solve of
-// the rows below), same storage.
+// the elimination tree. Here independent subtrees are factored on OpenMP's threads (one set of subtrees per thread), then the top of the
+// tree with multithreaded BLAS. Same algorithm as CHOLMOD's (left-looking supernodal: each supernode gathers the updates of its
+// descendants, then a dense Cholesky of its diagonal block and a triangular solve of the rows below), same storage.
 #pragma once
 #include <cholmod.h>
 
@@ -19,16 +18,17 @@
 
 namespace trivcon::supernodal {
 
-// The supernodal elimination tree of a factor, split for two threads: `top` (the supernodes above the
-// split, done one at a time) and two sets of whole subtrees below it that do not depend on each other,
-// balanced by `work` (per supernode; a subtree's work is the sum over it). The largest remaining subtree
-// is split at its root while it holds more than half of the work below the top and more than `min_split`.
-// Each list is in increasing supernode order (descendants first).
+// The supernodal elimination tree of a factor, split for `parts` threads: `top` (the supernodes above
+// the split, done one at a time) and `parts` sets of whole subtrees below it that do not depend on each
+// other, balanced by `work` (per supernode; a subtree's work is the sum over it): the largest remaining
+// subtree is split at its root while it holds more than 1/parts of the work below the top and more than
+// `min_split`, then the subtrees go, largest first, to the part with the least work so far. Each list is
+// in increasing supernode order (descendants first). parts ≥ 1; with 1 everything is in part[0].
 struct TreeSplit {
   std::vector<int> top;
-  std::array<std::vector<int>, 2> part;
+  std::vector<std::vector<int>> part;
 };
-TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& work, double min_split);
+TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& work, double min_split, int parts = 2);
 
 // CHOLMOD's supernodal factor, read in place: supernode s holds the columns first(s) … first(s) + cols(s)
 // − 1; its rows (its own columns first, then rows of its ancestors) are row(s, 0 … height(s) − 1), its
