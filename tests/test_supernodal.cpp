@@ -251,6 +251,18 @@ BelowTop expect_valid_split(const std::vector<int>& parent, const std::vector<do
   return below;
 }
 
+// A random forest of up to 400 supernodes (a parent after its children, one root in 20 on average) with
+// random work.
+void random_forest(std::mt19937& rng, std::vector<int>& parent, std::vector<double>& work) {
+  const int count = 1 + static_cast<int>(rng() % 400);
+  parent.assign(count, -1);
+  work.resize(count);
+  for (int s = 0; s < count; ++s) {
+    work[s] = 1 + rng() % 1000;
+    if (s + 1 < count && rng() % 20 != 0) parent[s] = s + 1 + static_cast<int>(rng() % std::min(5, count - s - 1));
+  }
+}
+
 TEST(Supernodal, TreeSplitIsIndependentAndBalanced) {
   using supernodal::split_tree;
   {  // Two equal leaves under a heavy root: the root is the top, one leaf per part.
@@ -279,13 +291,9 @@ TEST(Supernodal, TreeSplitIsIndependentAndBalanced) {
   int split_in_two = 0;
   for (int trial = 0; trial < 50; ++trial) {
     SCOPED_TRACE("trial " + std::to_string(trial));
-    const int count = 1 + static_cast<int>(rng() % 400);
-    std::vector<int> parent(count, -1);
-    std::vector<double> work(count);
-    for (int s = 0; s < count; ++s) {
-      work[s] = 1 + rng() % 1000;
-      if (s + 1 < count && rng() % 20 != 0) parent[s] = s + 1 + static_cast<int>(rng() % std::min(5, count - s - 1));
-    }
+    std::vector<int> parent;
+    std::vector<double> work;
+    random_forest(rng, parent, work);
     const supernodal::TreeSplit split = split_tree(parent, work, 100);
     split_in_two += expect_valid_split(parent, work, 100, split).roots.size() >= 2;
   }
@@ -310,13 +318,9 @@ TEST(Supernodal, TreeSplitIntoAnyNumberOfParts) {
     int all_used = 0;
     for (int trial = 0; trial < 40; ++trial) {
       SCOPED_TRACE("parts " + std::to_string(parts) + ", trial " + std::to_string(trial));
-      const int count = 1 + static_cast<int>(rng() % 400);
-      std::vector<int> parent(count, -1);
-      std::vector<double> work(count);
-      for (int s = 0; s < count; ++s) {
-        work[s] = 1 + rng() % 1000;
-        if (s + 1 < count && rng() % 20 != 0) parent[s] = s + 1 + static_cast<int>(rng() % std::min(5, count - s - 1));
-      }
+      std::vector<int> parent;
+      std::vector<double> work;
+      random_forest(rng, parent, work);
       const supernodal::TreeSplit split = split_tree(parent, work, 100, parts);
       all_used += static_cast<int>(expect_valid_split(parent, work, 100, split, parts).roots.size()) >= parts;
     }
