@@ -81,6 +81,7 @@ class CholeskyEngine : public SolverEngine {
   mutable std::unique_ptr<AnalysisState> cholmod_ = std::make_unique<AnalysisState>();
   cholmod_common& cc() const { return *cholmod_->cc; }
   Factorization factorization_;
+  const char* numeric_by_ = "";  // who computed the factor's values (SetupTimings::numeric_factorization)
   cholmod_factor* factor = nullptr;
   bool analysis_adopted = false;
   Eigen::VectorXd w;
@@ -125,6 +126,7 @@ class CholeskyEngine : public SolverEngine {
       t0 = Clock::now();
       factorize(M);
       timings.factor += seconds_since(t0);
+      timings.numeric_factorization = numeric_by_;
       t0 = Clock::now();
       prepare_schur();
       timings.schur += seconds_since(t0);
@@ -152,7 +154,11 @@ class CholeskyEngine : public SolverEngine {
   // the first column not positive definite, or n.
   int numeric(const Csc& M) {
     const int n = nD + nC;
-    if (factorization_ == Factorization::Parallel) return supernodal::factorize(*factor, M.outer, M.inner, M.values, cc());
+    if (factorization_ == Factorization::Parallel) {
+      numeric_by_ = "trivcon";
+      return supernodal::factorize(*factor, M.outer, M.inner, M.values, cc());
+    }
+    numeric_by_ = "cholmod";
     cholmod_sparse A = upper_view(M.outer, M.inner, M.values, n);
     const int ok = cholmod_factorize(&A, factor, &cc());
     check(ok && (cc().status == CHOLMOD_OK || cc().status == CHOLMOD_NOT_POSDEF), "CHOLMOD factorization failed");

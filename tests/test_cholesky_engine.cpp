@@ -67,6 +67,8 @@ Design solve(const Case& c, Factorization factorization, std::vector<int>* fixed
     designer.set_fixed_faces(faces);
     if (fixed_used) *fixed_used = faces;
   }
+  // The route asked for is the one that ran.
+  EXPECT_EQ(designer.solver().timings().numeric_factorization, factorization == Factorization::Cholmod ? "cholmod" : "trivcon");
   return designer.design(p);
 }
 

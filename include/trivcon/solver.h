@@ -86,6 +86,9 @@ struct SetupTimings {
   // the stored forward substitution; analysis_wait: time spent waiting for a given SolverAnalysis.
   double assemble = 0, factor = 0, schur = 0, analysis_wait = 0;
   bool analysis_adopted = false;  // the factorization used the given SolverAnalysis
+  // Who computed the Cholesky factor's values: "trivcon" (Factorization::Parallel) or "cholmod"
+  // (Factorization::Cholmod); "" on the QR route and for an empty system.
+  std::string numeric_factorization;
 };
 
 namespace detail {
