@@ -121,9 +121,9 @@ mkdir -p "$scratch" "$logs"
 touch "$scratch/.trivcon-mutants"
 rm -rf "$src"
 mkdir -p "$src"
-tar -C "$repo" --exclude=./.git --exclude='./build*' --exclude=./demo-output -cf - . | tar -C "$src" -xf -
-# Every file a mutant touches is recompiled once (a ccache hit): its object may come from an interrupted run.
-for f in $(printf '%s\n' "${m_file[@]}" | sort -u); do [ -f "$src/$f" ] && touch "$src/$f"; done
+# -m: the copies get the current time, so the reused build folder recompiles every file (ccache hits
+# where unchanged) and never keeps an object of an older copy whose file kept an older time.
+tar -C "$repo" --exclude=./.git --exclude='./build*' --exclude=./demo-output -cf - . | tar -C "$src" -xmf -
 # Tests look for the shared meshes next to the source tree (../shared/data/meshes).
 if [ -d "$repo/../shared" ] && [ ! -e "$scratch/shared" ]; then ln -s "$(cd "$repo/../shared" && pwd)" "$scratch/shared"; fi
 
