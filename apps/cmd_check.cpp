@@ -27,12 +27,7 @@ void run_check(CheckOptions& o) {
   const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
   const Geometry g = compute_geometry(mesh.V, t);
   const Cycles cycles = compute_cycles(t);
-  int file_N = 0;
-  const MatrixX3d directions = read_field(o.field, t.num_faces, &file_N);
-  if (o.prescription.N_given() && file_N > 0 && file_N != o.prescription.N)
-    throw Error("the field file " + o.field + " holds an N = " + std::to_string(file_N) + " field but -N " +
-                std::to_string(o.prescription.N) + " was given");
-  if (!o.prescription.N_given() && file_N > 0) o.prescription.N = file_N;
+  const MatrixX3d directions = o.prescription.read_field_file(o.field, t.num_faces, o.prescription.N);
   // Without a prescription, check only lists the field's singularities.
   const bool compare = !o.prescription.empty();
   const IndexPrescription p = o.prescription.build();

@@ -161,12 +161,7 @@ void run_solve(const SolveOptions& o) {
                 << r.vertex.size() << "\n";
   }
   if (!o.sing_from_field.empty()) {
-    int file_N = 0;
-    const MatrixX3d directions = read_field(o.sing_from_field, designer.topology().num_faces, &file_N);
-    if (o.prescription.N_given() && file_N > 0 && file_N != prescription.N)
-      throw Error("the field file " + o.sing_from_field + " holds an N = " + std::to_string(file_N) + " field but -N " +
-                  std::to_string(prescription.N) + " was given");
-    if (file_N > 0) prescription.N = file_N;
+    const MatrixX3d directions = o.prescription.read_field_file(o.sing_from_field, designer.topology().num_faces, prescription.N);
     const Field field = field_from_directions(designer.geometry(), directions, prescription.N);
     const FieldIndices idx = field_indices(designer.topology(), designer.geometry(), designer.cycles(), field);
     for (int v = 0; v < designer.topology().num_vertices; ++v)

@@ -1,5 +1,8 @@
 #include "prescription_options.h"
 
+#include "trivcon/error.h"
+#include "trivcon/field_io.h"
+
 namespace trivcon::cli {
 
 void PrescriptionOptions::add_to(CLI::App* cmd, bool with_cycles) {
@@ -21,6 +24,16 @@ IndexPrescription PrescriptionOptions::build() const {
   for (const auto& s : generators) add_generator_index(s, p);
   for (const auto& s : loops) add_loop_index(s, p);
   return p;
+}
+
+MatrixX3d PrescriptionOptions::read_field_file(const std::string& path, int num_faces, int& N_out) const {
+  int file_N = 0;
+  MatrixX3d directions = read_field(path, num_faces, &file_N);
+  if (N_given() && file_N > 0 && file_N != N_out)
+    throw Error("the field file " + path + " holds an N = " + std::to_string(file_N) + " field but -N " + std::to_string(N_out) +
+                " was given");
+  if (file_N > 0) N_out = file_N;
+  return directions;
 }
 
 }  // namespace trivcon::cli

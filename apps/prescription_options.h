@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "trivcon/common.h"
 #include "trivcon/indices.h"
 
 namespace trivcon::cli {
@@ -21,6 +22,9 @@ struct PrescriptionOptions {
   void add_to(CLI::App* cmd, bool with_cycles);
   // The prescription the options give (files read, specs parsed; throws trivcon::Error).
   IndexPrescription build() const;
+  // A per-face field file (trivcon/field_io.h read_field): its directions; `N` becomes the file's N when
+  // the file states one, which must agree with -N when that was given (trivcon::Error otherwise).
+  MatrixX3d read_field_file(const std::string& path, int num_faces, int& N) const;
 };
 
 }  // namespace trivcon::cli
