@@ -59,10 +59,9 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   const Connection& c = d.connection;
 
   // Verification: constraint residuals relative to the right-hand sides, transport, fixed faces, indices.
-  const double tolerance = 1e-9 * std::max(1.0, c.rhs_scale);
   const double residual = std::max(c.max_vertex_residual, c.max_cycle_residual);
   const std::vector<int>& unexplained = d.unexplained_mismatch_vertices;
-  const bool ok = residual <= tolerance && d.transport_mismatch <= tolerance && d.max_fixed_error <= tolerance && unexplained.empty();
+  const bool ok = design_verified(d);
 
   auto t1 = Clock::now();
   StagedOutputs staged;

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Builds everything, then computes a cross field (N = 4) on the bundled mesh data/cube_sphere.obj with
 # the eight +1/4 singularities of a cube (data/cube_sphere.sing), writes the field files, a report and a
-# picture (field.png) to demo-output/, and prints the summary.
+# picture (field.png) to demo-output/, and prints the summary. Then the same from Python: the module installed
+# into build/venv (scripts/python.sh) runs examples/cross_field.py (read, solve, edit, write, render) into
+# demo-output/python/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
@@ -13,3 +15,5 @@ mkdir -p "$out"
   --report "$out/report.json" --png "$out/field.png"
 ./build/trivcon check data/cube_sphere.obj "$out/field.txt" -N 4 -s data/cube_sphere.sing
 echo "== wrote $(ls "$out" | tr '\n' ' ')to $out/"
+bash scripts/python.sh
+./build/venv/bin/python examples/cross_field.py --out "$out/python"

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Builds everything and runs all tests (GoogleTest through CTest). Tests on the real meshes in
-# ../shared/data/meshes run when that folder exists and are skipped with a message otherwise.
+# Builds everything and runs all tests: the C++ suite (GoogleTest through CTest), then the Python module,
+# installed the README's way into build/venv, and its pytest suite (scripts/python.sh --test). Tests on the real
+# meshes in ../shared/data/meshes run when that folder exists and are skipped with a message otherwise.
 #   scripts/test.sh             Release build in build/, all tests
-#   scripts/test.sh --sanitize  the same under AddressSanitizer + UndefinedBehaviorSanitizer, in build-asan/
+#   scripts/test.sh --sanitize  the C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer, in build-asan/
+#                               (not the Python suite: an ASan library cannot be loaded into python3)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ "${1:-}" = "--sanitize" ]; then
@@ -13,5 +15,9 @@ else
   export BUILD_DIR=build
   bash scripts/build.sh
 fi
-cd "$BUILD_DIR"
-ctest --output-on-failure -j"$(nproc)"
+(cd "$BUILD_DIR" && ctest --output-on-failure -j"$(nproc)")
+if [ "$BUILD_DIR" = build ]; then
+  bash scripts/python.sh --test
+else
+  echo "== python: the pytest suite runs without --sanitize only"
+fi

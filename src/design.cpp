@@ -120,4 +120,12 @@ Design FieldDesigner::design(const IndexPrescription& prescription, const std::v
   return d;
 }
 
+bool design_verified(const Design& d) {
+  const Connection& c = d.connection;
+  const double tolerance = 1e-9 * std::max(1.0, c.rhs_scale);
+  const double residual = std::max(c.max_vertex_residual, c.max_cycle_residual);
+  return residual <= tolerance && d.transport_mismatch <= tolerance && d.max_fixed_error <= tolerance &&
+         d.unexplained_mismatch_vertices.empty();
+}
+
 }  // namespace trivcon

@@ -50,6 +50,11 @@ struct Design {
   double solve_seconds = 0, field_seconds = 0, verify_seconds = 0;
 };
 
+// The verification `trivcon solve` applies (exit status 3 when it fails): the holonomy residuals, the transport
+// mismatch and the fixed faces' deviation at most 1e-9 × max(1, rhs_scale), and no index mismatch that a
+// turn of π/N or more across an edge does not explain (Design::unexplained_mismatch_vertices).
+bool design_verified(const Design& design);
+
 struct PrepareTimings {
   // Seconds of each stage; cycles and analysis ran on the second thread, concurrently with geometry and
   // plan. prepare: wall time of the constructor plus the solver's set-up (what a user waits for).

@@ -1,0 +1,875 @@
+"""trivcon: direction fields on triangle meshes with exactly the singularities you ask for.
+
+Vector fields (N = 1), line fields (N = 2), cross fields (N = 4), any N: the trivial connection closest
+to Levi-Civita (Crane, Desbrun & Schroeder, "Trivial Connections on Discrete Surfaces", SGP 2010), the
+same C++ library as the `trivcon` command line. Plain numpy arrays in, plain arrays out:
+
+    import trivcon
+    V, F = trivcon.read_mesh("mesh.obj")         # float64 (n, 3), int64 (m, 3): the file's own ids
+    d = trivcon.FieldDesigner(V, F)              # validates and factors once
+    r = d.solve(N=4, singularities={12: "1/4", 40: -0.25, ...})   # milliseconds per re-solve
+    r.directions, r.angles, r.connection, r.edges, r.energy, r.residual, r.singularities
+    r2 = d.solve(N=4, singularities="auto")      # the singularities of the smoothest cross field
+    trivcon.field_indices(V, F, r.directions, N=4)          # {vertex: Fraction}, of any tool's field
+    trivcon.write_field("f.rawfield", V, F, r.directions, N=4)
+    image = trivcon.render(V, F, r.directions, N=4, size=(800, 600))   # (600, 800, 3) uint8
+
+Conventions (the CLI's, see the README):
+- Ids are the file's own, 0-based; nothing is renumbered. Polygons are fan-triangulated in order.
+- Indices are exact multiples of 1/N. They are given as int, float (a multiple of 1/N),
+  fractions.Fraction or "p/q" strings, and returned as fractions.Fraction.
+- Orientation: FieldDesigner re-orients a component whose faces disagree (flipping the smaller class);
+  FieldDesigner.F is the oriented copy, and face frames, normals and angles refer to it.
+- Face frames: face f's x axis runs along its first edge (corner 0 -> corner 1 of the oriented face), the
+  y axis is normal x x_axis, angles increase counter-clockwise about the normal (p1 - p0) x (p2 - p0).
+  A field's angle a at face f is the world direction cos(a) X[f] + sin(a) Y[f]; its N directions are
+  a + 2 pi k / N.
+- Edges (i, j) have i < j, sorted by (i, j); face L holds the half-edge i -> j, R the half-edge j -> i.
+  A direction at angle b in L is carried to b + rho - x in R (x: the connection, radians).
+- Arrays: V accepts any real dtype, F any integer dtype (both any layout, (n, 3) and (m, 3));
+  directions are (m, 3) world vectors. Outputs are float64 and int64 arrays.
+
+Every error -- a bad array, a bad index, and every error of the library (a bad file, a non-manifold mesh,
+a prescription violating Gauss-Bonnet, ...) -- raises trivcon.Error, a ValueError whose message is the
+one the CLI prints after "trivcon: error: ". Long calls release the GIL.
+
+Batches of meshes on a Dask cluster: python3 -m trivcon.batch --help (trivcon/batch.py).
+"""
+
+import math
+import numbers
+from collections.abc import Mapping
+from fractions import Fraction
+
+import numpy as np
+
+from . import _core
+
+__version__ = _core.__version__
+
+__all__ = [
+    "Error",
+    "FieldDesigner",
+    "Result",
+    "AutoResult",
+    "read_mesh",
+    "write_mesh",
+    "field_indices",
+    "read_field",
+    "write_field",
+    "read_singularities",
+    "write_singularities",
+    "render",
+    "write_png",
+    "make_icosphere",
+    "make_uv_sphere",
+    "make_cube_sphere",
+    "make_torus",
+    "make_genus_surface",
+    "make_disk",
+    "make_annulus",
+    "make_holed_grid",
+    "blas_kernels",
+]
+
+Error = _core.Error
+Error.__module__ = "trivcon"
+Error.__doc__ = """Every error trivcon reports: a ValueError whose message names the problem and where.
+
+Library errors carry the message the CLI prints after "trivcon: error: " (e.g. "mesh.obj:12: face
+index 40 out of range (file has 39 vertices)", "singular vertex 7 is on boundary loop 0: ...", "the
+indices on component 0 sum to 3/2, but Gauss-Bonnet needs its Euler characteristic 2"); array
+errors name the array and its shape or dtype (e.g. "V must have shape (n, 3), got shape (8, 2)")."""
+
+_INT32_MAX = 2**31 - 1
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Arrays in
+
+
+def _array(value, name):
+    try:
+        return np.asarray(value)
+    except (ValueError, TypeError) as e:
+        raise Error(f"{name} must be an array: {e}") from None
+
+
+def _shape_text(shape):
+    return "(" + ", ".join(str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
+
+
+def _vectors(value, name, rows=None, rows_text="n"):
+    """float64 C-contiguous (rows, 3) copy or view of a real array; trivcon.Error naming `name` otherwise."""
+    a = _array(value, name)
+    if a.ndim != 2 or a.shape[1] != 3 or (rows is not None and a.shape[0] != rows):
+        want = f"({rows_text}, 3)" if rows is None else f"({rows}, 3)"
+        raise Error(f"{name} must have shape {want}, got shape {_shape_text(a.shape)}")
+    if a.dtype.kind not in "fiu":
+        raise Error(f"{name} must hold real numbers, got dtype {a.dtype}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _vertices(V):
+    return _vectors(V, "V")
+
+
+def _faces(F, num_vertices):
+    """int32 C-contiguous (m, 3) copy of an integer array (ids checked by the library)."""
+    a = _array(F, "F")
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise Error(f"F must have shape (m, 3), got shape {_shape_text(a.shape)}")
+    if a.dtype.kind not in "iu":
+        raise Error(f"F must hold integers, got dtype {a.dtype}")
+    if a.size and (int(a.min()) < -_INT32_MAX or int(a.max()) > _INT32_MAX):
+        # Beyond what the library's int ids hold: report the first bad face as the library would.
+        for f in range(a.shape[0]):
+            row = [int(i) for i in a[f]]
+            for i in row:
+                if i < 0 or i >= num_vertices:
+                    raise Error(f"vertex index {i} out of range in face {f} (mesh has {num_vertices} vertices)")
+            if len(set(row)) < 3:
+                raise Error(f"face {f} has a repeated vertex ({row[0]}, {row[1]}, {row[2]})")
+    return np.ascontiguousarray(a, dtype=np.int32)
+
+
+def _mesh(V, F):
+    V = _vertices(V)
+    return V, _faces(F, V.shape[0])
+
+
+def _directions(directions, num_faces):
+    return _vectors(directions, "directions", rows=num_faces)
+
+
+def _symmetry(N):
+    if isinstance(N, bool) or not isinstance(N, numbers.Integral):
+        raise Error(f"N must be an integer, got {N!r}")
+    N = int(N)
+    if N < 1:
+        raise Error(f"the symmetry N must be at least 1 (got {N})")
+    if N > _INT32_MAX:
+        raise Error(f"the symmetry N = {N} is too large")
+    return N
+
+
+def _id(key, what):
+    if isinstance(key, bool) or not isinstance(key, numbers.Integral):
+        raise Error(f"{what}: ids must be integers, got {key!r}")
+    key = int(key)
+    if abs(key) > _INT32_MAX:
+        raise Error(f"{what}: id {key} out of range")
+    return key
+
+
+def _index_text(value, N, where):
+    """The library's text for an index given as int, float, Fraction or "p/q" (parsed by the library)."""
+    if isinstance(value, bool):
+        raise Error(f"{where}: an index must be an int, a float, a fractions.Fraction or a 'p/q' string, not a bool")
+    if isinstance(value, str):
+        return value
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Rational):
+        return f"{int(value.numerator)}/{int(value.denominator)}"
+    if isinstance(value, numbers.Real):
+        v = float(value)
+        if not math.isfinite(v):
+            raise Error(f"{where}: index {v!r} is not finite")
+        n = round(v * N)
+        if abs(v * N - n) > 1e-9 * max(1.0, abs(v * N)):
+            raise Error(f"{where}: index {v!r} is not a multiple of 1/{N}")
+        return f"{n}/{N}"
+    raise Error(f"{where}: an index must be an int, a float, a fractions.Fraction or a 'p/q' string, not {type(value).__name__}")
+
+
+def _items(mapping, what):
+    if mapping is None:
+        return []
+    if isinstance(mapping, Mapping):
+        return list(mapping.items())
+    try:
+        items = [tuple(item) for item in mapping]
+    except TypeError:
+        raise Error(f"{what} must be a dict {{id: index}} or a list of (id, index) pairs, not {type(mapping).__name__}") from None
+    if any(len(item) != 2 for item in items):
+        raise Error(f"{what} must be a dict {{id: index}} or a list of (id, index) pairs")
+    return items
+
+
+def _indices(mapping, N, what):
+    """{id: n} (index n/N) of a user's {id: index}; errors name `what[id]`."""
+    out = {}
+    for key, value in _items(mapping, what):
+        key = _id(key, what)
+        where = f"{what}[{key}]"
+        if key in out:
+            raise Error(f"{where}: given twice")
+        out[key] = _core.parse_index(_index_text(value, N, where), N, where)
+    return out
+
+
+def _fractions(ns, N):
+    """{id: Fraction} of {id: n} or of a per-id sequence (zeros left out for vertices)."""
+    if isinstance(ns, Mapping):
+        return {int(k): Fraction(int(n), N) for k, n in sorted(ns.items())}
+    return {i: Fraction(int(n), N) for i, n in enumerate(ns)}
+
+
+def _nonzero_fractions(per_vertex, N):
+    per_vertex = np.asarray(per_vertex)
+    return {int(v): Fraction(int(per_vertex[v]), N) for v in np.flatnonzero(per_vertex)}
+
+
+def _render_args(size, view, up, style, spacing, flat, legend, supersampling):
+    a = _core.RenderArgs()
+    try:
+        a.width, a.height = (int(s) for s in size)
+    except (TypeError, ValueError):
+        raise Error(f"render: size must be (width, height), got {size!r}") from None
+    try:
+        a.azimuth, a.elevation = (float(s) for s in view)
+    except (TypeError, ValueError):
+        raise Error(f"render: view must be (azimuth, elevation) in degrees, got {view!r}") from None
+    a.up, a.style = str(up), str(style)
+    a.spacing, a.flat, a.legend, a.supersampling = float(spacing), bool(flat), bool(legend), int(supersampling)
+    return a
+
+
+def _singular_pairs(singularities, N):
+    if singularities is None:
+        return None
+    return sorted(_indices(singularities, N, "singularities").items())
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Files
+
+
+def read_mesh(path, info=False):
+    """Read a triangle mesh: OBJ, OFF or PLY (ascii or binary), each optionally gzipped (.obj.gz, ...).
+
+    Returns (V, F): V float64 (n, 3), F int64 (m, 3), in the file's order with the file's ids (0-based);
+    polygons are fan-triangulated in order, (a,b,c), (a,c,d), ...; unreferenced vertices are kept.
+    With info=True returns (V, F, info), info a dict with "format" ("obj", "off", "ply-ascii",
+    "ply-binary-le", "ply-binary-be"), "polygon_count" and "polygon_of_triangle" (int64 (m,): the file
+    polygon each triangle comes from). Errors (trivcon.Error) name the file and line or byte offset.
+    """
+    V, F, polygon_of_triangle, polygon_count, fmt = _core.read_mesh(str(path))
+    if info:
+        return V, F, {"format": fmt, "polygon_count": polygon_count, "polygon_of_triangle": polygon_of_triangle}
+    return V, F
+
+
+def write_mesh(path, V, F):
+    """Write a mesh as OBJ (17 significant digits) or binary PLY (doubles), by the path's extension.
+
+    Written atomically (a temporary file renamed into place); read_mesh reads it back identically.
+    """
+    V, F = _mesh(V, F)
+    _core.write_mesh(str(path), V, F)
+
+
+def read_field(path, num_faces):
+    """Read a per-face field file: trivcon's .txt or .ply, or Directional's .rawfield.
+
+    Returns (directions, N): directions float64 (num_faces, 3), the first direction of each face in world
+    coordinates, and the N the file states (None when it states none). The file must have num_faces faces.
+    """
+    directions, N = _core.read_field(str(path), int(num_faces))
+    return directions, (N if N > 0 else None)
+
+
+def write_field(path, V, F, directions, N=1):
+    """Write a per-face field in the CLI's formats, chosen by extension.
+
+    .rawfield: Directional's (first line "N F", then 3N numbers per face); .ply: binary PLY of the mesh
+    with face properties fx fy fz; anything else: trivcon's text format ("# N <N>", then "x y z" per
+    face). directions (m, 3) are projected onto the faces (the first of the N directions per face).
+    To write a solve's own field exactly, use Result.write_field.
+    """
+    V, F = _mesh(V, F)
+    N = _symmetry(N)
+    _core.write_field(str(path), V, F, _directions(directions, F.shape[0]), N)
+
+
+def read_singularities(path, N=1):
+    """Read a singularity file ("VERTEX INDEX" lines, INDEX an integer or p/q; or Directional's .sings).
+
+    Returns {vertex: Fraction}. Every index must be a multiple of 1/N.
+    """
+    N = _symmetry(N)
+    return _fractions(_core.read_singularities(str(path), N), N)
+
+
+def write_singularities(path, singularities, N=1):
+    """Write {vertex: index} in the plain format `trivcon solve -s` reads (indices as reduced fractions)."""
+    N = _symmetry(N)
+    _core.write_singularities(str(path), _indices(singularities, N, "singularities"), N)
+
+
+def write_png(path, image):
+    """Write an (h, w, 3) uint8 image (e.g. from render) as an 8-bit RGB PNG, atomically."""
+    a = _array(image, "image")
+    if a.ndim != 3 or a.shape[2] != 3:
+        raise Error(f"image must have shape (h, w, 3), got shape {_shape_text(a.shape)}")
+    if a.dtype != np.uint8:
+        raise Error(f"image must hold uint8 values, got dtype {a.dtype}")
+    _core.write_png(str(path), np.ascontiguousarray(a))
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Fields on plain arrays
+
+
+def field_indices(V, F, directions, N=1):
+    """The singularities of any per-face field (trivcon's, Directional's, your own): {vertex: Fraction}.
+
+    directions (m, 3): one world vector per face (the first of its N directions; projected onto the
+    face). Across each interior edge the field's jump relative to parallel transport is reduced to
+    (-pi/N, pi/N]; a vertex's index is (angle defect + the sum of the jumps around it) / 2 pi, exactly as
+    `trivcon check` reads it. Only vertices of nonzero index are listed.
+    """
+    V, F = _mesh(V, F)
+    N = _symmetry(N)
+    vertex, _, _ = _core.field_indices(V, F, _directions(directions, F.shape[0]), N)
+    return _nonzero_fractions(vertex, N)
+
+
+def render(V, F, directions, N=1, size=(1200, 900), view=(30, 20), up="y", style="hedgehog", spacing=11, flat=False,
+           legend=True, singularities=None, supersampling=3):
+    """A picture of a per-face field on its surface, rendered in software: an (h, w, 3) uint8 array.
+
+    size (width, height) in pixels; view (azimuth, elevation) in degrees; up "x", "y" or "z"; style
+    "hedgehog" (N segments per face, or an even subset) or "streamlines"; spacing: pixels between glyphs
+    or streamlines (at 900 pixels); flat: flat shading; legend: list N and the indices in a corner.
+    singularities {vertex: index} are drawn as discs (red positive, blue negative); None (default):
+    those of the field itself, as `trivcon render` does. Save with write_png. Deterministic.
+    """
+    V, F = _mesh(V, F)
+    N = _symmetry(N)
+    args = _render_args(size, view, up, style, spacing, flat, legend, supersampling)
+    return _core.render(V, F, _directions(directions, F.shape[0]), N, _singular_pairs(singularities, N), args)
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Meshes built in code (trivcon/generate.h): each returns (V, F) like read_mesh.
+
+
+def make_icosphere(level):
+    """Unit sphere: an icosahedron subdivided `level` times; 10*4**level + 2 vertices, 20*4**level faces."""
+    return _core.make_icosphere(int(level))
+
+
+def make_uv_sphere(rings, segments):
+    """Unit sphere as a latitude/longitude grid; vertex 0 the north pole (0, 0, 1), the last the south pole."""
+    return _core.make_uv_sphere(int(rings), int(segments))
+
+
+def make_cube_sphere(n, spherical=True):
+    """Cube [-1, 1]^3 with n x n grids on its faces, projected to the unit sphere when spherical.
+
+    6n^2 + 2 vertices, 12n^2 faces; for n >= 2 the 8 cube corners are its only vertices of valence 3.
+    """
+    return _core.make_cube_sphere(int(n), bool(spherical))
+
+
+def make_torus(nu, nv, R=1.0, r=0.4):
+    """Torus around the z axis (major radius R, minor r), nu x nv quads split into triangles; genus 1."""
+    return _core.make_torus(int(nu), int(nv), float(R), float(r))
+
+
+def make_genus_surface(g, resolution=1):
+    """Closed surface of genus g: a voxel plate with g holes (chi = 2 - 2g), each voxel face a grid."""
+    return _core.make_genus_surface(int(g), int(resolution))
+
+
+def make_disk(rings, segments):
+    """Flat unit disk in z = 0 (a centre vertex and `rings` rings); chi = 1, one boundary loop."""
+    return _core.make_disk(int(rings), int(segments))
+
+
+def make_annulus(rings, segments, r_in=0.5, r_out=1.0):
+    """Flat annulus in z = 0 with radii r_in < r_out; chi = 0, two boundary loops."""
+    return _core.make_annulus(int(rings), int(segments), float(r_in), float(r_out))
+
+
+def make_holed_grid(n, holes):
+    """Flat n x n grid of the unit square with `holes` square holes in a row; chi = 1 - holes."""
+    return _core.make_holed_grid(int(n), int(holes))
+
+
+def blas_kernels():
+    """The OpenBLAS kernels the factorization runs on ("SkylakeX", "Haswell", "Prescott", ...).
+
+    Debian 12's OpenBLAS falls back to generic "Prescott" kernels on CPUs it does not recognise; start
+    Python with OPENBLAS_CORETYPE set (e.g. to the value of _core.native_blas_kernels()) for faster
+    factorizations. The `trivcon` program does this by itself.
+    """
+    return _core.blas_kernels()
+
+
+# ---------------------------------------------------------------------------------------------------------
+# The designer
+
+
+class FieldDesigner:
+    """A mesh prepared for fields: validated, its geometry and cycles computed, the system factored once.
+
+    FieldDesigner(V, F, weights="cotan", solver="cholesky", factorization="own")
+
+    V (n, 3) real, F (m, 3) integer, ids as in the file. Validation errors (non-finite coordinate,
+    vertex id out of range, repeated vertex, non-manifold edge or vertex, non-orientable component)
+    raise trivcon.Error with the library's message. weights: "cotan" (clamped cotangent weights,
+    default) or "unit"; solver: "cholesky" (default) or "qr" (the paper's SuiteSparseQR route);
+    factorization: "own" (trivcon's, on several threads) or "cholmod".
+
+    solve() then costs milliseconds per new set of singularities. Fixed faces change the matrix: a
+    solve with a different set of fixed faces than the previous one refactors once; changing only
+    their directions or the singularities does not. Safe to share between threads (solves on one
+    designer run one at a time); the GIL is released while it works.
+    """
+
+    def __init__(self, V, F, weights="cotan", solver="cholesky", factorization="own"):
+        V, F = _mesh(V, F)
+        for name, value, allowed in (("weights", weights, ("cotan", "unit")), ("solver", solver, ("cholesky", "qr")),
+                                     ("factorization", factorization, ("own", "cholmod"))):
+            if value not in allowed:
+                raise Error(f"{name} must be " + " or ".join(repr(a) for a in allowed) + f", not {value!r}")
+        self._d = _core.Designer(V, F, weights, solver, factorization)
+        self.weights = weights
+        self.solver = solver
+
+    def __repr__(self):
+        return (f"<trivcon.FieldDesigner: {self.num_vertices} vertices, {self.num_faces} faces, chi {self.euler_characteristic}, "
+                f"{self.num_generators} generators, {len(self.boundary_loops)} boundary loops>")
+
+    # --- The mesh.
+
+    @property
+    def V(self):
+        """Vertex positions, float64 (n, 3), as given."""
+        return self._d.V
+
+    @property
+    def F(self):
+        """The consistently oriented faces, int64 (m, 3): equal to the input except for flipped_faces,
+        which are reversed (a, b, c) -> (a, c, b). Face frames and angles refer to these."""
+        return self._d.F
+
+    @property
+    def num_vertices(self):
+        """n, including unreferenced vertices."""
+        return self._d.num_vertices
+
+    @property
+    def num_faces(self):
+        """m."""
+        return self._d.num_faces
+
+    @property
+    def num_edges(self):
+        """The number of edges (interior and boundary)."""
+        return self._d.num_edges
+
+    @property
+    def euler_characteristic(self):
+        """chi = V - E + F over the referenced vertices (summed over components)."""
+        return self._d.euler_characteristic
+
+    @property
+    def num_generators(self):
+        """2g per component: the generator ids solve(generators=) takes (as `trivcon info --cycles`)."""
+        return self._d.num_generators
+
+    @property
+    def flipped_faces(self):
+        """int64 array of the faces whose orientation was reversed to make their component consistent."""
+        return self._d.flipped_faces
+
+    @property
+    def unreferenced_vertices(self):
+        """int64 array of the vertices no face uses (kept, never singular)."""
+        return self._d.unreferenced_vertices
+
+    @property
+    def boundary_loops(self):
+        """List of int64 arrays: each boundary loop's vertices in order (surface on the left), loop ids
+        (solve(boundary=)) by smallest vertex id, each loop starting at its smallest vertex."""
+        return self._d.boundary_loops
+
+    @property
+    def boundary_vertices(self):
+        """int64 array of the vertices on a boundary loop (they cannot be singular)."""
+        return self._d.boundary_vertices
+
+    @property
+    def components(self):
+        """Per connected component (numbered by smallest face id): a dict with faces, vertices, edges,
+        euler_characteristic, genus, boundary_loops (ids), first_face."""
+        return self._d.components
+
+    @property
+    def edges(self):
+        """Every edge, int64 (E, 2), (i, j) with i < j, sorted by (i, j)."""
+        return self._d.edges
+
+    @property
+    def edge_faces(self):
+        """(L, R) per edge of `edges`, int64 (E, 2): L holds the half-edge i -> j, R the half-edge j -> i;
+        -1 where there is none (boundary edges)."""
+        return self._d.edge_faces
+
+    def face_frames(self):
+        """(X, Y, normal), each float64 (m, 3) unit vectors per face: X along the oriented face's first
+        edge (corner 0 -> 1), Y = normal x X, normal along (p1 - p0) x (p2 - p0). The angle a in face f
+        is the direction cos(a) X[f] + sin(a) Y[f]."""
+        return self._d.face_frames()
+
+    @property
+    def timings(self):
+        """Seconds per set-up stage (topology, geometry, cycles, plan, analysis, setup, prepare)."""
+        return self._d.timings
+
+    # --- Fields.
+
+    def _fixed(self, fixed, align_boundary):
+        """{face: angle} of fixed= ({face: angle or (x, y, z)}) and align_boundary (explicit faces win)."""
+        out = dict(self._d.boundary_alignment()) if align_boundary else {}
+        explicit = {}
+        for key, value in _items(fixed, "fixed"):
+            face = _id(key, "fixed")
+            if face in explicit:
+                raise Error(f"fixed[{face}]: given twice")
+            self._d.check_fixed_face(face)
+            if isinstance(value, numbers.Real) and not isinstance(value, bool):
+                explicit[face] = float(value)
+            else:
+                v = _array(value, f"fixed[{face}]")
+                if v.shape != (3,) or v.dtype.kind not in "fiu":
+                    raise Error(f"fixed[{face}]: expected an angle (radians, in the face's frame) or a direction (x, y, z), "
+                                f"got {value!r}")
+                explicit[face] = self._d.fixed_angle(face, v.astype(np.float64))
+        out.update(explicit)
+        return out
+
+    def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False, roots=None,
+              auto_cancel=0.0):
+        """The smoothest N-direction field with exactly the given singularities: a Result.
+
+        N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
+        singularities: {vertex: index} (or a list of (vertex, index) pairs); indices int, float (a
+          multiple of 1/N), fractions.Fraction or "p/q" strings; vertices not listed have index 0. On
+          every closed component the indices must sum to chi (Gauss-Bonnet). Boundary vertices cannot
+          be singular. Or "auto": those of the globally smoothest field (auto_singularities, with
+          auto_cancel as its cancel distance and the same fixed faces), then the exact solve.
+        generators, boundary: {id: index} for generators and boundary loops (ids as num_generators and
+          boundary_loops); those not given are chosen to make the field smoothest.
+        fixed: {face: direction}, an angle in radians in the face's frame or a world vector (x, y, z)
+          (projected onto the face): the field holds it exactly, modulo 2 pi / N.
+        align_boundary: fix every face with a boundary edge to that edge's direction (fixed= wins).
+        roots: {face: angle}: where the field's propagation starts per component (default: each
+          component's smallest face, angle 0; a component with fixed faces starts at its smallest one).
+
+        Errors in the prescription raise trivcon.Error with the library's message. The result is
+        verified (residuals, transport, indices read back): see Result.verified.
+        """
+        N = _symmetry(N)
+        fixed_angles = self._fixed(fixed, align_boundary)
+        auto = None
+        if isinstance(singularities, str) and singularities == "auto":
+            auto = self.auto_singularities(N=N, cancel=auto_cancel, fixed=fixed, align_boundary=align_boundary)
+            vertex = dict(auto._a.vertex)
+        else:
+            if auto_cancel:
+                raise Error("auto_cancel needs singularities='auto'")
+            vertex = _indices(singularities, N, "singularities")
+        root_list = []
+        for key, angle in _items(roots, "roots"):
+            face = _id(key, "roots")
+            if isinstance(angle, bool) or not isinstance(angle, numbers.Real):
+                raise Error(f"roots[{face}]: the angle must be a number, got {angle!r}")
+            root_list.append((face, float(angle)))
+        r = self._d.design(N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), fixed_angles,
+                           root_list)
+        return Result(self, r, auto)
+
+    def auto_singularities(self, N=1, cancel=0.0, cancel_absolute=False, iterations=8, fixed=None, align_boundary=False):
+        """Singularities found automatically: those of the globally smoothest N-field (Knoeppel et al. 2013).
+
+        cancel: remove pairs of opposite singularities (+n, -n) at most this far apart along edges, closest
+          first, in mean edge lengths (or in the mesh's units with cancel_absolute=True); 0: none.
+        iterations: inverse-power iterations (default 8).
+        fixed, align_boundary: faces held as in solve (Dirichlet values of the smoothest field).
+        Returns an AutoResult; AutoResult.singularities go straight into solve(singularities=...).
+        """
+        N = _symmetry(N)
+        try:
+            cancel = float(cancel)
+        except (TypeError, ValueError):
+            raise Error(f"cancel must be a number, got {cancel!r}") from None
+        if not (math.isfinite(cancel) and cancel >= 0):
+            raise Error(f"singularity cancellation: invalid distance {cancel!r} (need a finite number >= 0)")
+        fixed_angles = self._fixed(fixed, align_boundary)
+        return AutoResult(self._d.auto_singularities(N, int(iterations), cancel, bool(cancel_absolute), fixed_angles))
+
+    def field_indices(self, directions, N=1):
+        """{vertex: Fraction} of a per-face field (m, 3) on this mesh (as trivcon.field_indices)."""
+        N = _symmetry(N)
+        vertex, _, _ = self._d.field_indices(_directions(directions, self.num_faces), N)
+        return _nonzero_fractions(vertex, N)
+
+    def cycle_indices(self, directions, N=1):
+        """(loops, generators) of a per-face field: {loop id: Fraction}, {generator id: Fraction}: the
+        field's turns around each boundary loop and generator, relative to parallel transport."""
+        N = _symmetry(N)
+        _, loops, generators = self._d.field_indices(_directions(directions, self.num_faces), N)
+        return _fractions(loops, N), _fractions(generators, N)
+
+
+class Result:
+    """One solve of a FieldDesigner: the field, its connection, what was used and how well it holds.
+
+    Arrays (new numpy arrays, computed once):
+      directions  float64 (m, 3): the first of the N unit directions per face, in world coordinates
+                  (the others are rotated by 2 pi k / N about the face normal)
+      angles      float64 (m,): the same as angles in the face frames (FieldDesigner.face_frames), in [0, 2 pi)
+      edges       int64 (E, 2): the interior edges (i, j), i < j, sorted by (i, j), as --connection-out
+      connection  float64 (E,): the adjustment angle x per edge of `edges` (radians): a direction at angle
+                  b in the face holding half-edge i -> j is carried to b + rho - x in the other face
+    Numbers: N, energy (sum of x^2 / w), residual (largest holonomy residual over all vertex, loop and
+      generator cycles, radians), transport_mismatch, fixed_error, large_turn_edges.
+    Indices (dicts of fractions.Fraction): singularities (the vertex indices used), generators and
+      boundary (the indices used, given or chosen), generators_chosen / boundary_chosen (ids chosen by
+      the solver), field_singularities (read back from the field itself).
+    verified: the check `trivcon solve` applies (residuals, transport and fixed faces within 1e-9
+      relative, indices read back equal to the prescription except where the connection turns by pi/N
+      or more across an edge); auto: the AutoResult when solved with singularities="auto".
+    Files: write_field, write_connection, write_lines, write_singularities write what the CLI's
+      --field-out, --connection-out, --lines-out, --sing-out write for the same solve; render draws it.
+    """
+
+    def __init__(self, designer, result, auto=None):
+        self._designer = designer
+        self._r = result
+        self.auto = auto
+        self._cache = {}
+
+    def _get(self, key, compute):
+        if key not in self._cache:
+            self._cache[key] = compute()
+        return self._cache[key]
+
+    def __repr__(self):
+        return (f"<trivcon.Result: N {self.N}, {len(self.singularities)} singular vertices, energy {self.energy:.6g}, "
+                f"residual {self.residual:.3g}, {'verified' if self.verified else 'NOT verified'}>")
+
+    @property
+    def designer(self):
+        """The FieldDesigner this came from."""
+        return self._designer
+
+    @property
+    def N(self):
+        """The symmetry."""
+        return self._r.N
+
+    @property
+    def directions(self):
+        """float64 (m, 3) unit vectors: the first of the N directions per face, world coordinates."""
+        return self._get("directions", lambda: self._r.directions)
+
+    @property
+    def angles(self):
+        """float64 (m,): the field's first direction per face as an angle in the face's frame, [0, 2 pi)."""
+        return self._get("angles", lambda: self._r.angles)
+
+    def _connection(self):
+        return self._get("connection", self._r.connection)
+
+    @property
+    def edges(self):
+        """int64 (E, 2): the interior edges (i, j), i < j, sorted by (i, j): the rows of --connection-out."""
+        return self._connection()[0]
+
+    @property
+    def connection(self):
+        """float64 (E,): the adjustment angle x (radians) per edge of `edges`."""
+        return self._connection()[1]
+
+    @property
+    def energy(self):
+        """sum over edges of x^2 / w (w the cotan or unit weights)."""
+        return self._r.energy
+
+    @property
+    def residual(self):
+        """Largest |holonomy - prescription| over all vertex, loop and generator cycles (radians)."""
+        return max(self._r.max_vertex_residual, self._r.max_cycle_residual)
+
+    @property
+    def rhs_scale(self):
+        """The scale of the constraints' right-hand sides (verification is relative to max(1, this))."""
+        return self._r.rhs_scale
+
+    @property
+    def transport_mismatch(self):
+        """Largest mismatch of the field with its connection across an edge, modulo 2 pi / N (radians)."""
+        return self._r.transport_mismatch
+
+    @property
+    def fixed_error(self):
+        """Largest deviation of the field from a fixed direction, modulo 2 pi / N (radians)."""
+        return self._r.max_fixed_error
+
+    @property
+    def fixed(self):
+        """{face: angle}: the fixed directions used (angles in the face frames)."""
+        return dict(self._r.fixed)
+
+    @property
+    def conflicts(self):
+        """[(face_a, face_b, turn)]: adjacent fixed faces the field must turn sharply between (> pi/(2N))."""
+        return self._r.conflicts
+
+    @property
+    def singularities(self):
+        """{vertex: Fraction}: the vertex indices prescribed (the ones found, with singularities="auto")."""
+        return self._get("singularities", lambda: _fractions(self._r.vertex, self.N))
+
+    @property
+    def generators(self):
+        """{generator id: Fraction}: every generator's index as used (given, or chosen by the solver)."""
+        return _fractions(self._r.generator_index, self.N)
+
+    @property
+    def generators_chosen(self):
+        """Ids of the generators whose index the solver chose."""
+        return [i for i, c in enumerate(self._r.generator_chosen) if c]
+
+    @property
+    def boundary(self):
+        """{loop id: Fraction}: every boundary loop's index as used (given, or chosen by the solver)."""
+        return _fractions(self._r.loop_index, self.N)
+
+    @property
+    def boundary_chosen(self):
+        """Ids of the boundary loops whose index the solver chose."""
+        return [i for i, c in enumerate(self._r.loop_chosen) if c]
+
+    @property
+    def field_singularities(self):
+        """{vertex: Fraction}: the indices read back from the field itself (as field_indices)."""
+        return self._get("field_singularities", lambda: _nonzero_fractions(self._r.indices[0], self.N))
+
+    @property
+    def index_mismatches(self):
+        """int64 array: interior vertices whose index read back differs from the prescription."""
+        return self._r.index_mismatch_vertices
+
+    @property
+    def unexplained_mismatches(self):
+        """int64 array: those of index_mismatches next to no edge turning by pi/N or more (real errors)."""
+        return self._r.unexplained_mismatch_vertices
+
+    @property
+    def large_turn_edges(self):
+        """How many edges have |x| >= pi/N (where a per-face field cannot show an index)."""
+        return self._r.large_turn_edges
+
+    @property
+    def verified(self):
+        """True when every check `trivcon solve` makes passed (its exit status 3 otherwise)."""
+        return self._r.verified
+
+    @property
+    def seconds(self):
+        """Seconds of the solve, the field propagation and the verification."""
+        return self._r.seconds
+
+    def write_field(self, path):
+        """Write the field exactly as --field-out does (.txt, .rawfield or .ply by extension)."""
+        self._r.write_field(str(path))
+
+    def write_connection(self, path):
+        """Write the connection as --connection-out does ("i j x" per interior edge, sorted)."""
+        self._r.write_connection(str(path))
+
+    def write_lines(self, path):
+        """Write an OBJ with a segment per face and direction, as --lines-out does."""
+        self._r.write_lines(str(path))
+
+    def write_singularities(self, path):
+        """Write the singularities used, as --sing-out does (readable by `trivcon solve -s`)."""
+        self._r.write_singularities(str(path))
+
+    def render(self, size=(1200, 900), view=(30, 20), up="y", style="hedgehog", spacing=11, flat=False, legend=True,
+               singularities=None, supersampling=3):
+        """An (h, w, 3) uint8 picture of this field, as trivcon.render; singularities default to the ones
+        prescribed (as `trivcon solve --png`)."""
+        args = _render_args(size, view, up, style, spacing, flat, legend, supersampling)
+        return self._r.render(_singular_pairs(singularities, self.N), args)
+
+
+class AutoResult:
+    """Singularities found automatically (FieldDesigner.auto_singularities).
+
+      singularities  {vertex: Fraction} to prescribe (after cancellation)
+      found          {vertex: Fraction} of the smoothest field, before cancellation
+      pairs          [(vertex of +n, vertex of -n)] cancelled, in order
+      directions     float64 (m, 3), angles float64 (m,): the smoothest field itself (not the exact solve)
+      energy         its Rayleigh quotient E(u) / |u|^2_M; vanishing_faces: faces where it vanished
+      seconds        per stage (assemble, factor, iterate, indices, cancel)
+    """
+
+    def __init__(self, a):
+        self._a = a
+
+    def __repr__(self):
+        return (f"<trivcon.AutoResult: N {self.N}, found {len(self.found)} singularities, cancelled {len(self.pairs)} pairs, "
+                f"using {len(self.singularities)}>")
+
+    @property
+    def N(self):
+        """The symmetry."""
+        return self._a.N
+
+    @property
+    def singularities(self):
+        """{vertex: Fraction}: the singularities to prescribe (after cancellation)."""
+        return _fractions(self._a.vertex, self.N)
+
+    @property
+    def found(self):
+        """{vertex: Fraction}: the singularities of the smoothest field, before cancellation."""
+        return _fractions(self._a.found, self.N)
+
+    @property
+    def pairs(self):
+        """[(positive vertex, negative vertex)]: the cancelled pairs, in the order they were cancelled."""
+        return list(self._a.pairs)
+
+    @property
+    def directions(self):
+        """float64 (m, 3): the smoothest field's first direction per face (world coordinates)."""
+        return self._a.directions
+
+    @property
+    def angles(self):
+        """float64 (m,): the smoothest field's angles in the face frames."""
+        return self._a.angles
+
+    @property
+    def energy(self):
+        """E(u) / |u|^2_M of the smoothest field over the whole mesh."""
+        return self._a.energy
+
+    @property
+    def vanishing_faces(self):
+        """Faces where the smoothest field vanished (they take their neighbours' direction)."""
+        return self._a.vanishing_faces
+
+    @property
+    def seconds(self):
+        """Seconds per stage: assemble, factor, iterate, indices, cancel."""
+        return self._a.seconds
