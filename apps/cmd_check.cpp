@@ -25,6 +25,7 @@ void run_check(CheckOptions& o) {
   const MeshData mesh = load_mesh(o.mesh);
   check_finite(mesh.V);
   const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
+  check_coordinate_range(mesh.V, t);
   const Geometry g = compute_geometry(mesh.V, t);
   const Cycles cycles = compute_cycles(t);
   const MatrixX3d directions = o.prescription.read_field_file(o.field, t.num_faces, o.prescription.N);

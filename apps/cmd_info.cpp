@@ -20,6 +20,7 @@ void register_info(CLI::App& app) {
     const MeshData mesh = load_mesh(path);
     check_finite(mesh.V);
     const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
+    check_coordinate_range(mesh.V, t);
     const Geometry g = compute_geometry(mesh.V, t);
     nlohmann::ordered_json j = mesh_summary(path, mesh, t, g);
     Cycles cycles;
@@ -43,7 +44,10 @@ void register_info(CLI::App& app) {
     std::cout << "unreferenced vertices " << t.unreferenced_vertices.size() << "\n"
               << "zero-area faces " << g.zero_area_faces << " (degenerate, treated specially: " << g.degenerate_faces << ")\n"
               << "re-oriented faces " << t.flipped_faces.size() << "\n"
-              << "interior edges with negative cotangent weight " << g.negative_cotan_edges << "\n";
+              << "interior edges with negative cotangent weight " << g.negative_cotan_edges << "\n"
+              << "weight policy: " << g.mollified_faces << " faces below the triangle-inequality margin, lengths mollified by "
+              << g.mollify_epsilon << "; " << g.clamped_cotangents << " negative cotangents clamped to 0; " << g.zero_weight_edges
+              << " interior edges of zero weight\n";
     if (with_cycles) {
       for (size_t i = 0; i < cycles.generators.size(); ++i)
         std::cout << "generator " << i << ": component " << cycles.generators[i].component << ", " << cycles.generators[i].edges.size()

@@ -55,6 +55,7 @@ void run_render(const RenderCommand& c) {
   const MeshData mesh = load_mesh(c.mesh);
   check_finite(mesh.V);
   const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
+  check_coordinate_range(mesh.V, t);
   const Geometry g = compute_geometry(mesh.V, t);
   int file_N = 0;
   const MatrixX3d directions = read_field(c.field, t.num_faces, &file_N);

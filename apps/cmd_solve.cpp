@@ -35,6 +35,7 @@ struct SolveOptions {
   std::string sing_from_field;
   OutputPaths out;
   bool quiet = false;
+  double tolerance = kDefaultTolerance;  // --tolerance
 };
 
 // --fix takes "F:x,y,z" / "F:angle=A" specs and files; a spec starts with a face id and a colon.
@@ -61,7 +62,7 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   // Verification: constraint residuals relative to the right-hand sides, transport, fixed faces, indices.
   const double residual = std::max(c.max_vertex_residual, c.max_cycle_residual);
   const std::vector<int>& unexplained = d.unexplained_mismatch_vertices;
-  const bool ok = design_verified(d);
+  const bool ok = design_verified(d, o.tolerance);
 
   auto t1 = Clock::now();
   StagedOutputs staged;
@@ -95,7 +96,7 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
   if (!ok)
     std::cerr << "trivcon: verification failed" << (name.empty() ? "" : " for " + name) << ": residual " << residual
               << ", transport mismatch " << d.transport_mismatch << ", fixed faces off by " << d.max_fixed_error << ", "
-              << unexplained.size() << " unexplained index mismatches\n";
+              << unexplained.size() << " unexplained index mismatches: " << verification_failure(designer, d, o.tolerance) << "\n";
   return ok;
 }
 
@@ -228,6 +229,10 @@ void register_solve(CLI::App& app) {
   cmd->add_option("--png", o.out.png, "Picture of the field (as `trivcon render` with its defaults)");
   cmd->add_option("--report", o.out.report, "JSON report: sizes, topology, indices used, energy, residuals, timings");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");
+  cmd->add_option("--tolerance", o.tolerance,
+                  "Verification limit on the holonomy residuals, transport and fixed faces, relative to max(1, right-hand sides) "
+                  "(default 1e-9); a solve that misses it exits 3 and says why")
+      ->check(CLI::PositiveNumber);
   cmd->callback([] { run_solve(o); });
 }
 

@@ -39,6 +39,12 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
                      {"regularized_edges", designer.solver().regularized_edges()},
                      {"max_error", d.max_fixed_error},
                      {"conflicts", conflicts}};
+  // The weight policy's work on this solve (the mesh's part is in "mesh"): edges given the small
+  // regularization weight, and steps of iterative refinement.
+  report["weight_policy"] = {
+      {"mollified_faces", designer.geometry().mollified_faces},       {"mollify_epsilon", designer.geometry().mollify_epsilon},
+      {"clamped_cotangents", designer.geometry().clamped_cotangents}, {"zero_weight_edges", designer.geometry().zero_weight_edges},
+      {"regularized_edges", designer.solver().regularized_edges()},   {"refinements", c.refinements}};
   report["energy"] = c.energy;
   report["residuals"] = {{"max_vertex", c.max_vertex_residual},
                          {"max_cycle", c.max_cycle_residual},

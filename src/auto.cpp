@@ -301,6 +301,7 @@ AutoResult auto_singularities(const FieldDesigner& designer, const AutoOptions& 
 AutoResult auto_singularities(const MatrixX3d& V, const MatrixX3i& F, const AutoOptions& options) {
   check_finite(V);
   const Topology t = build_topology(F, static_cast<int>(V.rows()));
+  check_coordinate_range(V, t);
   const Geometry g = compute_geometry(V, t);
   const Cycles cycles = compute_cycles(t);
   return auto_singularities(V, t, g, cycles, options);

@@ -359,6 +359,26 @@ class CholeskyEngine : public SolverEngine {
     }
     Eigen::VectorXd& y = z;  // [λ; μ] in factor order
     backward(y);
+    return edge_values(y);
+  }
+
+  bool refine(const Eigen::VectorXd& b, Eigen::VectorXd& x) const override {
+    const int n = nD + nC;
+    if (n == 0) return false;
+    // r = Π (b − A x), in factor order.
+    Eigen::VectorXd r(n);
+    for (int row = 0; row < n; ++row) r(position_[row]) = b(row);
+    for (int a = 0; a < m; ++a)
+      for (int k = edge_rows_.start[a]; k < edge_rows_.start[a + 1]; ++k) r(edge_rows_.row[k]) -= edge_rows_.coefficient[k] * x(a);
+    Eigen::VectorXd y = lower_solve(r);
+    backward(y);
+    x += edge_values(y);
+    return true;
+  }
+
+ private:
+  // x = W Aᵀ y for y in factor order.
+  Eigen::VectorXd edge_values(const Eigen::VectorXd& y) const {
     Eigen::VectorXd x(m);
 #pragma omp parallel for schedule(static) if (m > kParallelMinEditElements)
     for (int a = 0; a < m; ++a) {

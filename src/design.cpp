@@ -1,5 +1,9 @@
 #include "trivcon/design.h"
 
+#include <iomanip>
+
+#include <sstream>
+
 #include <chrono>
 #include <algorithm>
 #include <cmath>
@@ -24,6 +28,7 @@ FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptio
   timed(timings_.topology, [&] {
     check_finite(V_);
     topology_ = build_topology(F, static_cast<int>(V_.rows()));
+    check_coordinate_range(V_, topology_);
   });
   // The cycles and the solver's symbolic analysis depend on the connectivity only: on the Cholesky
   // route a second thread computes them while this one computes the geometry and the plan (design.h).
@@ -120,12 +125,49 @@ Design FieldDesigner::design(const IndexPrescription& prescription, const std::v
   return d;
 }
 
-bool design_verified(const Design& d) {
+bool design_verified(const Design& d, double tolerance) {
   const Connection& c = d.connection;
-  const double tolerance = 1e-9 * std::max(1.0, c.rhs_scale);
+  const double limit = tolerance * std::max(1.0, c.rhs_scale);
   const double residual = std::max(c.max_vertex_residual, c.max_cycle_residual);
-  return residual <= tolerance && d.transport_mismatch <= tolerance && d.max_fixed_error <= tolerance &&
-         d.unexplained_mismatch_vertices.empty();
+  return residual <= limit && d.transport_mismatch <= limit && d.max_fixed_error <= limit && d.unexplained_mismatch_vertices.empty();
+}
+
+std::string verification_failure(const FieldDesigner& designer, const Design& d, double tolerance) {
+  if (design_verified(d, tolerance)) return "";
+  const Connection& c = d.connection;
+  const double limit = tolerance * std::max(1.0, c.rhs_scale);
+  const double residual = std::max(c.max_vertex_residual, c.max_cycle_residual);
+  std::ostringstream out;
+  out << std::setprecision(3);
+  std::vector<std::string> parts;
+  if (residual > limit) {
+    const Geometry& g = designer.geometry();
+    std::ostringstream p;
+    p << std::setprecision(3) << "the holonomy constraints are met only to " << residual << " (the limit is " << limit << " = " << tolerance
+      << " x max(1, right-hand sides " << c.rhs_scale << ")) after " << c.refinements
+      << " steps of iterative refinement: the normal equations A W A^T are too ill-conditioned on this mesh (weights from "
+      << designer.solver().weights().minCoeff() << " to " << designer.solver().weights().maxCoeff() << "; " << g.mollified_faces
+      << " faces mollified, " << g.zero_weight_edges << " edges of zero weight, " << designer.solver().regularized_edges()
+      << " regularized); try --solver qr, which solves the constraints without the normal equations, or --weights unit";
+    parts.push_back(p.str());
+  }
+  if (d.transport_mismatch > limit) {
+    std::ostringstream p;
+    p << std::setprecision(3) << "the field departs from the connection's transport by " << d.transport_mismatch << " rad (limit " << limit
+      << ")";
+    parts.push_back(p.str());
+  }
+  if (d.max_fixed_error > limit) {
+    std::ostringstream p;
+    p << std::setprecision(3) << "a fixed face is off its direction by " << d.max_fixed_error << " rad (limit " << limit << ")";
+    parts.push_back(p.str());
+  }
+  if (!d.unexplained_mismatch_vertices.empty())
+    parts.push_back(std::to_string(d.unexplained_mismatch_vertices.size()) + " vertices (first " +
+                    std::to_string(d.unexplained_mismatch_vertices[0]) +
+                    ") read back an index other than the prescription with no turn of pi/N or more beside them");
+  for (size_t k = 0; k < parts.size(); ++k) out << (k ? "; " : "") << parts[k];
+  return out.str();
 }
 
 }  // namespace trivcon

@@ -15,6 +15,8 @@
 #include <sstream>
 #include <string>
 #include <unordered_map>
+
+#include <Eigen/Geometry>
 #include <utility>
 
 #include "trivcon/error.h"
@@ -548,6 +550,72 @@ Mesh permute(const Mesh& mesh, unsigned seed, std::vector<int>* vertex_perm, std
   }
   if (vertex_perm) *vertex_perm = new_vertex;
   if (face_perm) *face_perm = new_face;
+  return out;
+}
+
+Mesh split_edges_near_end(const Mesh& mesh, double t, double lift, std::vector<int>* parent_face) {
+  require_valid_faces("split_edges_near_end", mesh);
+  require(t >= 0 && t < 1, "split_edges_near_end", "t", t, "0 <= t < 1");
+  require(std::isfinite(lift), "split_edges_near_end", "lift", lift, "a finite lift");
+  const Eigen::Index num_vertices = mesh.V.rows(), num_faces = mesh.F.rows();
+  require_size("split_edges_near_end", double(num_vertices) + 1.5 * num_faces, 2.0 * num_faces);
+  const EdgeIndex index = index_edges(mesh.F, static_cast<int>(num_vertices));
+  const size_t num_edges = index.edges.size();
+  // The faces of each edge (up to two are used; a non-manifold edge is never split).
+  std::vector<std::array<int, 3>> edge_faces(num_edges, {-1, -1, 0});
+  for (Eigen::Index f = 0; f < num_faces; ++f)
+    for (int k = 0; k < 3; ++k) {
+      std::array<int, 3>& slot = edge_faces[index.edge_of_halfedge[3 * f + k]];
+      if (slot[2] < 2) slot[slot[2]] = static_cast<int>(f);
+      ++slot[2];
+    }
+  // Edges in increasing (i, j) order: index_edges numbers them so.
+  std::vector<int> order(num_edges);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return index.edges[a] < index.edges[b]; });
+  std::vector<char> face_used(num_faces, 0);
+  std::vector<int> split_vertex(num_edges, -1);
+  std::vector<Eigen::RowVector3d> new_vertices;
+  for (int e : order) {
+    const std::array<int, 3>& s = edge_faces[e];
+    if (s[2] > 2 || face_used[s[0]] || (s[1] >= 0 && face_used[s[1]])) continue;
+    face_used[s[0]] = 1;
+    if (s[1] >= 0) face_used[s[1]] = 1;
+    const Eigen::RowVector3d pi = mesh.V.row(index.edges[e][0]), pj = mesh.V.row(index.edges[e][1]);
+    Eigen::RowVector3d normal = Eigen::RowVector3d::Zero();
+    for (int side = 0; side < 2 && s[side] >= 0; ++side) {
+      const Eigen::RowVector3d a = mesh.V.row(mesh.F(s[side], 0)), b = mesh.V.row(mesh.F(s[side], 1)), c = mesh.V.row(mesh.F(s[side], 2));
+      const Eigen::RowVector3d n = (b - a).cross(c - a);
+      if (n.norm() > 0) normal += n.normalized();
+    }
+    if (normal.norm() > 0) normal.normalize();
+    split_vertex[e] = static_cast<int>(num_vertices + new_vertices.size());
+    new_vertices.push_back(pi + t * (pj - pi) + lift * (pj - pi).norm() * normal);
+  }
+  Mesh out;
+  out.V.resize(num_vertices + static_cast<Eigen::Index>(new_vertices.size()), 3);
+  out.V.topRows(num_vertices) = mesh.V;
+  for (size_t k = 0; k < new_vertices.size(); ++k) out.V.row(num_vertices + static_cast<Eigen::Index>(k)) = new_vertices[k];
+  std::vector<std::array<int, 3>> appended;
+  std::vector<int> appended_parent;
+  out.F = mesh.F;
+  for (Eigen::Index f = 0; f < num_faces; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int m = split_vertex[index.edge_of_halfedge[3 * f + k]];
+      if (m < 0) continue;
+      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3), c = mesh.F(f, (k + 2) % 3);
+      out.F.row(f) << a, m, c;
+      appended.push_back({m, b, c});
+      appended_parent.push_back(static_cast<int>(f));
+    }
+  out.F.conservativeResize(num_faces + static_cast<Eigen::Index>(appended.size()), 3);
+  for (size_t k = 0; k < appended.size(); ++k)
+    out.F.row(num_faces + static_cast<Eigen::Index>(k)) << appended[k][0], appended[k][1], appended[k][2];
+  if (parent_face) {
+    parent_face->resize(out.F.rows());
+    std::iota(parent_face->begin(), parent_face->begin() + num_faces, 0);
+    std::copy(appended_parent.begin(), appended_parent.end(), parent_face->begin() + num_faces);
+  }
   return out;
 }
 

@@ -9,7 +9,29 @@ namespace trivcon {
 
 namespace {
 constexpr double kDegenerateArea = 1e-14;  // relative to the longest edge squared
+constexpr double kMollifyFactor = 1e-5;    // δ of the mollification, relative to the component's mean edge length
 using detail::kParallelMinElements;
+
+// Cotangents of the three corner angles of a triangle with edge lengths l[k] (edge k: corner k → k+1,
+// opposite corner k+2), all positive and satisfying the triangle inequality strictly: cot at corner j is
+// (b² + c² − a²) / 4A with a the opposite edge, and A by Kahan's form of Heron's formula, which keeps its
+// accuracy on needles and slivers ("Miscalculating Area and Angles of a Needle-like Triangle", 2014).
+// The lengths are divided by the longest first (cotangents do not depend on the size), so that the
+// product of four lengths can neither overflow nor underflow.
+Eigen::Vector3d cotangents_from_lengths(const double l_in[3]) {
+  const double longest = std::max({l_in[0], l_in[1], l_in[2]});
+  const double l[3] = {l_in[0] / longest, l_in[1] / longest, l_in[2] / longest};
+  double s[3] = {l[0], l[1], l[2]};
+  std::sort(s, s + 3, [](double a, double b) { return a > b; });
+  const double a = s[0], b = s[1], c = s[2];
+  const double area = 0.25 * std::sqrt((a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c)));
+  Eigen::Vector3d cot;
+  for (int j = 0; j < 3; ++j) {
+    const double opposite = l[(j + 1) % 3], u = l[j], w = l[(j + 2) % 3];
+    cot(j) = (u * u + w * w - opposite * opposite) / (4 * area);
+  }
+  return cot;
+}
 
 // Intrinsic corner angles with the documented conventions for degenerate triangles.
 Eigen::Vector3d corner_angles_of(const Eigen::Vector3d p[3]) {
@@ -57,7 +79,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   g.frame_x.resize(nF, 3);
   g.frame_y.resize(nF, 3);
   g.normal.resize(nF, 3);
-  MatrixX3d cot(nF, 3);  // cotangent of each corner angle, 0 for degenerate faces
+  MatrixX3d cot(nF, 3);  // cotangent of each corner angle: 0 for degenerate faces until mollified below
   std::vector<Eigen::Vector3d> raw_normal(nF);
   int degenerate_faces = 0, zero_area_faces = 0;
   // Faces, then edges, are independent of one another: both loops run on all cores (OpenMP).
@@ -130,10 +152,51 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   for (int f = 0; f < nF; ++f)
     for (int k = 0; k < 3; ++k) g.angle_defect(t.F(f, k)) -= g.corner_angles(f, k);
 
+  // Intrinsic mollification (Sharp & Crane 2020, "A Laplacian for Nonmanifold Triangle Meshes", Sec. 4.5)
+  // for the cotangent weights only, per connected component (so that components of very different sizes
+  // do not share one tolerance): when some face's edge lengths miss the triangle inequality by less than
+  // δ = kMollifyFactor × the component's mean edge length (slivers, needles, zero-area faces, zero-length
+  // edges), the smallest ε that gives every face of the component a margin of δ is added to every edge
+  // length of the component, and its cotangents are taken from those lengths. Every face then has a
+  // defined shape and bounded cotangents (|cot| ≲ longest edge / δ), no vertex moves, and the angles,
+  // holonomies and frames above stay those of the mesh as given. Components whose faces all have the
+  // margin keep their cotangents unchanged (ε = 0).
+  std::vector<double> length(nE);
+#pragma omp parallel for schedule(static) num_threads(team) if (nE > kParallelMinElements)
+  for (int e = 0; e < nE; ++e) length[e] = (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).norm();
+  const size_t nC = t.components.size();
+  std::vector<double> component_length(nC, 0), component_epsilon(nC, 0);
+  std::vector<int> component_edges(nC, 0);
+  for (int e = 0; e < nE; ++e) {
+    const int c = t.face_component[t.edge_faces(e, 0)];
+    component_length[c] += length[e], ++component_edges[c];
+  }
+  int mollified_faces = 0;
+  for (int f = 0; f < nF; ++f) {
+    const int c = t.face_component[f];
+    const double delta = kMollifyFactor * component_length[c] / component_edges[c];
+    const double l0 = length[t.face_edges(f, 0)], l1 = length[t.face_edges(f, 1)], l2 = length[t.face_edges(f, 2)];
+    const double margin = std::min({l0 + l1 - l2, l1 + l2 - l0, l2 + l0 - l1});
+    if (margin < delta) component_epsilon[c] = std::max(component_epsilon[c], delta - margin), ++mollified_faces;
+  }
+  g.mollified_faces = mollified_faces;
+  g.mollify_epsilon = nC > 0 ? *std::max_element(component_epsilon.begin(), component_epsilon.end()) : 0.0;
+  if (g.mollify_epsilon > 0) {
+#pragma omp parallel for schedule(static) num_threads(team) if (nF > kParallelMinElements)
+    for (int f = 0; f < nF; ++f) {
+      const double epsilon = component_epsilon[t.face_component[f]];
+      if (epsilon == 0) continue;
+      const double l[3] = {length[t.face_edges(f, 0)] + epsilon, length[t.face_edges(f, 1)] + epsilon,
+                           length[t.face_edges(f, 2)] + epsilon};
+      cot.row(f) = cotangents_from_lengths(l);
+    }
+  }
+
   g.rho.setZero(nE);
   g.cotan_weight.setZero(nE);
-  int negative_cotan_edges = 0;
-#pragma omp parallel for schedule(static) reduction(+ : negative_cotan_edges) num_threads(team) if (nE > kParallelMinElements)
+  int negative_cotan_edges = 0, clamped_cotangents = 0, zero_weight_edges = 0;
+#pragma omp parallel for schedule(static) reduction(+ : negative_cotan_edges, clamped_cotangents, zero_weight_edges) num_threads(team) \
+    if (nE > kParallelMinElements)
   for (int e = 0; e < nE; ++e) {
     if (t.is_boundary_edge(e)) continue;
     const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
@@ -144,9 +207,11 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
     // The corner opposite edge k of a face is corner k+2.
     const double cl = cot(L, (kL + 2) % 3), cr = cot(R, (kR + 2) % 3);
     if (cl + cr < 0) ++negative_cotan_edges;
+    clamped_cotangents += (cl < 0) + (cr < 0);
     g.cotan_weight(e) = 0.5 * (std::max(cl, 0.0) + std::max(cr, 0.0));
+    zero_weight_edges += g.cotan_weight(e) == 0;
   }
-  g.negative_cotan_edges = negative_cotan_edges;
+  g.negative_cotan_edges = negative_cotan_edges, g.clamped_cotangents = clamped_cotangents, g.zero_weight_edges = zero_weight_edges;
   return g;
 }
 

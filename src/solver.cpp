@@ -22,6 +22,10 @@ namespace trivcon {
 namespace {
 // Beyond this many fixed-face paths the Cholesky route keeps them out of the dense block.
 constexpr int kMaxDensePaths = 256;
+// Iterative refinement (see ConnectionSolver::solve): when the largest constraint residual exceeds this
+// (relative to max(1, the right-hand sides' scale): 100× below what verification accepts), up to this many steps.
+constexpr double kRefineAbove = 1e-11;
+constexpr int kMaxRefinements = 3;
 using detail::Clock;
 using detail::kParallelMinEditElements;
 using detail::seconds_since;
@@ -435,12 +439,31 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   Eigen::VectorXd n_C = cycle.n0;
   Eigen::VectorXd n_E;  // path turns, when the path rows are sparse
   const Eigen::VectorXd b = s.sparse_paths ? s.round_sparse_path_turns(prescription, b_D, n_E) : b_D;
-  const Eigen::VectorXd x_active = s.engine->solve(b, [&](const Eigen::VectorXd& r0) {
+  Eigen::VectorXd b_C;
+  Eigen::VectorXd x_active = s.engine->solve(b, [&](const Eigen::VectorXd& r0) {
     const Eigen::VectorXd u = (cycle.H - r0) / step;
     n_C += cycle.M * detail::nearest_lattice_point(*s.engine, u, cycle.n0, cycle.M, cycle.identity).cast<double>();
-    return Eigen::VectorXd(cycle.H - step * n_C);
+    b_C = cycle.H - step * n_C;
+    return b_C;
   });
-  return s.result(prescription, x_active, cycle, n_C, n_E);
+  Connection connection = s.result(prescription, x_active, cycle, n_C, n_E);
+  // Iterative refinement, only when the residual asks for it: on meshes whose weights span many orders
+  // of magnitude (slivers, needles) one substitution with A W Aᵀ can leave a residual far above round-off.
+  // Each step costs one forward and one backward substitution with the factor at hand; a step is kept
+  // only when it lowers the residual.
+  auto residual_of = [](const Connection& c) { return std::max(c.max_vertex_residual, c.max_cycle_residual); };
+  Eigen::VectorXd b_full(b.size() + b_C.size());
+  b_full << b, b_C;
+  for (int step_count = 0; step_count < kMaxRefinements && residual_of(connection) > kRefineAbove * std::max(1.0, connection.rhs_scale);
+       ++step_count) {
+    Eigen::VectorXd refined = x_active;
+    if (!s.engine->refine(b_full, refined)) break;
+    Connection better = s.result(prescription, refined, cycle, n_C, n_E);
+    if (!(residual_of(better) < residual_of(connection))) break;
+    better.refinements = step_count + 1;
+    connection = std::move(better), x_active = std::move(refined);
+  }
+  return connection;
 }
 
 // x on every edge, the indices used (the dropped loop's from Gauss–Bonnet), the energy, and the

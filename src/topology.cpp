@@ -179,6 +179,32 @@ void check_finite(const MatrixX3d& V) {
       if (!std::isfinite(V(v, k))) throw Error("non-finite coordinate in vertex " + std::to_string(v));
 }
 
+void check_coordinate_range(const MatrixX3d& V, const Topology& t) {
+  constexpr double kLargest = 1e150, kSmallest = 1e-150;
+  for (int v = 0; v < V.rows(); ++v)
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(V(v, k)) > kLargest) {
+        std::ostringstream message;
+        message << "vertex " << v << " has coordinate " << V(v, k)
+                << " beyond +-1e150: squared lengths would overflow; scale the mesh down (angles and fields do not depend on its size)";
+        throw Error(message.str());
+      }
+  double longest = 0;
+  int longest_edge = -1;
+  for (int e = 0; e < t.num_edges; ++e) {
+    const double l = (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).cwiseAbs().maxCoeff();
+    if (l > longest) longest = l, longest_edge = e;
+  }
+  if (t.num_edges > 0 && longest < kSmallest) {
+    std::ostringstream message;
+    message << "the mesh is too small: its longest edge";
+    if (longest_edge >= 0) message << " (" << t.edge_vertices(longest_edge, 0) << ", " << t.edge_vertices(longest_edge, 1) << ")";
+    message << " spans " << longest
+            << ", below 1e-150, where squared lengths underflow; scale the mesh up (angles and fields do not depend on its size)";
+    throw Error(message.str());
+  }
+}
+
 int Topology::euler_characteristic() const {
   int chi = 0;
   for (const auto& c : components) chi += c.euler_characteristic;

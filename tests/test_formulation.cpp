@@ -45,32 +45,52 @@ double angle_at(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eig
   const Eigen::Vector3d u = a - apex, w = b - apex;
   return std::atan2(u.cross(w).norm(), u.dot(w));
 }
-// README: degenerate = area ≤ 1e-14 × longest edge², or a zero-length edge.
-bool degenerate(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2) {
-  const double l01 = (p1 - p0).squaredNorm(), l12 = (p2 - p1).squaredNorm(), l20 = (p0 - p2).squaredNorm();
-  const double area = 0.5 * (p1 - p0).cross(p2 - p0).norm();
-  return l01 == 0 || l12 == 0 || l20 == 0 || !(area > 1e-14 * std::max({l01, l12, l20}));
-}
-
 struct EdgeData {
   int faces = 0;
-  double weight = 0;   // ½ Σ max(cot, 0) over the non-degenerate faces
+  double weight = 0;   // ½ Σ max(cot, 0)
   double cot_sum = 0;  // Σ cot (unclamped), for counting negative-cotangent edges
 };
 
-// README: w_e = ½ (max(cot α, 0) + max(cot β, 0)) over the angles opposite interior edge e; a degenerate
-// face contributes 0; boundary edges have weight 0.
+// Cotangent of the angle opposite side `a` of a triangle with sides a, b, c, by the law of cosines
+// (a different route from the library's Kahan–Heron area).
+double cot_from_sides(double a, double b, double c) {
+  const double cosine = (b * b + c * c - a * a) / (2 * b * c);
+  return cosine / std::sqrt(std::max(0.0, 1 - cosine * cosine));
+}
+
+// The mollification's ε for a mesh of one component (README "Weight policy", Sharp & Crane 2020 Sec. 4.5): δ = 1e-5 × the mean edge
+// length; ε = the largest δ − (l_i + l_j − l_k) over faces and sides, or 0.
+double mollify_epsilon(const MatrixX3d& V, const MatrixX3i& F) {
+  std::map<Edge, double> length;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) length[edge_of(F(f, k), F(f, (k + 1) % 3))] = (pos(V, F(f, k)) - pos(V, F(f, (k + 1) % 3))).norm();
+  double total = 0;
+  for (auto [e, l] : length) total += l;
+  const double delta = 1e-5 * total / static_cast<double>(length.size());
+  double epsilon = 0;
+  for (int f = 0; f < F.rows(); ++f) {
+    double l[3];
+    for (int k = 0; k < 3; ++k) l[k] = length.at(edge_of(F(f, k), F(f, (k + 1) % 3)));
+    for (int k = 0; k < 3; ++k) epsilon = std::max(epsilon, delta - (l[k] + l[(k + 1) % 3] - l[(k + 2) % 3]));
+  }
+  return epsilon;
+}
+
+// README: w_e = ½ (max(cot α, 0) + max(cot β, 0)) over the angles opposite interior edge e, of the
+// mollified intrinsic triangles when ε > 0 (every length + ε), of the faces as given otherwise; boundary
+// edges have weight 0.
 std::map<Edge, EdgeData> independent_weights(const MatrixX3d& V, const MatrixX3i& F) {
+  const double epsilon = mollify_epsilon(V, F);
   std::map<Edge, EdgeData> edges;
   for (int f = 0; f < F.rows(); ++f) {
     const Eigen::Vector3d p[3] = {pos(V, F(f, 0)), pos(V, F(f, 1)), pos(V, F(f, 2))};
-    const bool deg = degenerate(p[0], p[1], p[2]);
     for (int k = 0; k < 3; ++k) {
       // Edge k → k+1 is opposite corner k+2.
       EdgeData& e = edges[edge_of(F(f, k), F(f, (k + 1) % 3))];
       ++e.faces;
-      if (deg) continue;
-      const double c = cot_at(p[(k + 2) % 3], p[k], p[(k + 1) % 3]);
+      const Eigen::Vector3d &apex = p[(k + 2) % 3], &a = p[k], &b = p[(k + 1) % 3];
+      const double c = epsilon > 0 ? cot_from_sides((a - b).norm() + epsilon, (apex - a).norm() + epsilon, (apex - b).norm() + epsilon)
+                                   : cot_at(apex, a, b);
       e.weight += 0.5 * std::max(c, 0.0);
       e.cot_sum += c;
     }
@@ -152,9 +172,10 @@ double reduce(double a, int N) {
 struct PairCase {
   const char* name;
   Eigen::Vector3d up, down;
-  double weight;       // worked out by hand
+  double weight;       // worked out by hand (to O(δ) relative where mollified)
   int negative_cotan;  // 1 when cot α + cot β < 0
   int degenerate_faces, zero_area_faces;
+  int mollified_faces = 0;
 };
 
 Mesh pair_mesh(const PairCase& c) {
@@ -185,19 +206,41 @@ TEST(Formulation, CotanWeightsOfHandMadePairs) {
       {"both obtuse", {1, 0.2, 0}, {1, -0.2, 0}, 0.0, 1, 0, 0},
       // A fold out of the plane: apex (1,−1,1): (−1,1,−1)·(1,1,−1) = 1, cross (0,−2,−2), |.| = 2√2.
       {"folded", {1, 1, 0}, {1, -1, 1}, 0.5 * (1 / (2 * std::sqrt(2.0))), 0, 0, 0},
-      // Collinear (3,0,0): a zero-area face (its cot would be +∞) contributes nothing.
-      {"collinear", {3, 0, 0}, {1, -2, 0}, 0.5 * 0.75, 0, 1, 1},
-      // Area 1e-15 ≤ 1e-14 × longest edge² (9): degenerate although not exactly flat (cot would be 1.5e15).
-      {"below the degeneracy threshold", {3, 1e-15, 0}, {1, -2, 0}, 0.5 * 0.75, 0, 1, 0},
-      // Area 1e-6 is above the threshold: (−3,−1e-6)·(−1,−1e-6) = 3 + 1e-12, |cross| = 2e-6.
-      {"thin but not degenerate", {3, 1e-6, 0}, {1, -2, 0}, 0.5 * ((3 + 1e-12) / 2e-6 + 0.75), 0, 0, 0},
+      // Collinear (3,0,0): a zero-area face (its cot would be +∞), mollified. Edges 2, 1, 3, √5, √5: mean
+      // m = (6 + 2√5)/5, δ = 1e-5 m; the face (a, b, p) has margin 2 + 1 − 3 = 0, so ε = δ and its sides
+      // are 2 + δ, 1 + δ, 3 + δ: cos at p = (6 + 4δ + δ²)/(6 + 8δ + 2δ²) ≈ 1 − 2δ/3, cot ≈ √(3/(4δ)) ≈ 189;
+      // the other face keeps cot 3/4 (to O(δ)).
+      {"collinear", {3, 0, 0}, {1, -2, 0}, 0.5 * (std::sqrt(3 / (4e-5 * (6 + 2 * std::sqrt(5.0)) / 5)) + 0.75), 0, 1, 1, 1},
+      // Area 1e-15 ≤ 1e-14 × longest edge² (9): degenerate (its cot would be 1.5e15), mollified alike (the
+      // apex is within 1e-15 of the line: the margin is ~1e-30, so ε = δ to round-off).
+      {"below the degeneracy threshold",
+       {3, 1e-15, 0},
+       {1, -2, 0},
+       0.5 * (std::sqrt(3 / (4e-5 * (6 + 2 * std::sqrt(5.0)) / 5)) + 0.75),
+       0,
+       1,
+       0,
+       1},
+      // Area 1e-6 is above the degeneracy threshold, but the margin 2 + √(1 + 1e-12) − √(9 + 1e-12) ≈ 3e-13 is
+      // far below δ: mollified like the collinear face (its unmollified cot would be (3 + 1e-12) / 2e-6).
+      {"thin but not degenerate",
+       {3, 1e-6, 0},
+       {1, -2, 0},
+       0.5 * (std::sqrt(3 / (4e-5 * (6 + 2 * std::sqrt(5.0)) / 5)) + 0.75),
+       0,
+       0,
+       0,
+       1},
+      // Margin 2 + √(1 + 0.01) − √(9 + 0.01) ≈ 3.3e-3 > δ: not mollified, (−3,−0.1)·(−1,−0.1) = 3.01, |cross| = 0.2.
+      {"thin, above the margin", {3, 0.1, 0}, {1, -2, 0}, 0.5 * (3.01 / 0.2 + 0.75), 0, 0, 0},
   };
   for (const PairCase& c : cases) {
     SCOPED_TRACE(c.name);
     const Mesh m = pair_mesh(c);
     // The test's own formula agrees with the hand value (so it can be trusted on larger meshes below).
     const std::map<Edge, EdgeData> mine = independent_weights(m.V, m.F);
-    ASSERT_NEAR(mine.at({0, 1}).weight, c.weight, 1e-12 * std::max(1.0, c.weight));
+    const double hand_tolerance = c.mollified_faces > 0 ? 1e-3 : 1e-12, tolerance = c.mollified_faces > 0 ? 1e-6 : 1e-12;
+    ASSERT_NEAR(mine.at({0, 1}).weight, c.weight, hand_tolerance * std::max(1.0, c.weight));
 
     const FieldDesigner designer(m.V, m.F);
     const Topology& t = designer.topology();
@@ -205,14 +248,15 @@ TEST(Formulation, CotanWeightsOfHandMadePairs) {
     ASSERT_EQ(t.num_edges, 5);
     for (int e = 0; e < t.num_edges; ++e) {
       const bool shared = t.edge_vertices(e, 0) == 0 && t.edge_vertices(e, 1) == 1;
-      const double want = shared ? c.weight : 0.0;
-      EXPECT_NEAR(g.cotan_weight(e), want, 1e-12 * std::max(1.0, want)) << "edge " << e;
-      EXPECT_NEAR(designer.solver().weights()(e), want, 1e-12 * std::max(1.0, want)) << "edge " << e;
+      const double want = shared ? mine.at({0, 1}).weight : 0.0;
+      EXPECT_NEAR(g.cotan_weight(e), want, tolerance * std::max(1.0, want)) << "edge " << e;
+      EXPECT_NEAR(designer.solver().weights()(e), want, tolerance * std::max(1.0, want)) << "edge " << e;
       EXPECT_TRUE(std::isfinite(g.cotan_weight(e)));
     }
     EXPECT_EQ(g.negative_cotan_edges, c.negative_cotan);
     EXPECT_EQ(g.degenerate_faces, c.degenerate_faces);
     EXPECT_EQ(g.zero_area_faces, c.zero_area_faces);
+    EXPECT_EQ(g.mollified_faces, c.mollified_faces);
     // Unit weights: 1 on the interior edge, 0 on the boundary.
     SolverOptions unit;
     unit.weights = WeightKind::Unit;

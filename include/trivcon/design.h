@@ -24,6 +24,7 @@
 #pragma once
 #include <future>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -51,9 +52,11 @@ struct Design {
 };
 
 // The verification `trivcon solve` applies (exit status 3 when it fails): the holonomy residuals, the transport
-// mismatch and the fixed faces' deviation at most 1e-9 × max(1, rhs_scale), and no index mismatch that a
-// turn of π/N or more across an edge does not explain (Design::unexplained_mismatch_vertices).
-bool design_verified(const Design& design);
+// mismatch and the fixed faces' deviation at most tolerance × max(1, rhs_scale) (tolerance 1e-9 unless the
+// user asks for another, `solve --tolerance`), and no index mismatch that a turn of π/N or more across an
+// edge does not explain (Design::unexplained_mismatch_vertices).
+constexpr double kDefaultTolerance = 1e-9;
+bool design_verified(const Design& design, double tolerance = kDefaultTolerance);
 
 struct PrepareTimings {
   // Seconds of each stage; cycles and analysis ran on the second thread, concurrently with geometry and
@@ -95,5 +98,10 @@ class FieldDesigner {
   // Declared last: destroyed (joined) first, while the members its thread reads still exist.
   mutable std::future<SolverAnalysis> analysis_;
 };
+
+// Why a design failed design_verified, and what to try, in one sentence ("" when it passed); names the
+// largest residual against its limit, the steps of iterative refinement taken, and what the weight
+// policy did on this mesh (trivcon/geometry.h).
+std::string verification_failure(const FieldDesigner& designer, const Design& design, double tolerance = kDefaultTolerance);
 
 }  // namespace trivcon

@@ -62,6 +62,16 @@ Mesh concatenate(const std::vector<Mesh>& parts);
 // (a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca), so orientation is kept. Positions are not
 // smoothed. Works for any triangle mesh (face indices must be in [0, V)); O(V + F).
 Mesh subdivide_midpoint(const Mesh& mesh);
+// Sliver, needle and coincident-vertex variants of a clean mesh (the surface kept, more triangles): the
+// edges of a greedy set in which no two share a face (taken in increasing order of (i, j), i < j, which
+// picks about 30 % of a closed mesh's edges) are each split at m = p_i + t·(p_j − p_i), 0 ≤ t < 1, moved by
+// lift·|p_j − p_i| along the mean unit normal of the edge's faces (lift = 0 keeps the surface exactly).
+// t = 0 and lift = 0 makes m coincide with p_i (zero-area faces); a small t makes triangles with an angle
+// of about t (slivers), and lift ≈ t makes needles. Input vertex ids are kept; the new vertex of the k-th
+// split edge is V + k. A face (a, b, c) whose half-edge a → b is split becomes (a, m, c), keeping its
+// index, and (m, b, c), appended; `parent_face[f]` (when not null) is the input face each output face
+// lies in. Throws like the generators above for t outside [0, 1) or invalid faces.
+Mesh split_edges_near_end(const Mesh& mesh, double t, double lift = 0, std::vector<int>* parent_face = nullptr);
 // Random permutation of vertex ids and of face order (faces keep their orientation, corners
 // rotate cyclically by a random amount); deterministic for a seed on every platform (draws come
 // straight from std::mt19937). `vertex_perm[old] = new`, `face_perm[old] = new` when not null.

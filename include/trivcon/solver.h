@@ -6,11 +6,12 @@
 //   interior vertex v:      Σ_e s_ve x_e = K_v − 2π k_v      (s_ve = +1 if v is e's larger id, else −1)
 //   boundary loop ℓ:        Σ_e c_e x_e  = K_ℓ − 2π k_ℓ      (c: the loop cycle, K_ℓ its loop_curvature)
 //   generator γ:            Σ_e c_e x_e  = z_γ − 2π k_γ      (z_γ = levi_civita_holonomy)
-// Objective: minimise Σ x_e² / w_e (w = cotan or unit weights); an edge with w_e = 0 gets x_e = 0, except
+// Objective: minimise Σ x_e² / w_e (w = cotan or unit weights; the cotan weights are clamped and, on meshes
+// with slivers or degenerate faces, mollified: trivcon/geometry.h); an edge with w_e = 0 gets x_e = 0, except
 // where that would make the constraints unsatisfiable: the edges of a cycle or fixed-face path that has no
 // edge of positive weight, and the edges around a vertex that zero weights cut off from the rest of its
-// component (e.g. one surrounded by zero-area faces) get 1e-6 × the median positive weight, so the field
-// can still turn there when nothing else can (regularized_edges()).
+// component, get 1e-6 × the median positive weight, so the field can still turn there when nothing else
+// can (regularized_edges()). Since the mollification, zero-area faces no longer cause either.
 //
 // Default route (SolverKind::Cholesky): x = W Aᵀ y with (A W Aᵀ) y = b, where A = [D; C] holds the
 // interior-vertex rows D and the cycle rows C (loops, generators). D W Dᵀ is the cotan Laplacian on
@@ -23,6 +24,10 @@
 // prescription only changes b: nothing is refactored. The forward substitution of the prescription without singularities is stored, so an
 // edit that places a few singularities updates it along their paths in the elimination tree only, then does one full backward substitution,
 // on OpenMP's threads (the top of the elimination tree first, then one set of independent subtrees per thread).
+// Every solve is verified (Connection's residuals); when the largest residual exceeds 1e-11 × max(1, rhs_scale),
+// up to 3 steps of iterative refinement with the same factor follow (x += W Aᵀ (A W Aᵀ)⁻¹ (b − A x)), each kept
+// only if it lowers the residual (Connection::refinements): one substitution is not enough where the weights
+// span many orders of magnitude.
 // Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
 // system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
 //
@@ -78,6 +83,8 @@ struct Connection {
   // Verification: largest |Σ coefficient · x − right-hand side| over all interior vertices (including
   // the dropped ones), all loops and all generators, and the scale of the right-hand sides.
   double max_vertex_residual = 0, max_cycle_residual = 0, rhs_scale = 0;
+  // Steps of iterative refinement the solve took (0 on most meshes; see ConnectionSolver::solve).
+  int refinements = 0;
 };
 
 struct SetupTimings {

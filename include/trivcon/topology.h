@@ -72,5 +72,9 @@ Topology build_topology(const MatrixX3i& F, int num_vertices);
 
 // Checks that every coordinate is finite; throws naming the first bad vertex.
 void check_finite(const MatrixX3d& V);
+// Checks that the mesh's size lets squared lengths, cross products and areas be computed in double
+// precision: every coordinate within ±1e150, and the longest edge at least 1e-150 (when there are edges).
+// Throws naming the vertex or the edge and what to do (scale the mesh).
+void check_coordinate_range(const MatrixX3d& V, const Topology& topology);
 
 }  // namespace trivcon

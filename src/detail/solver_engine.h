@@ -28,6 +28,10 @@ class SolverEngine {
   // The vertex right-hand side most solves differ from in only a few rows (the angle defects: no
   // singularity), so that a solve can update a stored forward substitution instead of redoing it.
   virtual void set_base_rhs(const Eigen::VectorXd& /*b_D*/) {}
+  // One step of iterative refinement with the factor at hand: x += W Aᵀ (A W Aᵀ)⁻¹ (b − A x), for the
+  // full right-hand side b = [b_D; b_C] (vertex rows, then cycle rows, as solve() used them). Returns
+  // false, leaving x, on a route that has nothing to refine (QR solves the constraints directly).
+  virtual bool refine(const Eigen::VectorXd& /*b*/, Eigen::VectorXd& /*x*/) const { return false; }
   // The fill-reducing order the factorization used.
   virtual std::string ordering() const = 0;
   // diag(P)
