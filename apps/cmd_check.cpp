@@ -9,6 +9,7 @@
 #include "trivcon/field.h"
 #include "trivcon/field_io.h"
 #include "trivcon/geometry.h"
+#include "trivcon/matching.h"
 #include "trivcon/topology.h"
 
 namespace trivcon::cli {
@@ -18,6 +19,7 @@ namespace {
 struct CheckOptions {
   std::string mesh, field;
   PrescriptionOptions prescription;
+  std::string matching;  // --matching
   bool json = false;
 };
 
@@ -34,7 +36,9 @@ void run_check(CheckOptions& o) {
   const IndexPrescription p = o.prescription.build();
   if (compare) validate_prescription(t, static_cast<int>(cycles.generators.size()), p);
   const Field field = field_from_directions(g, directions, p.N);
-  const FieldIndices idx = field_indices(t, g, cycles, field);
+  // With --matching the directions are paired as the file says; otherwise by the closest (principal) matching.
+  const FieldIndices idx = o.matching.empty() ? field_indices(t, g, cycles, field)
+                                              : indices_with_matching(t, g, cycles, field, read_matching(o.matching, t, p.N));
   nlohmann::ordered_json found = nlohmann::ordered_json::array(), differ = nlohmann::ordered_json::array();
   for (int v = 0; v < t.num_vertices; ++v) {
     const int want = p.vertex.count(v) ? p.vertex.at(v) : 0;
@@ -77,6 +81,9 @@ void register_check(CLI::App& app) {
   check->add_option("mesh", c.mesh, "Mesh file")->required();
   check->add_option("field", c.field, "Field: trivcon's .txt or .ply, or Directional's .rawfield")->required();
   c.prescription.add_to(check, false);
+  check->add_option("--matching", c.matching,
+                    "Matching file (.matching, as solve --matching-out writes): pair the faces' directions as it says instead of by the "
+                    "closest direction");
   check->add_flag("--json", c.json, "Print JSON");
   check->callback([] { run_check(c); });
 }

@@ -15,6 +15,7 @@
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
+#include "trivcon/matching.h"
 #include "trivcon/field_io.h"
 
 namespace trivcon::cli {
@@ -92,6 +93,20 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
       std::cout << " (" << d.index_mismatch_vertices.size() - unexplained.size()
                 << " at vertices where the connection turns by pi/N or more across an edge, which a per-face field cannot show)";
     std::cout << "\ntime: solve " << fmt(d.solve_seconds) << " s, field " << fmt(d.field_seconds) << " s\n";
+  }
+  // Where the connection turns by π/N or more, a tool that pairs directions itself sees other indices.
+  const std::vector<int> large = large_turn_edges(designer.topology(), c.x, prescription.N);
+  if (!large.empty() && !o.quiet) {
+    int consumer = 0, extra = 0;
+    for (int v = 0; v < designer.topology().num_vertices; ++v) {
+      const auto it = prescription.vertex.find(v);
+      consumer += d.indices.vertex[v] != 0;
+      extra += d.indices.vertex[v] != (it == prescription.vertex.end() ? 0 : it->second);
+    }
+    std::cerr << "trivcon: warning" << (name.empty() ? "" : " for " + name) << ": " << large.size()
+              << " edges turn by pi/N or more; a tool that matches directions itself (Directional, QuadWild, MIQ) will read " << consumer
+              << " singular vertices from this field, " << extra
+              << " of them differing from the prescription (report: large_turns); give it --matching-out, or refine the mesh there\n";
   }
   if (!ok)
     std::cerr << "trivcon: verification failed" << (name.empty() ? "" : " for " + name) << ": residual " << residual
@@ -225,6 +240,9 @@ void register_solve(CLI::App& app) {
   cmd->add_option("--field-out", o.out.field, "Field file: .txt (x y z per face), .rawfield (Directional) or .ply");
   cmd->add_option("--connection-out", o.out.connection, "Connection file: 'i j x' per interior edge");
   cmd->add_option("--lines-out", o.out.lines, "OBJ with a short segment per face and direction");
+  cmd->add_option("--matching-out", o.out.matching,
+                  "Matching file (Directional's .matching: 'N E', then 'L R i j m' per interior edge): the 2pi/N steps our connection "
+                  "pairs the faces' directions with, so that tools read exactly the prescribed singularities");
   cmd->add_option("--sing-out", o.out.singularities, "Singularity file of the singularities used ('VERTEX INDEX' lines, readable by -s)");
   cmd->add_option("--png", o.out.png, "Picture of the field (as `trivcon render` with its defaults)");
   cmd->add_option("--report", o.out.report, "JSON report: sizes, topology, indices used, energy, residuals, timings");

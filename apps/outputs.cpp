@@ -1,5 +1,7 @@
 #include "outputs.h"
 
+#include "trivcon/matching.h"
+
 #include <filesystem>
 #include <functional>
 #include <system_error>
@@ -59,6 +61,10 @@ void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const
   if (!paths.connection.empty())
     staged.write(output_path(paths.connection, name),
                  [&](const std::string& path) { write_connection(path, designer.topology(), d.connection.x, prescription.N); });
+  if (!paths.matching.empty())
+    staged.write(output_path(paths.matching, name), [&](const std::string& path) {
+      write_matching(path, designer.topology(), connection_matching(designer.topology(), g, d.field, d.connection.x), prescription.N);
+    });
   if (!paths.lines.empty())
     staged.write(output_path(paths.lines, name), [&](const std::string& path) { write_field_lines(path, mesh.V, mesh.F, g, d.field); });
   if (!paths.singularities.empty())

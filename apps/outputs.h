@@ -14,7 +14,7 @@ namespace trivcon::cli {
 
 // The output paths given on the command line; an empty one is not written.
 struct OutputPaths {
-  std::string field, connection, lines, report, png, singularities;  // singularities: --sing-out
+  std::string field, connection, lines, report, png, singularities, matching;  // singularities: --sing-out, matching: --matching-out
 };
 
 // Output paths for one prescription of a batch: "{name}" in a path is replaced by the item's name;

@@ -1,6 +1,7 @@
 #include "report.h"
 
 #include "summary.h"
+#include "trivcon/matching.h"
 #include "trivcon/blas.h"
 
 namespace trivcon::cli {
@@ -57,6 +58,13 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
                        {"field_mismatches", mism},
                        {"unexplained_mismatches", d.unexplained_mismatch_vertices.size()},
                        {"large_turn_edges", d.large_turn_edges}};
+  // Edges turning by π/N or more, and what a tool with its own (principal) matching reads from the field.
+  nlohmann::ordered_json turns = nlohmann::ordered_json::array(), consumer = nlohmann::ordered_json::array();
+  for (int e : large_turn_edges(t, c.x, prescription.N))
+    turns.push_back({{"i", t.edge_vertices(e, 0)}, {"j", t.edge_vertices(e, 1)}, {"x", c.x(e)}});
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (d.indices.vertex[v] != 0) consumer.push_back({{"vertex", v}, {"index", format_index(d.indices.vertex[v], prescription.N)}});
+  report["large_turns"] = {{"edges", turns}, {"principal_matching_singularities", consumer}};
   const PrepareTimings& pt = designer.timings();
   const SetupTimings& st = designer.solver().timings();
   report["symbolic_analysis"] = st.analysis_adopted ? "concurrent" : "in set-up";

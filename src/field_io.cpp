@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <iomanip>
@@ -220,6 +221,96 @@ Eigen::VectorXd read_connection(const std::string& path, const Topology& t) {
       throw Error(path + ": interior edge (" + std::to_string(t.edge_vertices(e, 0)) + ", " + std::to_string(t.edge_vertices(e, 1)) +
                   ") is missing");
   return x;
+}
+
+namespace {
+// Interior edges in increasing (i, j).
+std::vector<int> edges_by_vertices(const Topology& t) {
+  std::vector<int> order;
+  for (int e = 0; e < t.num_edges; ++e)
+    if (!t.is_boundary_edge(e)) order.push_back(e);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return std::make_pair(t.edge_vertices(a, 0), t.edge_vertices(a, 1)) < std::make_pair(t.edge_vertices(b, 0), t.edge_vertices(b, 1));
+  });
+  return order;
+}
+
+// A whole number token within [lo, hi], or an error naming the line and what it should be.
+long long whole_number(const std::string& token, const TextLines& lines, long long lo, long long hi, const char* what) {
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(token.c_str(), &end, 10);
+  if (token.empty() || end != token.c_str() + token.size() || errno == ERANGE || v < lo || v > hi)
+    throw Error(lines.where() + ": " + what + " '" + token + "' is not a whole number in [" + std::to_string(lo) + ", " +
+                std::to_string(hi) + "]");
+  return v;
+}
+}  // namespace
+
+void write_matching(const std::string& path, const Topology& t, const Eigen::VectorXi& matching, int N) {
+  if (matching.size() != t.num_edges)
+    throw Error("write_matching: " + std::to_string(matching.size()) + " values for " + std::to_string(t.num_edges) + " edges");
+  const std::vector<int> order = edges_by_vertices(t);
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << N << " " << order.size() << "\n";
+    for (int e : order)
+      out << t.edge_faces(e, 0) << " " << t.edge_faces(e, 1) << " " << t.edge_vertices(e, 0) << " " << t.edge_vertices(e, 1) << " "
+          << ((matching(e) % N) + N) % N << "\n";
+  });
+}
+
+Eigen::VectorXi read_matching(const std::string& path, const Topology& t, int N) {
+  TextLines lines(path);
+  auto tokens = [&](size_t expected) {
+    std::istringstream fields(lines.line);
+    std::vector<std::string> out;
+    std::string token;
+    while (fields >> token) out.push_back(token);
+    if (out.size() != expected)
+      throw Error(lines.where() + ": expected " + std::to_string(expected) + " numbers, got " + std::to_string(out.size()));
+    return out;
+  };
+  if (!lines.next()) throw Error(path + ": empty matching file (expected a first line 'N E')");
+  std::vector<std::string> head = tokens(2);
+  const long long file_N = whole_number(head[0], lines, 1, 1 << 20, "N");
+  const long long count = whole_number(head[1], lines, 0, t.num_edges, "the edge count");
+  if (file_N != N) throw Error(path + ": the matching is for N = " + std::to_string(file_N) + ", the field has N = " + std::to_string(N));
+  int interior = 0;
+  for (int e = 0; e < t.num_edges; ++e) interior += !t.is_boundary_edge(e);
+  if (count != interior)
+    throw Error(lines.where() + ": the file lists " + std::to_string(count) + " edges, the mesh has " + std::to_string(interior) +
+                " interior edges");
+  Eigen::VectorXi m = Eigen::VectorXi::Zero(t.num_edges);
+  std::vector<char> seen(t.num_edges, 0);
+  for (long long k = 0; k < count; ++k) {
+    if (!lines.next()) throw Error(path + ": ends after " + std::to_string(k) + " of its " + std::to_string(count) + " edges");
+    const std::vector<std::string> v = tokens(5);
+    const int a = static_cast<int>(whole_number(v[0], lines, 0, t.num_faces - 1, "face"));
+    const int b = static_cast<int>(whole_number(v[1], lines, 0, t.num_faces - 1, "face"));
+    const int i = static_cast<int>(whole_number(v[2], lines, 0, t.num_vertices - 1, "vertex"));
+    const int j = static_cast<int>(whole_number(v[3], lines, 0, t.num_vertices - 1, "vertex"));
+    const long long value = whole_number(v[4], lines, -(1LL << 40), 1LL << 40, "matching");
+    int edge = -1;
+    for (int q = t.vertex_edge_offsets[std::min(i, j)]; q < t.vertex_edge_offsets[std::min(i, j) + 1] && edge < 0; ++q) {
+      const int e = t.vertex_edges[q];
+      if (t.edge_vertices(e, 0) == std::min(i, j) && t.edge_vertices(e, 1) == std::max(i, j)) edge = e;
+    }
+    if (edge < 0 || t.is_boundary_edge(edge))
+      throw Error(lines.where() + ": (" + std::to_string(i) + ", " + std::to_string(j) + ") is not an interior edge of the mesh");
+    const int L = t.edge_faces(edge, 0), R = t.edge_faces(edge, 1);
+    if (!((a == L && b == R) || (a == R && b == L)))
+      throw Error(lines.where() + ": faces " + std::to_string(a) + " and " + std::to_string(b) + " are not the faces of edge (" +
+                  std::to_string(t.edge_vertices(edge, 0)) + ", " + std::to_string(t.edge_vertices(edge, 1)) + "), which are " +
+                  std::to_string(L) + " and " + std::to_string(R));
+    if (seen[edge])
+      throw Error(lines.where() + ": edge (" + std::to_string(t.edge_vertices(edge, 0)) + ", " + std::to_string(t.edge_vertices(edge, 1)) +
+                  ") is listed twice");
+    seen[edge] = 1;
+    const long long signed_value = a == L ? value : -value;
+    m(edge) = static_cast<int>(((signed_value % N) + N) % N);
+  }
+  if (lines.next()) throw Error(lines.where() + ": text after the " + std::to_string(count) + " edges the first line announced");
+  return m;
 }
 
 void write_field_lines(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& g, const Field& field) {

@@ -11,6 +11,9 @@
 //   vertex_indices, then double fx fy fz = the first direction).
 // - Connection: "# trivcon connection", "# N <N>", then one line "i j x" per interior edge, i < j,
 //   sorted by (i, j); x is the adjustment angle in radians with the sign of trivcon/solver.h.
+// - Matching (.matching, Directional's format): first line "N E" (E interior edges), then one line
+//   "L R i j m" per interior edge in increasing (i, j): its faces L = edge_faces(e, 0) and R, its vertices
+//   i < j, and m in [0, N): direction 0 of L, carried into R, is direction m of R (trivcon/matching.h).
 // - Lines (.obj): for each face and each of its N directions, a segment from the face centroid of length
 //   0.4 × the face's mean edge length: "v" lines, then "l a b" lines (1-based, OBJ).
 // Readers accept what the writers write (and .rawfield from Directional) and report the file and line of
@@ -34,6 +37,11 @@ MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file = nu
 void write_connection(const std::string& path, const Topology& topology, const Eigen::VectorXd& x, int N);
 // Reads (i, j) → x back; returns per-edge x (0 on boundary edges); every interior edge must be listed once.
 Eigen::VectorXd read_connection(const std::string& path, const Topology& topology);
+
+void write_matching(const std::string& path, const Topology& topology, const Eigen::VectorXi& matching, int N);
+// Reads a .matching back: per-edge m in [0, N) (0 on boundary edges); every interior edge listed once, as
+// "L R i j m" or with its faces swapped ("R L i j m", read as −m); the file's N must be `N`.
+Eigen::VectorXi read_matching(const std::string& path, const Topology& topology, int N);
 
 void write_field_lines(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& geometry, const Field& field);
 

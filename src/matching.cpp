@@ -1,0 +1,75 @@
+// Matchings of a per-face field across edges (trivcon/matching.h).
+#include "trivcon/matching.h"
+
+#include <cmath>
+
+#include "trivcon/error.h"
+
+namespace trivcon {
+
+namespace {
+// a in (−π, π].
+double wrap_pi(double a) { return wrap_angle(a); }
+int modulo(long long a, int N) { return static_cast<int>(((a % N) + N) % N); }
+// The whole number of 2π/N steps nearest to `angle`, modulo N.
+int steps_of(double angle, int N) { return modulo(std::llround(angle * N / (2 * kPi)), N); }
+}  // namespace
+
+Eigen::VectorXi principal_matching(const Topology& t, const Geometry& g, const Field& field) {
+  Eigen::VectorXi m = Eigen::VectorXi::Zero(t.num_edges);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    // d_e = β_R + 2πm/N − β_L − ρ_e smallest: 2πm/N nearest to β_L + ρ_e − β_R.
+    m(e) = steps_of(field.angle(t.edge_faces(e, 0)) + g.rho(e) - field.angle(t.edge_faces(e, 1)), field.N);
+  }
+  return m;
+}
+
+Eigen::VectorXi connection_matching(const Topology& t, const Geometry& g, const Field& field, const Eigen::VectorXd& x) {
+  if (x.size() != t.num_edges)
+    throw Error("connection_matching: the connection has " + std::to_string(x.size()) + " values, the mesh " + std::to_string(t.num_edges) +
+                " edges");
+  Eigen::VectorXi m = Eigen::VectorXi::Zero(t.num_edges);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    m(e) = steps_of(field.angle(t.edge_faces(e, 0)) + g.rho(e) - x(e) - field.angle(t.edge_faces(e, 1)), field.N);
+  }
+  return m;
+}
+
+FieldIndices indices_with_matching(const Topology& t, const Geometry& g, const Cycles& cycles, const Field& field,
+                                   const Eigen::VectorXi& matching) {
+  if (matching.size() != t.num_edges)
+    throw Error("the matching has " + std::to_string(matching.size()) + " values, the mesh " + std::to_string(t.num_edges) + " edges");
+  const int N = field.N;
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(t.num_edges);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    d(e) = wrap_pi(field.angle(t.edge_faces(e, 1)) + 2 * kPi * modulo(matching(e), N) / N - field.angle(t.edge_faces(e, 0)) - g.rho(e));
+  }
+  FieldIndices out;
+  auto to_n = [&](double raw_turns) {
+    const double scaled = raw_turns * N, rounded = std::round(scaled);
+    out.max_rounding = std::max(out.max_rounding, std::abs(scaled - rounded));
+    return static_cast<int>(rounded);
+  };
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(t.num_vertices);
+  for (int e = 0; e < t.num_edges; ++e) sum(t.edge_vertices(e, 1)) += d(e), sum(t.edge_vertices(e, 0)) -= d(e);
+  out.vertex.assign(t.num_vertices, 0);
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (t.is_interior_vertex(v)) out.vertex[v] = to_n((g.angle_defect(v) + sum(v)) / (2 * kPi));
+  for (size_t l = 0; l < cycles.loops.size(); ++l)
+    out.loop.push_back(to_n((loop_curvature(t, g, static_cast<int>(l)) + cycle_sum(cycles.loops[l], d)) / (2 * kPi)));
+  for (const DualCycle& c : cycles.generators) out.generator.push_back(to_n((levi_civita_holonomy(c, g) + cycle_sum(c, d)) / (2 * kPi)));
+  return out;
+}
+
+std::vector<int> large_turn_edges(const Topology& t, const Eigen::VectorXd& x, int N) {
+  std::vector<int> out;
+  const double limit = kPi / N - 1e-9;
+  for (int e = 0; e < t.num_edges; ++e)
+    if (!t.is_boundary_edge(e) && std::abs(x(e)) >= limit) out.push_back(e);
+  return out;
+}
+
+}  // namespace trivcon
