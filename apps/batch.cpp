@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <system_error>
@@ -32,12 +33,12 @@ std::vector<fs::path> directory_files(const std::string& path) {
 
 std::vector<BatchItem> read_directory(const std::string& path, const IndexPrescription& base) {
   std::vector<BatchItem> items;
+  std::map<std::string, std::size_t> item_of_name;  // outputs are named by the item: two of a name would overwrite each other
   for (const fs::path& f : directory_files(path)) {
     BatchItem item{f.stem().string(), base, f.filename().string()};
-    for (const BatchItem& other : items)  // outputs are named by the item: two of a name would overwrite each other
-      if (other.name == item.name)
-        throw Error("--sing-batch " + path + ": files '" + other.source + "' and '" + f.filename().string() + "' have the same name '" +
-                    item.name + "'");
+    if (const auto [it, added] = item_of_name.emplace(item.name, items.size()); !added)
+      throw Error("--sing-batch " + path + ": files '" + items[it->second].source + "' and '" + f.filename().string() +
+                  "' have the same name '" + item.name + "'");
     item.prescription.vertex.clear();
     read_singularities(f.string(), item.prescription);
     items.push_back(std::move(item));
@@ -46,9 +47,17 @@ std::vector<BatchItem> read_directory(const std::string& path, const IndexPrescr
   return items;
 }
 
-std::vector<BatchItem> read_json_lines(const std::string& path, const IndexPrescription& base) {
+}  // namespace
+
+std::vector<BatchItem> read_batch(const std::string& path, const IndexPrescription& base) {
+  std::error_code error;  // a path that cannot be examined is read as a file, whose error names it
+  return fs::is_directory(path, error) ? read_directory(path, base) : read_batch_lines(read_file_bytes(path), path, base);
+}
+
+std::vector<BatchItem> read_batch_lines(const std::string& text, const std::string& path, const IndexPrescription& base) {
   std::vector<BatchItem> items;
-  std::istringstream in(read_file_bytes(path));
+  std::map<std::string, std::size_t> item_of_name;  // outputs are named by the item: two of a name would overwrite each other
+  std::istringstream in(text);
   std::string line;
   for (int line_no = 1; std::getline(in, line); ++line_no) {
     const std::string where = path + ":" + std::to_string(line_no);
@@ -63,13 +72,16 @@ std::vector<BatchItem> read_json_lines(const std::string& path, const IndexPresc
       throw Error(where + ": expected {\"name\": \"...\", \"sing\": {\"VERTEX\": \"INDEX\", ...}}");
     BatchItem item{j["name"].get<std::string>(), base, "line " + std::to_string(line_no)};
     if (item.name.empty() || item.name.find('/') != std::string::npos) throw Error(where + ": the name must be non-empty without '/'");
-    for (const BatchItem& other : items)  // outputs are named by the item: two of a name would overwrite each other
-      if (other.name == item.name) throw Error(where + ": the name '" + item.name + "' is already used on " + other.source);
+    if (const auto [it, added] = item_of_name.emplace(item.name, items.size()); !added)
+      throw Error(where + ": the name '" + item.name + "' is already used on " + items[it->second].source);
     item.prescription.vertex.clear();
     auto add = [&](const char* key, void (*adder)(const std::string&, IndexPrescription&)) {
       if (!j.contains(key)) return;
       if (!j[key].is_object()) throw Error(where + ": \"" + key + "\" must be an object");
       for (const auto& [id, index] : j[key].items()) {
+        // Only a string or a number is an index (dumping anything else back to text would recurse into it).
+        if (!index.is_string() && !index.is_number())
+          throw Error(where + ": the index of \"" + key + "\" \"" + id + "\" must be a string or a number, e.g. \"1/4\"");
         const std::string value = index.is_string() ? index.get<std::string>() : index.dump();
         try {
           adder(id + ":" + value, item.prescription);
@@ -85,13 +97,6 @@ std::vector<BatchItem> read_json_lines(const std::string& path, const IndexPresc
   }
   if (items.empty()) throw Error("--sing-batch " + path + ": no items");
   return items;
-}
-
-}  // namespace
-
-std::vector<BatchItem> read_batch(const std::string& path, const IndexPrescription& base) {
-  std::error_code error;  // a path that cannot be examined is read as a file, whose error names it
-  return fs::is_directory(path, error) ? read_directory(path, base) : read_json_lines(path, base);
 }
 
 }  // namespace trivcon::cli

@@ -20,5 +20,7 @@ struct BatchItem {
 // those of -s/--sing. Throws trivcon::Error naming the file (and line) for anything it cannot read, and
 // for two items of the same name (their outputs would overwrite each other).
 std::vector<BatchItem> read_batch(const std::string& path, const IndexPrescription& base);
+// The JSON-lines form on the file's text in memory; `path` names it in messages (used by read_batch and the fuzz target).
+std::vector<BatchItem> read_batch_lines(const std::string& text, const std::string& path, const IndexPrescription& base);
 
 }  // namespace trivcon::cli

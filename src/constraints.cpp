@@ -5,6 +5,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "detail/readers.h"
 #include "trivcon/error.h"
 #include "trivcon/field.h"
 #include "trivcon/io.h"
@@ -93,7 +94,8 @@ namespace {
 int parse_face(const std::string& text, const Topology& t, const std::string& where) {
   char* end = nullptr;
   const long long f = std::strtoll(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0') throw Error(where + ": malformed face id '" + text + "'");
+  // The whole token must be the number (a NUL byte in it would end it early for strtoll).
+  if (text.empty() || end != text.c_str() + text.size()) throw Error(where + ": malformed face id '" + text + "'");
   if (f < 0 || f >= t.num_faces)
     throw Error(where + ": face " + text + " out of range (mesh has " + std::to_string(t.num_faces) + " faces)");
   return static_cast<int>(f);
@@ -102,7 +104,7 @@ int parse_face(const std::string& text, const Topology& t, const std::string& wh
 double parse_number(const std::string& text, const std::string& where) {
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0') throw Error(where + ": malformed number '" + text + "'");
+  if (text.empty() || end != text.c_str() + text.size()) throw Error(where + ": malformed number '" + text + "'");
   if (!std::isfinite(v)) throw Error(where + ": number '" + text + "' is not finite");
   return v;
 }
@@ -126,7 +128,12 @@ void insert_fixed(std::map<int, double>& fixed, int face, double angle, const st
 }  // namespace
 
 void read_fixed_directions(const std::string& path, const Topology& t, const Geometry& g, std::map<int, double>& fixed) {
-  std::istringstream in(read_file_bytes(path));
+  detail::read_fixed_directions_from(read_file_bytes(path), path, t, g, fixed);
+}
+
+void detail::read_fixed_directions_from(const std::string& bytes, const std::string& path, const Topology& t, const Geometry& g,
+                                        std::map<int, double>& fixed) {
+  std::istringstream in(bytes);
   std::string line;
   for (int line_no = 1; std::getline(in, line); ++line_no) {
     const std::string where = path + ":" + std::to_string(line_no);

@@ -6,13 +6,19 @@
 #include <cmath>
 #include <cstring>
 #include <iomanip>
+#include <iterator>
 #include <sstream>
+#include <string_view>
 
+#include "detail/readers.h"
+#include "detail/text_scanner.h"
 #include "trivcon/error.h"
 
 namespace trivcon {
 
 namespace {
+
+constexpr int kMaxFieldN = 1000;  // the largest N a field file may state (as -N)
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -30,7 +36,7 @@ struct TextLines {
   std::istringstream in;
   std::string path, line;
   int number = 0;
-  explicit TextLines(const std::string& p) : in(read_file_bytes(p)), path(p) {}
+  TextLines(const std::string& bytes, const std::string& p) : in(bytes), path(p) {}
   bool next() {
     while (std::getline(in, line)) {
       ++number;
@@ -59,37 +65,87 @@ std::vector<double> parse_numbers(const TextLines& lines, size_t expected) {
   return values;
 }
 
-MatrixX3d read_field_ply(const std::string& path, int num_faces) {
-  const std::string bytes = read_file_bytes(path);
-  const std::string expected_vertex = "property double x\nproperty double y\nproperty double z\n";
-  const std::string expected_face =
-      "property list uchar int vertex_indices\nproperty double fx\nproperty double fy\nproperty double fz\nend_header\n";
-  const size_t header_end = bytes.find("end_header\n");
-  if (bytes.compare(0, 4, "ply\n") != 0 || header_end == std::string::npos ||
-      bytes.find("format binary_little_endian 1.0\n") == std::string::npos || bytes.find(expected_face) == std::string::npos ||
-      bytes.find(expected_vertex) == std::string::npos)
-    throw Error(path + ": not a field PLY written by trivcon (expected face properties fx fy fz after vertex_indices)");
-  int nv = -1, nf = -1;
-  std::istringstream header(bytes.substr(0, header_end));
-  std::string line;
-  while (std::getline(header, line)) {
-    if (sscanf(line.c_str(), "element vertex %d", &nv) == 1) continue;
-    if (sscanf(line.c_str(), "element face %d", &nf) == 1) continue;
+// The header write_field gives a field PLY, line by line ('#' stands for the vertex and face counts);
+// comment lines may come anywhere after the first.
+constexpr const char* kFieldPlyHeader[] = {"ply",
+                                           "format binary_little_endian 1.0",
+                                           "element vertex #",
+                                           "property double x",
+                                           "property double y",
+                                           "property double z",
+                                           "element face #",
+                                           "property list uchar int vertex_indices",
+                                           "property double fx",
+                                           "property double fy",
+                                           "property double fz",
+                                           "end_header"};
+
+MatrixX3d read_field_ply(const std::string& bytes, const std::string& path, int num_faces) {
+  const std::string not_ours = path + ": not a field PLY written by trivcon (expected face properties fx fy fz after vertex_indices)";
+  long long counts[2] = {-1, -1};  // vertices, faces
+  std::size_t pos = 0, expected = 0, count_index = 0;
+  while (expected < std::size(kFieldPlyHeader)) {
+    const std::size_t newline = bytes.find('\n', pos);
+    if (newline == std::string::npos) throw Error(not_ours);
+    const std::string_view line(bytes.data() + pos, newline - pos);
+    pos = newline + 1;
+    if (expected > 0 && line.substr(0, 8) == "comment ") continue;
+    const std::string_view want = kFieldPlyHeader[expected++];
+    const std::size_t hash = want.find('#');
+    if (hash == std::string_view::npos) {
+      if (line != want) throw Error(not_ours);
+      continue;
+    }
+    long long& count = counts[count_index++];
+    if (line.substr(0, hash) != want.substr(0, hash) || !detail::parse_integer(line.substr(hash), count) || count < 0)
+      throw Error(not_ours);
   }
+  const long long nv = counts[0], nf = counts[1];
   if (nf != num_faces) throw Error(path + ": has " + std::to_string(nf) + " faces, the mesh has " + std::to_string(num_faces));
-  size_t pos = header_end + std::strlen("end_header\n") + static_cast<size_t>(nv) * 24;
+  // The vertices are skipped, not read: a claim beyond the file is caught before the faces are looked at.
+  const std::size_t after_header = bytes.size() - pos;
+  if (static_cast<unsigned long long>(nv) > after_header / 24)
+    throw Error(path + ": header claims " + std::to_string(nv) + " vertices, but the file has only " + std::to_string(after_header) +
+                " bytes after the header (a vertex needs 24)");
+  pos += static_cast<std::size_t>(nv) * 24;
   MatrixX3d d(num_faces, 3);
   for (int f = 0; f < num_faces; ++f) {
     if (pos >= bytes.size()) throw Error(path + ": truncated at byte " + std::to_string(pos) + " (face " + std::to_string(f) + ")");
     const size_t count = static_cast<unsigned char>(bytes[pos]);
     pos += 1 + 4 * count;
-    if (pos + 24 > bytes.size()) throw Error(path + ": truncated at byte " + std::to_string(pos) + " (face " + std::to_string(f) + ")");
+    if (pos > bytes.size() || bytes.size() - pos < 24)  // pos: where the direction would start
+      throw Error(path + ": truncated at byte " + std::to_string(pos) + " (face " + std::to_string(f) + ")");
     double v[3];
     std::memcpy(v, bytes.data() + pos, 24);
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))  // as the text formats
+      throw Error(path + ": non-finite direction in face " + std::to_string(f) + " (at byte " + std::to_string(pos) + ")");
     pos += 24;
     d.row(f) << v[0], v[1], v[2];
   }
   return d;
+}
+
+// "# N <n>" among the leading comments of a field text file: n, 0 when there is none. Only a whole integer
+// counts (other "# N ..." lines are comments); it must be a valid symmetry, 1 to 1000 like -N.
+int field_text_N(const std::string& bytes, const std::string& path) {
+  int N = 0;
+  std::size_t pos = 0;
+  for (int line_no = 1; pos < bytes.size() && bytes[pos] == '#'; ++line_no) {
+    const std::size_t newline = std::min(bytes.find('\n', pos), bytes.size());
+    std::string_view line(bytes.data() + pos, newline - pos);
+    pos = newline + 1;
+    if (line.substr(0, 4) != "# N ") continue;
+    line.remove_prefix(4);
+    while (!line.empty() && detail::is_space(line.back())) line.remove_suffix(1);
+    while (!line.empty() && detail::is_space(line.front())) line.remove_prefix(1);
+    long long n;
+    if (!detail::parse_integer(line, n)) continue;
+    if (n < 1 || n > kMaxFieldN)
+      throw Error(path + ":" + std::to_string(line_no) + ": N " + std::to_string(n) + " out of range (1 to " + std::to_string(kMaxFieldN) +
+                  ")");
+    N = static_cast<int>(n);
+  }
+  return N;
 }
 
 }  // namespace
@@ -138,18 +194,26 @@ void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F
 }
 
 MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file) {
+  return detail::read_field_from(read_file_bytes(path), path, num_faces, N_in_file);
+}
+
+MatrixX3d detail::read_field_from(const std::string& bytes, const std::string& path, int num_faces, int* N_in_file) {
   if (N_in_file) *N_in_file = 0;
-  if (ends_with(path, ".ply")) return read_field_ply(path, num_faces);
+  if (ends_with(path, ".ply")) return read_field_ply(bytes, path, num_faces);
   MatrixX3d d(num_faces, 3);
   if (ends_with(path, ".rawfield")) {
-    TextLines lines(path);
+    TextLines lines(bytes, path);
     if (!lines.next()) throw Error(path + ": empty file (expected the header 'N F')");
     const std::vector<double> header = parse_numbers(lines, 2);
+    // Compared as doubles: a header value need not fit an int (converting it first would be undefined).
+    if (!(header[0] >= 1 && header[0] <= kMaxFieldN) || header[0] != std::floor(header[0]))
+      throw Error(lines.where() + ": malformed N in the header");
     const int N = static_cast<int>(header[0]);
-    if (header[0] != N || N < 1 || N > 1000) throw Error(lines.where() + ": malformed N in the header");
-    if (header[1] != num_faces)
-      throw Error(lines.where() + ": the field has " + std::to_string(static_cast<long long>(header[1])) + " faces, the mesh has " +
-                  std::to_string(num_faces));
+    if (header[1] != num_faces) {
+      std::ostringstream claimed;
+      claimed << std::setprecision(15) << header[1];  // integers below 10^15 print as written
+      throw Error(lines.where() + ": the field has " + claimed.str() + " faces, the mesh has " + std::to_string(num_faces));
+    }
     if (N_in_file) *N_in_file = N;
     for (int f = 0; f < num_faces; ++f) {
       if (!lines.next()) throw Error(path + ": truncated after line " + std::to_string(lines.number) + " (face " + std::to_string(f) + ")");
@@ -159,14 +223,10 @@ MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file) {
     if (lines.next()) throw Error(lines.where() + ": more lines than faces");
     return d;
   }
-  // Text: read "# N n" from the comments.
-  {
-    std::istringstream in(read_file_bytes(path));
-    std::string line;
-    while (std::getline(in, line) && !line.empty() && line[0] == '#')
-      if (line.rfind("# N ", 0) == 0 && N_in_file) *N_in_file = std::atoi(line.c_str() + 4);
-  }
-  TextLines lines(path);
+  // Text: "# N n" among the leading comments.
+  const int N = field_text_N(bytes, path);
+  if (N_in_file) *N_in_file = N;
+  TextLines lines(bytes, path);
   for (int f = 0; f < num_faces; ++f) {
     if (!lines.next())
       throw Error(path + ": has " + std::to_string(f) + " directions, the mesh has " + std::to_string(num_faces) + " faces");
@@ -205,13 +265,19 @@ Eigen::VectorXd read_connection(const std::string& path, const Topology& t) {
   };
   Eigen::VectorXd x = Eigen::VectorXd::Zero(t.num_edges);
   std::vector<char> seen(t.num_edges, 0);
-  TextLines lines(path);
+  TextLines lines(read_file_bytes(path), path);
+  const auto as_id = [](double value) {  // -1 unless a vertex id (converting a larger double to int is undefined)
+    return value >= 0 && value <= 2147483647.0 && value == std::floor(value) ? static_cast<int>(value) : -1;
+  };
   while (lines.next()) {
     const std::vector<double> v = parse_numbers(lines, 3);
-    const int i = static_cast<int>(v[0]), j = static_cast<int>(v[1]);
-    const int e = (v[0] == i && v[1] == j && i < j) ? find_edge(i, j) : -1;
-    if (e < 0 || t.is_boundary_edge(e))
-      throw Error(lines.where() + ": (" + std::to_string(i) + ", " + std::to_string(j) + ") is not an interior edge with i < j");
+    const int i = as_id(v[0]), j = as_id(v[1]);
+    const int e = (i >= 0 && j >= 0 && i < j) ? find_edge(i, j) : -1;
+    if (e < 0 || t.is_boundary_edge(e)) {
+      std::ostringstream pair;
+      pair << std::setprecision(17) << "(" << v[0] << ", " << v[1] << ")";
+      throw Error(lines.where() + ": " + pair.str() + " is not an interior edge with i < j");
+    }
     if (seen[e]) throw Error(lines.where() + ": edge (" + std::to_string(i) + ", " + std::to_string(j) + ") is listed twice");
     seen[e] = 1;
     x(e) = v[2];
@@ -260,7 +326,7 @@ void write_matching(const std::string& path, const Topology& t, const Eigen::Vec
 }
 
 Eigen::VectorXi read_matching(const std::string& path, const Topology& t, int N) {
-  TextLines lines(path);
+  TextLines lines(read_file_bytes(path), path);
   auto tokens = [&](size_t expected) {
     std::istringstream fields(lines.line);
     std::vector<std::string> out;

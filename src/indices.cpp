@@ -4,12 +4,15 @@
 #include <numeric>
 #include <sstream>
 
+#include "detail/readers.h"
 #include "trivcon/error.h"
 #include "trivcon/io.h"
 
 namespace trivcon {
 
 namespace {
+
+constexpr long long kMaxIndexPart = 1000000000;  // |p| and q of an index p/q; N of a .sings file
 
 std::string trim(const std::string& s) {
   const size_t a = s.find_first_not_of(" \t\r\n");
@@ -50,7 +53,7 @@ int parse_index(const std::string& text_in, int N, const std::string& where) {
   const bool ok =
       slash == std::string::npos ? parse_long(text, p) : parse_long(text.substr(0, slash), p) && parse_long(text.substr(slash + 1), q);
   if (!ok || q <= 0) throw Error(where + ": malformed index '" + text + "' (expected an integer or a fraction p/q, q > 0)");
-  if (std::llabs(p) > 1000000000LL || q > 1000000000LL) throw Error(where + ": index '" + text + "' is too large");
+  if (p > kMaxIndexPart || p < -kMaxIndexPart || q > kMaxIndexPart) throw Error(where + ": index '" + text + "' is too large");
   // n = p N / q must be an integer.
   if ((p * N) % q != 0)
     throw Error(where + ": index " + text + " is not a multiple of 1/" + std::to_string(N) + " (use -N to change the symmetry)");
@@ -87,8 +90,12 @@ void add_loop_index(const std::string& spec, IndexPrescription& p) {
   insert_once(p.loop, parse_id(id, "boundary loop", where), parse_index(index, p.N, where), "boundary loop", where);
 }
 
-void read_singularities(const std::string& path, IndexPrescription& p) {
-  std::istringstream in(read_file_bytes(path));
+void read_singularities(const std::string& path, IndexPrescription& p) { detail::read_singularities_from(read_file_bytes(path), path, p); }
+
+namespace detail {
+
+void read_singularities_from(const std::string& bytes, const std::string& path, IndexPrescription& p) {
+  std::istringstream in(bytes);
   const bool directional = path.size() >= 6 && path.compare(path.size() - 6, 6, ".sings") == 0;
   std::string line;
   int line_no = 0, file_N = 0;
@@ -105,6 +112,9 @@ void read_singularities(const std::string& path, IndexPrescription& p) {
       long long n, count;
       if (!parse_long(a, n) || !parse_long(b, count) || n < 1 || count < 0)
         throw Error(where + ": expected the header 'N count' of a .sings file");
+      if (n > kMaxIndexPart)
+        throw Error(where + ": N " + a + " in the header is too large (at most " + std::to_string(kMaxIndexPart) + ")");
+      // The count is only compared with the lines read (at the end): nothing is allocated by it.
       file_N = static_cast<int>(n), announced = count;
       continue;
     }
@@ -120,6 +130,8 @@ void read_singularities(const std::string& path, IndexPrescription& p) {
   if (directional && seen != announced)
     throw Error(path + ": the header announces " + std::to_string(announced) + " singularities but the file lists " + std::to_string(seen));
 }
+
+}  // namespace detail
 
 void validate_prescription(const Topology& t, int num_generators, const IndexPrescription& p) {
   if (p.N < 1) throw Error("the symmetry N must be at least 1 (got " + std::to_string(p.N) + ")");

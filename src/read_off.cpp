@@ -48,14 +48,14 @@ MeshData read_off(const std::string& buffer, const std::string& name) {
   // short); it is caught here, before anything is allocated by it. Each count is checked on its own
   // so that a file cut in the faces is reported at the line where it ends.
   const unsigned long long bytes_left = in.bytes_left() + 1;  // the last line may lack its newline
-  const auto check_count = [&](long long count, unsigned long long min_bytes, const char* what) {
+  const auto check_count = [&](long long count, unsigned long long min_bytes, const char* plural, const char* singular) {
     if (static_cast<unsigned long long>(count) > bytes_left / min_bytes) {
-      in.fail("header announces " + std::to_string(count) + " " + what + " but the file has only " + std::to_string(buffer.size()) +
-              " bytes (truncated file?)");
+      in.fail("header claims " + std::to_string(count) + " " + plural + ", but the file has only " + std::to_string(in.bytes_left()) +
+              " bytes after the header (" + singular + " needs at least " + std::to_string(min_bytes) + ")");
     }
   };
-  check_count(vertex_count, 6, "vertices");
-  check_count(face_count, 8, "faces");
+  check_count(vertex_count, 6, "vertices", "a vertex");
+  check_count(face_count, 8, "faces", "a face");
   if (vertex_count > kMaxCount || face_count > kMaxCount) {
     in.fail("too many vertices or faces (" + std::to_string(vertex_count) + ", " + std::to_string(face_count) + ")");
   }

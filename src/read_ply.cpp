@@ -106,8 +106,23 @@ class PlyAsciiSource {
   double read_double(PlyType) { return in_.number(token()); }
   long long read_integer(PlyType) { return in_.integer(token()); }
   void skip(PlyType) { token(); }
-  void skip_list(PlyType, long long count) {
-    for (long long i = 0; i < count; ++i) token();  // ends at the end of the line at the latest
+  // The list's values follow on the element's line; a count beyond them ends there, at the latest.
+  void begin_list(const PlyProperty&, long long count) {
+    list_count_ = count;
+    list_read_ = 0;
+  }
+  long long read_list_integer(const PlyProperty& property) {
+    std::string_view token;
+    if (!in_.next_token(token)) fail_list(property);
+    ++list_read_;
+    return in_.integer(token);
+  }
+  void skip_list(const PlyProperty& property, long long count) {
+    begin_list(property, count);
+    std::string_view token;
+    for (long long i = 0; i < count; ++i, ++list_read_) {
+      if (!in_.next_token(token)) fail_list(property);
+    }
   }
   [[noreturn]] void fail(const std::string& message) const { in_.fail(message); }
   std::string where() const { return element_->name + " " + std::to_string(index_); }
@@ -119,9 +134,14 @@ class PlyAsciiSource {
     return token;
   }
 
+  [[noreturn]] void fail_list(const PlyProperty& property) const {
+    fail(where() + " announces " + std::to_string(list_count_) + " '" + property.name + "' but lists " + std::to_string(list_read_));
+  }
+
   TextScanner& in_;
   const PlyElement* element_ = nullptr;
   unsigned long long index_ = 0;
+  long long list_count_ = 0, list_read_ = 0;
 };
 
 // Reads binary PLY data of either byte order; every read is bounds-checked.
@@ -173,10 +193,22 @@ class PlyBinarySource {
 
   void skip(PlyType type) { skip_bytes(ply_type_size(type)); }
 
-  void skip_list(PlyType type, long long count) {
-    const std::size_t item = ply_type_size(type);
-    if (static_cast<unsigned long long>(count) > (size_ - pos_) / item) truncated();
-    pos_ += static_cast<std::size_t>(count) * item;
+  // A list's items must fit in the rest of the data; checked before any is read, so that a count of
+  // billions is reported at once. The byte named is where the first item that is not there would start.
+  void begin_list(const PlyProperty& property, long long count) {
+    const std::size_t item = ply_type_size(property.type);
+    const std::size_t left = size_ - pos_;
+    if (static_cast<unsigned long long>(count) > left / item) {
+      detail::fail(name_, "truncated binary data at byte " + std::to_string(pos_ + left / item * item) + " (" + element_->name + " " +
+                              std::to_string(index_) + " of " + std::to_string(element_->count) + "; its '" + property.name +
+                              "' list claims " + std::to_string(count) + " items of " + std::to_string(item) + " bytes, but only " +
+                              std::to_string(left) + " bytes follow the count)");
+    }
+  }
+  long long read_list_integer(const PlyProperty& property) { return read_integer(property.type); }
+  void skip_list(const PlyProperty& property, long long count) {
+    begin_list(property, count);
+    pos_ += static_cast<std::size_t>(count) * ply_type_size(property.type);
   }
 
   [[noreturn]] void fail(const std::string& message) const { detail::fail(name_, message + " (at byte " + std::to_string(start_) + ")"); }
@@ -253,12 +285,13 @@ void read_ply_body(Source& source, const std::vector<PlyElement>& elements, cons
           const long long count = source.read_integer(property.count_type);
           if (count < 0) source.fail("negative list length " + std::to_string(count) + " in " + source.where());
           if (!(is_face && p == layout.index_property)) {
-            source.skip_list(property.type, count);
+            source.skip_list(property, count);
             continue;
           }
+          source.begin_list(property, count);
           corners.clear();
           for (long long j = 0; j < count; ++j) {  // bounded by the data: every read is checked
-            const long long index = source.read_integer(property.type);
+            const long long index = source.read_list_integer(property);
             if (index < 0 || index >= vertex_count) {
               source.fail(out_of_range_message(index, vertex_count) + " in " + source.where());
             }
@@ -404,9 +437,14 @@ MeshData read_ply(const std::string& buffer, const std::string& name) {
     }
     if (minimum == 0) fail_at_line(name, element.line, "element '" + element.name + "' has no properties");
     if (element.count > data_bytes / minimum) {
+      const std::string plural = e == layout.vertex_element ? "vertices"
+                                 : e == layout.face_element ? "faces"
+                                                            : "'" + element.name + "' elements";
+      const std::string singular = e == layout.vertex_element ? "a vertex" : e == layout.face_element ? "a face" : "an element";
       fail_at_line(name, element.line,
-                   "header announces " + std::to_string(element.count) + " '" + element.name + "' elements but the file has only " +
-                       std::to_string(buffer.size() - data_offset) + " bytes after the header (truncated file?)");
+                   "header claims " + std::to_string(element.count) + " " + plural + ", but the file has only " +
+                       std::to_string(buffer.size() - data_offset) + " bytes after the header (" + singular + " needs at least " +
+                       std::to_string(minimum) + ")");
     }
   }
   if (vertex_element.count > static_cast<unsigned long long>(kMaxCount) ||

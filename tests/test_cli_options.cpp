@@ -743,13 +743,14 @@ TEST(CliOptions, BinaryPlyErrorsNameTheByte) {
                  p + ": face 1 has a repeated vertex (2, 2, 1) (at byte " + std::to_string(H + 49) + ")");
     // Cut inside face 1 after its count and one index: the next read starts at H + 36 + 13 + 1 + 4.
     expect_error(info(two + vertices(0) + face(0, 1, 2) + face(0, 1, 2).substr(0, 7)),
-                 p + ": truncated binary data at byte " + std::to_string(H + 54) + " (face 1 of 2)");
+                 p + ": truncated binary data at byte " + std::to_string(H + 54) +
+                     " (face 1 of 2; its 'vertex_indices' list claims 3 items of 4 bytes, but only 6 bytes follow the count)");
     expect_error(info(one + vertices(std::nanf("")) + face(0, 1, 2)),
                  p + ": non-finite coordinate in vertex 1 (nan) (at byte " + std::to_string(H + 12) + ")");
     std::string many = one;
     many.replace(many.find("element vertex 3"), 16, "element vertex 1000");
     expect_error(info(many + vertices(0) + face(0, 1, 2)),
-                 p + ":3: header announces 1000 'vertex' elements but the file has only 49 bytes after the header (truncated file?)");
+                 p + ":3: header claims 1000 vertices, but the file has only 49 bytes after the header (a vertex needs at least 12)");
   }
 }
 

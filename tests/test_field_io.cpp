@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -241,6 +242,11 @@ TEST(FieldIo, FieldReaderErrorsNameTheLine) {
   const size_t start = bytes.find("end_header\n") + 11 + 12 * 24, cut = start + 7 * 37 + 5;
   EXPECT_EQ(error("cut.ply", bytes.substr(0, cut)), "FILE: truncated at byte " + std::to_string(start + 7 * 37 + 13) + " (face 7)");
   EXPECT_EQ(error("cut.ply", bytes.substr(0, start + 7 * 37)), "FILE: truncated at byte " + std::to_string(start + 7 * 37) + " (face 7)");
+  // A direction that is not finite is refused, as in the text formats (found by fuzz_field_ply).
+  std::string nan_bytes = bytes;
+  const double not_a_number = std::nan("");
+  std::memcpy(&nan_bytes[start + 3 * 37 + 13 + 8], &not_a_number, 8);  // fy of face 3
+  EXPECT_EQ(error("nan.ply", nan_bytes), "FILE: non-finite direction in face 3 (at byte " + std::to_string(start + 3 * 37 + 13) + ")");
   const std::string missing = temp_file("none.txt");
   EXPECT_EQ(message_of([&] { read_field(missing, 20); }, missing), "cannot open 'FILE': No such file or directory");
 }

@@ -440,9 +440,9 @@ TEST(ReadOff, ReportsErrorsWithFileAndLine) {
   EXPECT_EQ(off_error("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n# the end\n"), "m.off:8: file ends after 1 of 2 faces (truncated?)");
   // Counts that cannot fit in the file are rejected before anything is allocated for them.
   EXPECT_EQ(off_error("OFF\n1000000000000 1 0\n0 0 0\n3 0 0 0\n"),
-            "m.off:2: header announces 1000000000000 vertices but the file has only 36 bytes (truncated file?)");
+            "m.off:2: header claims 1000000000000 vertices, but the file has only 14 bytes after the header (a vertex needs at least 6)");
   EXPECT_EQ(off_error("OFF\n3 2000000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
-            "m.off:2: header announces 2000000000 faces but the file has only 45 bytes (truncated file?)");
+            "m.off:2: header claims 2000000000 faces, but the file has only 26 bytes after the header (a face needs at least 8)");
   EXPECT_EQ(off_error("OFF\n99999999999999999999 1 0\n"), "m.off:2: malformed integer '99999999999999999999'");
   // A bogus corner count is caught by the line running out, not by allocating for it.
   EXPECT_EQ(off_error("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n"), "m.off:6: face 0 announces 2000000000 corners but lists 3");
@@ -599,13 +599,12 @@ TEST(ReadPly, ReportsAsciiDataErrors) {
   EXPECT_EQ(ply_error(header + "0 0 0\n1 0 0\n0 1 0\n2 0 1\n"), "m.ply:13: face 0 has 2 corners (at least 3 needed)");
   EXPECT_EQ(ply_error(header + "0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n"), "m.ply:13: negative list length -3 in face 0");
   EXPECT_EQ(ply_error(header + "0 0 0\n1 0 0\n0 1 0\n1000000000 0 1 2\n"),
-            "m.ply:13: too few values for face 0 (the header lists more properties)");
+            "m.ply:13: face 0 announces 1000000000 'vertex_indices' but lists 3");
   EXPECT_EQ(ply_error(header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2.5\n"), "m.ply:13: malformed integer '2.5'");
   EXPECT_EQ(ply_error(header + "0 0 0\n1 0 0\n0 1 0\n\n\n"), "m.ply:14: file ends after 0 of 1 'face' elements (truncated?)");
   EXPECT_EQ(ply_error("ply\nformat ascii 1.0\nelement vertex 1000000000000\nproperty float x\nproperty float y\nproperty float z\n"
                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n3 0 0 0\n"),
-            "m.ply:3: header announces 1000000000000 'vertex' elements but the file has only 14 bytes after the header "
-            "(truncated file?)");
+            "m.ply:3: header claims 1000000000000 vertices, but the file has only 14 bytes after the header (a vertex needs at least 6)");
 }
 
 TEST(ReadPly, ReportsBinaryDataErrorsWithByteOffsets) {
@@ -616,7 +615,8 @@ TEST(ReadPly, ReportsBinaryDataErrorsWithByteOffsets) {
 
   // Cut inside the face: the first missing byte and the element are named.
   EXPECT_EQ(ply_error(good.substr(0, good.size() - 2)),
-            "m.ply: truncated binary data at byte " + std::to_string(data_start + 72 + 9) + " (face 0 of 1)");
+            "m.ply: truncated binary data at byte " + std::to_string(data_start + 72 + 9) +
+                " (face 0 of 1; its 'vertex_indices' list claims 3 items of 4 bytes, but only 10 bytes follow the count)");
   // Cut inside a vertex whose size the header cannot bound (it has a list).
   spec.extras = true;
   const std::string with_lists = make_binary_ply(spec, kPlyVertices, {{0, 1, 2}});
@@ -645,23 +645,24 @@ TEST(ReadPly, ReportsBinaryDataErrorsWithByteOffsets) {
   const std::int32_t minus_one = -1;
   std::memcpy(&negative[int_count_start + 72], &minus_one, 4);
   EXPECT_EQ(ply_error(negative), "m.ply: negative list length -1 in face 0 (at byte " + std::to_string(int_count_start + 72) + ")");
-  // A list count of four billion runs into the end of the data instead of allocating.
+  // A list count of four billion is compared with the data left instead of allocating.
   spec.count_type = "uint";
   std::string huge_list = make_binary_ply(spec, kPlyVertices, {{0, 1, 2}});
   const std::size_t uint_count_start = huge_list.find("end_header\n") + 11;
   const std::uint32_t four_billion = 4000000000u;
   std::memcpy(&huge_list[uint_count_start + 72], &four_billion, 4);
-  EXPECT_EQ(ply_error(huge_list), "m.ply: truncated binary data at byte " + std::to_string(huge_list.size()) + " (face 0 of 1)");
+  EXPECT_EQ(ply_error(huge_list), "m.ply: truncated binary data at byte " + std::to_string(huge_list.size()) +
+                                      " (face 0 of 1; its 'vertex_indices' list claims 4000000000 items of 4 bytes, but only 12 bytes "
+                                      "follow the count)");
 
   // Counts beyond what the data can hold are rejected before anything is allocated.
   std::string huge = good;
   huge.replace(huge.find("element vertex 6"), 16, "element vertex 1000000000000");
   EXPECT_EQ(ply_error(huge),
-            "m.ply:4: header announces 1000000000000 'vertex' elements but the file has only 85 bytes after "
-            "the header (truncated file?)");
+            "m.ply:4: header claims 1000000000000 vertices, but the file has only 85 bytes after the header (a vertex needs at least 12)");
   huge = good;
   huge.replace(huge.find("element face 1"), 14, "element face 4000000000");
-  EXPECT_THAT(ply_error(huge), HasSubstr("m.ply:8: header announces 4000000000 'face' elements"));
+  EXPECT_THAT(ply_error(huge), HasSubstr("m.ply:8: header claims 4000000000 faces, but the file has only 85 bytes"));
 }
 
 // ------------------------------------------------------------------------------------------------
