@@ -2,6 +2,8 @@
 #include <algorithm>
 #include <iomanip>
 #include <iostream>
+#include <memory>
+#include <numeric>
 #include <map>
 #include <sstream>
 
@@ -15,6 +17,7 @@
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
+#include "trivcon/generate.h"
 #include "trivcon/matching.h"
 #include "trivcon/field_io.h"
 
@@ -37,7 +40,11 @@ struct SolveOptions {
   OutputPaths out;
   bool quiet = false;
   double tolerance = kDefaultTolerance;  // --tolerance
+  bool split_large_turns = false;        // --split-large-turns
 };
+
+// Rounds of --split-large-turns before it gives up (each splits every edge still turning by π/N or more).
+constexpr int kMaxSplitRounds = 8;
 
 // --fix takes "F:x,y,z" / "F:angle=A" specs and files; a spec starts with a face id and a colon.
 bool is_fix_spec(const std::string& s) {
@@ -185,9 +192,76 @@ void run_solve(const SolveOptions& o) {
     if (!o.quiet) std::cout << "sing-from-field: " << o.sing_from_field << " has " << prescription.vertex.size() << " singularities\n";
   }
 
+  // --split-large-turns: split the edges turning by π/N or more (and the faces beside them), re-solve with
+  // the same singularities on the refined mesh, until none is left or the rounds run out.
+  std::unique_ptr<FieldDesigner> refined_designer;
+  MeshData refined_mesh;
+  if (o.split_large_turns) {
+    if (!batch.empty()) throw Error("--split-large-turns refines the mesh for one prescription: not with --sing-batch");
+    if (!prescription.generator.empty() || !prescription.loop.empty())
+      throw Error(
+          "--split-large-turns makes new generators and boundary loops: leave their indices to be chosen (no --generator, --boundary)");
+    std::map<int, Eigen::Vector3d> fixed_world;  // --fix directions in world space, per input face
+    for (auto [f, angle] : explicit_fixed) fixed_world[f] = designer.geometry().direction_in_face(f, angle);
+    const FieldDesigner* current = &designer;
+    MeshData current_mesh = mesh;
+    std::vector<int> parent(mesh.F.rows());  // input face of every current face
+    std::iota(parent.begin(), parent.end(), 0);
+    IndexPrescription p = prescription;
+    nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
+    bool converged = false;
+    for (int round = 0;; ++round) {
+      const Design d = current->design(p, roots);
+      const std::vector<int> large = large_turn_edges(current->topology(), d.connection.x, p.N);
+      if (large.empty()) {
+        converged = true;
+        break;
+      }
+      if (round == kMaxSplitRounds) break;
+      // The faces beside each such edge are split at their centroids: every corner gains an edge, so the
+      // turning around the edge's ends spreads over more edges.
+      std::vector<int> beside;
+      for (int e : large) beside.push_back(current->topology().edge_faces(e, 0)), beside.push_back(current->topology().edge_faces(e, 1));
+      std::vector<int> step_parent;
+      const Mesh next = split_faces_at_centroids(current_mesh, beside, &step_parent);
+      std::vector<int> composed(step_parent.size());
+      for (size_t f = 0; f < step_parent.size(); ++f) composed[f] = parent[step_parent[f]];
+      parent.swap(composed);
+      std::vector<int> polygon(parent.size());
+      for (size_t f = 0; f < parent.size(); ++f)
+        polygon[f] = mesh.polygon_of_triangle.empty() ? parent[f] : mesh.polygon_of_triangle[parent[f]];
+      current_mesh.V = next.V, current_mesh.F = next.F, current_mesh.polygon_of_triangle = polygon;
+      refined_designer = std::make_unique<FieldDesigner>(current_mesh.V, current_mesh.F, options);
+      current = refined_designer.get();
+      p.fixed.clear();
+      if (o.align_boundary) p.fixed = boundary_alignment(current->V(), current->topology(), current->geometry());
+      for (int f = 0; f < static_cast<int>(parent.size()); ++f) {
+        const auto it = fixed_world.find(parent[f]);
+        if (it != fixed_world.end()) p.fixed[f] = current->geometry().angle_in_face(f, it->second);
+      }
+      std::vector<int> faces;
+      for (auto [f, angle] : p.fixed) faces.push_back(f);
+      refined_designer->set_fixed_faces(faces);
+      rounds.push_back({{"split_edges", large.size()}, {"vertices", current_mesh.V.rows()}, {"faces", current_mesh.F.rows()}});
+      if (!o.quiet)
+        std::cout << "split-large-turns: round " << round + 1 << " split " << large.size()
+                  << " edges turning by pi/N or more: " << current_mesh.V.rows() << " vertices, " << current_mesh.F.rows() << " faces\n";
+    }
+    extra["split_large_turns"] = {{"rounds", rounds}, {"converged", converged}, {"max_rounds", kMaxSplitRounds}};
+    if (!converged)
+      std::cerr << "trivcon: warning: --split-large-turns stopped after " << kMaxSplitRounds
+                << " rounds with edges still turning by pi/N or more (see large_turns in the report)\n";
+    if (refined_designer) {
+      refined_mesh = std::move(current_mesh);
+      prescription = p;
+    }
+  }
+  const MeshData& out_mesh = refined_designer ? refined_mesh : mesh;
+  FieldDesigner& out_designer = refined_designer ? *refined_designer : designer;
+
   bool ok = true;
   if (batch.empty()) {
-    ok = solve_one(o, mesh, designer, prescription, roots, "", read_seconds, extra);
+    ok = solve_one(o, out_mesh, out_designer, prescription, roots, "", read_seconds, extra);
   } else {
     for (BatchItem& item : batch) {  // check every item before writing anything
       item.prescription.fixed = prescription.fixed;
@@ -240,6 +314,12 @@ void register_solve(CLI::App& app) {
   cmd->add_option("--field-out", o.out.field, "Field file: .txt (x y z per face), .rawfield (Directional) or .ply");
   cmd->add_option("--connection-out", o.out.connection, "Connection file: 'i j x' per interior edge");
   cmd->add_option("--lines-out", o.out.lines, "OBJ with a short segment per face and direction");
+  cmd->add_flag("--split-large-turns", o.split_large_turns,
+                "Refine the mesh where the connection turns by pi/N or more (split those edges and their faces; input ids kept, new "
+                "vertices and faces appended) and solve again, until no edge does, so that any tool's own matching reads exactly the "
+                "prescribed singularities; write the refined mesh with --mesh-out");
+  cmd->add_option("--mesh-out", o.out.mesh,
+                  "The mesh the field belongs to (.ply binary, else .obj): with --split-large-turns the refined one");
   cmd->add_option("--matching-out", o.out.matching,
                   "Matching file (Directional's .matching: 'N E', then 'L R i j m' per interior edge): the 2pi/N steps our connection "
                   "pairs the faces' directions with, so that tools read exactly the prescribed singularities");

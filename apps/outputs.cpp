@@ -61,6 +61,15 @@ void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const
   if (!paths.connection.empty())
     staged.write(output_path(paths.connection, name),
                  [&](const std::string& path) { write_connection(path, designer.topology(), d.connection.x, prescription.N); });
+  if (!paths.mesh.empty())
+    staged.write(output_path(paths.mesh, name), [&](const std::string& path) {
+      const std::string& final_path = paths.mesh;
+      const bool ply = final_path.size() >= 4 && final_path.compare(final_path.size() - 4, 4, ".ply") == 0;
+      if (ply)
+        write_ply(path, mesh.V, mesh.F);
+      else
+        write_obj(path, mesh.V, mesh.F);
+    });
   if (!paths.matching.empty())
     staged.write(output_path(paths.matching, name), [&](const std::string& path) {
       write_matching(path, designer.topology(), connection_matching(designer.topology(), g, d.field, d.connection.x), prescription.N);

@@ -15,6 +15,7 @@ namespace trivcon::cli {
 // The output paths given on the command line; an empty one is not written.
 struct OutputPaths {
   std::string field, connection, lines, report, png, singularities, matching;  // singularities: --sing-out, matching: --matching-out
+  std::string mesh;                                                            // --mesh-out: the mesh the field belongs to (.ply or .obj)
 };
 
 // Output paths for one prescription of a batch: "{name}" in a path is replaced by the item's name;

@@ -21,15 +21,24 @@ std::vector<FixedPath> fixed_face_paths(const Topology& t, const std::vector<int
     region[fixed[i]] = static_cast<int>(i);
     queue.push_back(fixed[i]);
   }
-  for (size_t q = 0; q < queue.size(); ++q) {  // multi-source breadth-first growth
-    const int f = queue[q];
-    for (int k = 0; k < 3; ++k) {
-      const int e = t.face_edges(f, k);
-      if (t.is_boundary_edge(e) || !usable[e]) continue;
-      const int g = t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
-      if (region[g] >= 0) continue;
-      region[g] = region[f], parent_edge[g] = e, parent_face[g] = f, depth[g] = depth[f] + 1;
-      queue.push_back(g);
+  // Multi-source breadth-first growth through usable edges; then, from everything reached, through the
+  // unusable ones too, so that faces walled in by zero weights (and the fixed faces among them) still get a
+  // region, and every fixed face of a component is linked to the others (a face cut off by zero weights
+  // was left without a path before, and its direction was not held).
+  for (int phase = 0; phase < 2; ++phase) {
+    const size_t start = queue.size();
+    if (phase == 1)
+      for (size_t q = 0; q < start; ++q) queue.push_back(queue[q]);
+    for (size_t q = phase == 0 ? 0 : start; q < queue.size(); ++q) {
+      const int f = queue[q];
+      for (int k = 0; k < 3; ++k) {
+        const int e = t.face_edges(f, k);
+        if (t.is_boundary_edge(e) || (phase == 0 && !usable[e])) continue;
+        const int g = t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
+        if (region[g] >= 0) continue;
+        region[g] = region[f], parent_edge[g] = e, parent_face[g] = f, depth[g] = depth[f] + 1;
+        queue.push_back(g);
+      }
     }
   }
   // Links between regions: interior edges whose faces lie in different regions, shortest first.

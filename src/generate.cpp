@@ -619,4 +619,37 @@ Mesh split_edges_near_end(const Mesh& mesh, double t, double lift, std::vector<i
   return out;
 }
 
+Mesh split_faces_at_centroids(const Mesh& mesh, const std::vector<int>& faces, std::vector<int>* parent_face) {
+  require_valid_faces("split_faces_at_centroids", mesh);
+  const Eigen::Index num_vertices = mesh.V.rows(), num_faces = mesh.F.rows();
+  std::vector<int> list = faces;
+  std::sort(list.begin(), list.end());
+  list.erase(std::unique(list.begin(), list.end()), list.end());
+  for (int f : list)
+    if (f < 0 || f >= num_faces)
+      throw Error("split_faces_at_centroids: face " + std::to_string(f) + " out of range (mesh has " + std::to_string(num_faces) +
+                  " faces)");
+  require_size("split_faces_at_centroids", double(num_vertices) + list.size(), double(num_faces) + 2.0 * list.size());
+  const Eigen::Index added = static_cast<Eigen::Index>(list.size());
+  Mesh out;
+  out.V.resize(num_vertices + added, 3);
+  out.V.topRows(num_vertices) = mesh.V;
+  out.F.resize(num_faces + 2 * added, 3);
+  out.F.topRows(num_faces) = mesh.F;
+  for (Eigen::Index k = 0; k < added; ++k) {
+    const int f = list[k], a = mesh.F(f, 0), b = mesh.F(f, 1), c = mesh.F(f, 2);
+    const int g = static_cast<int>(num_vertices + k);
+    out.V.row(g) = (mesh.V.row(a) + mesh.V.row(b) + mesh.V.row(c)) / 3.0;
+    out.F.row(f) << a, b, g;
+    out.F.row(num_faces + 2 * k) << b, c, g;
+    out.F.row(num_faces + 2 * k + 1) << c, a, g;
+  }
+  if (parent_face) {
+    parent_face->resize(out.F.rows());
+    std::iota(parent_face->begin(), parent_face->begin() + num_faces, 0);
+    for (Eigen::Index k = 0; k < added; ++k) (*parent_face)[num_faces + 2 * k] = (*parent_face)[num_faces + 2 * k + 1] = list[k];
+  }
+  return out;
+}
+
 }  // namespace trivcon

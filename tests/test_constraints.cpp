@@ -264,3 +264,26 @@ TEST(Constraints, ManyFixedFacesSparseRoute) {
     EXPECT_EQ(a.indices.loop, (std::vector<int>{0, 0}));
   }
 }
+
+// Fixed faces walled in by zero-weight edges (here: every edge unusable) are still joined to the others:
+// one path per fixed face beyond the first of each component, so every direction is held. Before, the
+// regions grew through usable edges only, and a fixed face whose neighbours no region reached was left out.
+TEST(Constraints, FixedFacesBehindZeroWeightsAreStillJoined) {
+  const Mesh m = make_icosphere(2);
+  const Topology t = test::topo(m);
+  const std::vector<int> fixed = {0, 57, 123, 200};
+  const std::vector<char> none(t.num_edges, 0);
+  const std::vector<FixedPath> paths = fixed_face_paths(t, fixed, none);
+  ASSERT_EQ(paths.size(), fixed.size() - 1);
+  // The paths span the fixed faces (a tree: each joins two of them, and together they connect all).
+  std::vector<int> group = {0, 1, 2, 3};
+  auto id = [&](int f) { return static_cast<int>(std::find(fixed.begin(), fixed.end(), f) - fixed.begin()); };
+  for (const FixedPath& p : paths) {
+    const int a = group[id(p.from_face)], b = group[id(p.to_face)];
+    EXPECT_NE(a, b);
+    for (int& g : group)
+      if (g == b) g = a;
+    EXPECT_FALSE(p.path.edges.empty());
+  }
+  EXPECT_TRUE(std::all_of(group.begin(), group.end(), [&](int g) { return g == group[0]; }));
+}

@@ -11,6 +11,7 @@
 #include "support.h"
 #include "trivcon/error.h"
 #include "trivcon/field_io.h"
+#include "trivcon/io.h"
 #include "trivcon/matching.h"
 
 namespace trivcon {
@@ -224,6 +225,86 @@ TEST(Matching, ReaderNamesTheProblem) {
   EXPECT_EQ(error_of([&] { read_matching(path, t, 4); }), path + ":1: the file lists 29 edges, the mesh has 30 interior edges");
   test::write_text(path, "4 1000000000000\n");
   EXPECT_EQ(error_of([&] { read_matching(path, t, 4); }), path + ":1: the edge count '1000000000000' is not a whole number in [0, 30]");
+}
+
+TEST(Matching, CentroidSplitKeepsIdsSurfaceAndOrientation) {
+  const Mesh m = make_icosphere(1);
+  std::vector<int> parent;
+  const Mesh s = split_faces_at_centroids(m, {5, 3, 5}, &parent);
+  ASSERT_EQ(s.V.rows(), m.V.rows() + 2);
+  ASSERT_EQ(s.F.rows(), m.F.rows() + 4);
+  EXPECT_TRUE(s.V.topRows(m.V.rows()) == m.V) << "input vertices keep their ids and positions";
+  for (int f = 0; f < m.F.rows(); ++f)
+    if (f != 3 && f != 5) {
+      EXPECT_TRUE(s.F.row(f) == m.F.row(f)) << "face " << f;
+    }
+  // Face 3 (the smaller id) got the first centroid: (a, b, g) in place, then (b, c, g), (c, a, g).
+  const int g = static_cast<int>(m.V.rows());
+  EXPECT_EQ(s.F.row(3), Eigen::RowVector3i(m.F(3, 0), m.F(3, 1), g));
+  EXPECT_EQ(s.F.row(m.F.rows()), Eigen::RowVector3i(m.F(3, 1), m.F(3, 2), g));
+  EXPECT_EQ(s.F.row(m.F.rows() + 1), Eigen::RowVector3i(m.F(3, 2), m.F(3, 0), g));
+  EXPECT_LE((Eigen::Vector3d(s.V.row(g)) - (m.V.row(m.F(3, 0)) + m.V.row(m.F(3, 1)) + m.V.row(m.F(3, 2))).transpose() / 3).norm(), 1e-15);
+  EXPECT_EQ(parent[m.F.rows()], 3);
+  EXPECT_EQ(parent[m.F.rows() + 3], 5);
+  // Same total area, same orientation (every child's normal agrees with its parent's).
+  auto area = [](const Mesh& mesh, int f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    return (b - a).cross(c - a);
+  };
+  Eigen::Vector3d total_in = Eigen::Vector3d::Zero(), total_out = Eigen::Vector3d::Zero();
+  for (int f = 0; f < m.F.rows(); ++f) total_in += area(m, f);
+  for (int f = 0; f < s.F.rows(); ++f) {
+    total_out += area(s, f);
+    EXPECT_GT(area(s, f).dot(area(m, parent[f])), 0) << "face " << f;
+  }
+  EXPECT_LE((total_in - total_out).norm(), 1e-12);
+  EXPECT_EQ(error_of([&] { split_faces_at_centroids(m, {80}); }), "split_faces_at_centroids: face 80 out of range (mesh has 80 faces)");
+}
+
+// --split-large-turns: refined where the connection turns by π/N or more, the field on --mesh-out read by an
+// independent principal matching has exactly the prescribed singularities at their vertex ids, and nothing else.
+TEST(Matching, SplitLargeTurnsLetsAnyMatchingReadThePrescription) {
+  const LargeTurnCase c;
+  const std::string dir = test::temp_dir("matching_split");
+  const std::string mesh = save(dir, "ico", c.mesh), field = dir + "/f.txt", refined = dir + "/refined.obj", report = dir + "/r.json";
+  const std::string sing = " --sing 0:3/2 --sing 1:1/4 --sing 2:1/4";
+  const test::CommandResult r = run_cli("solve " + q(mesh) + " -N 4" + sing + " --split-large-turns --field-out " + q(field) +
+                                        " --mesh-out " + q(refined) + " --report " + q(report));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "") << "no edge turns by pi/N or more any more, so no warning";
+  EXPECT_TRUE(contains(r.out, "split-large-turns: round 1 split ")) << r.out;
+  const MeshData out = read_mesh(refined);
+  ASSERT_GT(out.F.rows(), c.mesh.F.rows());
+  EXPECT_TRUE(out.V.topRows(c.mesh.V.rows()).isApprox(c.mesh.V, 1e-15)) << "input vertices keep their ids";
+  const MatrixX3d dirs = read_field(field, static_cast<int>(out.F.rows()));
+  EXPECT_EQ(independent_indices(out.V, out.F, dirs, 4, nullptr), c.p.vertex);
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
+  EXPECT_TRUE(j["split_large_turns"]["converged"].get<bool>());
+  EXPECT_TRUE(j["large_turns"]["edges"].empty());
+  EXPECT_EQ(j["mesh"]["faces"].get<int>(), out.F.rows());
+  // Not with prescribed generator or loop indices (the refined mesh has cycles of its own), nor a batch.
+  const test::CommandResult g = run_cli("solve " + q(mesh) + " -N 4" + sing + " --split-large-turns --boundary 0:1");
+  EXPECT_EQ(g.status, 1);
+  EXPECT_TRUE(contains(g.err, "--split-large-turns makes new generators and boundary loops: leave their indices to be chosen")) << g.err;
+}
+
+TEST(Matching, SplitLargeTurnsKeepsFixedDirections) {
+  // A coarse disk with the boundary aligned, a face fixed, and a large index at its centre: the refined mesh
+  // is aligned and fixed too.
+  const Mesh m = make_disk(6, 6);
+  const std::string dir = test::temp_dir("matching_split_fixed");
+  const std::string mesh = save(dir, "disk", m), field = dir + "/f.txt", refined = dir + "/refined.ply";
+  const test::CommandResult r =
+      run_cli("solve " + q(mesh) + " -N 4 --sing 0:-1 --align-boundary --fix 40:1,0,0 --split-large-turns -q --field-out " + q(field) +
+              " --mesh-out " + q(refined));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const MeshData out = read_mesh(refined);
+  const MatrixX3d dirs = read_field(field, static_cast<int>(out.F.rows()));
+  // Face 40 keeps the --fix direction (1, 0, 0) modulo a quarter turn.
+  const double a = std::atan2(dirs(40, 1), dirs(40, 0));
+  EXPECT_LE(std::abs(std::remainder(a, kPi / 2)), 1e-9);
+  std::map<int, int> want = {{0, -4}};
+  EXPECT_EQ(independent_indices(out.V, out.F, dirs, 4, nullptr), want);
 }
 
 }  // namespace

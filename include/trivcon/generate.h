@@ -9,6 +9,7 @@
 // "make_uv_sphere: invalid rings = 1 (need rings >= 2)"; parameters that would give more than
 // about 5·10^8 vertices or faces throw as well.
 #pragma once
+#include <utility>
 #include <vector>
 
 #include "trivcon/common.h"
@@ -72,6 +73,12 @@ Mesh subdivide_midpoint(const Mesh& mesh);
 // index, and (m, b, c), appended; `parent_face[f]` (when not null) is the input face each output face
 // lies in. Throws like the generators above for t outside [0, 1) or invalid faces.
 Mesh split_edges_near_end(const Mesh& mesh, double t, double lift = 0, std::vector<int>* parent_face = nullptr);
+// Splits each given face (a, b, c) at its centroid g into (a, b, g), keeping its index, and (b, c, g),
+// (c, a, g), appended in that order, face after face in increasing id (duplicates ignored); the centroid
+// of the k-th face is vertex V + k. The surface is kept exactly, orientation too, and every corner of a
+// split face gains an edge (solve --split-large-turns: the turning around a vertex is spread over more
+// edges). `parent_face` as above. Throws naming a face id out of range.
+Mesh split_faces_at_centroids(const Mesh& mesh, const std::vector<int>& faces, std::vector<int>* parent_face = nullptr);
 // Random permutation of vertex ids and of face order (faces keep their orientation, corners
 // rotate cyclically by a random amount); deterministic for a seed on every platform (draws come
 // straight from std::mt19937). `vertex_perm[old] = new`, `face_perm[old] = new` when not null.
