@@ -2,15 +2,20 @@
 # Installs the Debian 12 packages trivcon builds and tests with (as root; uses sudo otherwise).
 # Shared by scripts/demo.sh, scripts/test.sh and scripts/bench.sh.
 #   scripts/deps.sh            the C++ build (library, program, tests, benchmark)
+#   scripts/deps.sh --fuzz     also clang's libFuzzer and sanitizer runtimes (scripts/fuzz.sh)
 #   scripts/deps.sh --python   also the Python module's: pybind11, numpy, pytest, Dask (distributed), pip, venv,
 #                              setuptools and wheel, all from Debian (scripts/python.sh; no other package index)
 set -euo pipefail
 packages=(build-essential cmake pkg-config zlib1g-dev libeigen3-dev libsuitesparse-dev libopenblas-dev libmetis-dev
           libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libstb-dev)
-if [ "${1:-}" = "--python" ]; then
-  packages+=(python3 python3-dev python3-venv python3-pip python3-setuptools python3-wheel python3-numpy pybind11-dev
-             python3-pybind11 python3-pytest python3-distributed)
-fi
+for extra in "$@"; do
+  case "$extra" in
+    --python) packages+=(python3 python3-dev python3-venv python3-pip python3-setuptools python3-wheel python3-numpy pybind11-dev
+                         python3-pybind11 python3-pytest python3-distributed) ;;
+    --fuzz) packages+=(clang libclang-rt-14-dev libomp-14-dev) ;;  # libFuzzer, its sanitizer runtimes, OpenMP for clang
+    *) echo "deps.sh: unknown option $extra (known: --python, --fuzz)" >&2; exit 2 ;;
+  esac
+done
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

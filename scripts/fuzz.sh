@@ -22,20 +22,7 @@ fi
 seconds=$1
 shift
 
-bash scripts/deps.sh
-fuzz_packages=(clang libclang-rt-14-dev libomp-14-dev)
-missing=()
-for p in "${fuzz_packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "== installing: ${missing[*]}"
-  SUDO=""
-  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+bash scripts/deps.sh --fuzz
 
 build=${FUZZ_BUILD_DIR:-build-fuzz}
 launcher=()

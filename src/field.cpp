@@ -129,6 +129,10 @@ FieldIndices field_indices(const Topology& t, const Geometry& g, const Cycles& c
     if (t.is_boundary_edge(e)) continue;
     d(e) = reduce_angle(field.angle(t.edge_faces(e, 1)) - field.angle(t.edge_faces(e, 0)) - g.rho(e), N);
   }
+  return indices_from_jumps(t, g, cycles, d, N);
+}
+
+FieldIndices indices_from_jumps(const Topology& t, const Geometry& g, const Cycles& cycles, const Eigen::VectorXd& d, int N) {
   FieldIndices out;
   auto to_n = [&](double raw_turns) {
     const double scaled = raw_turns * N;

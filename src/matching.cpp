@@ -47,21 +47,7 @@ FieldIndices indices_with_matching(const Topology& t, const Geometry& g, const C
     if (t.is_boundary_edge(e)) continue;
     d(e) = wrap_pi(field.angle(t.edge_faces(e, 1)) + 2 * kPi * modulo(matching(e), N) / N - field.angle(t.edge_faces(e, 0)) - g.rho(e));
   }
-  FieldIndices out;
-  auto to_n = [&](double raw_turns) {
-    const double scaled = raw_turns * N, rounded = std::round(scaled);
-    out.max_rounding = std::max(out.max_rounding, std::abs(scaled - rounded));
-    return static_cast<int>(rounded);
-  };
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(t.num_vertices);
-  for (int e = 0; e < t.num_edges; ++e) sum(t.edge_vertices(e, 1)) += d(e), sum(t.edge_vertices(e, 0)) -= d(e);
-  out.vertex.assign(t.num_vertices, 0);
-  for (int v = 0; v < t.num_vertices; ++v)
-    if (t.is_interior_vertex(v)) out.vertex[v] = to_n((g.angle_defect(v) + sum(v)) / (2 * kPi));
-  for (size_t l = 0; l < cycles.loops.size(); ++l)
-    out.loop.push_back(to_n((loop_curvature(t, g, static_cast<int>(l)) + cycle_sum(cycles.loops[l], d)) / (2 * kPi)));
-  for (const DualCycle& c : cycles.generators) out.generator.push_back(to_n((levi_civita_holonomy(c, g) + cycle_sum(c, d)) / (2 * kPi)));
-  return out;
+  return indices_from_jumps(t, g, cycles, d, N);
 }
 
 std::vector<int> large_turn_edges(const Topology& t, const Eigen::VectorXd& x, int N) {

@@ -59,6 +59,11 @@ struct FieldIndices {
   double max_rounding = 0;     // largest distance of a raw index·N from an integer (a consistency check)
 };
 FieldIndices field_indices(const Topology& topology, const Geometry& geometry, const Cycles& cycles, const Field& field);
+// The indices given the field's jump d_e relative to parallel transport on every interior edge (0 on
+// boundary edges): what field_indices does after choosing the closest matching, and indices_with_matching
+// (trivcon/matching.h) after applying a given one.
+FieldIndices indices_from_jumps(const Topology& topology, const Geometry& geometry, const Cycles& cycles, const Eigen::VectorXd& jumps,
+                                int N);
 
 // Largest |β_R − β_L − (ρ_e − x_e)| over interior edges, reduced modulo 2π/N: 0 when the field is
 // exactly the one the connection x transports.
