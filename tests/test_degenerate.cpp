@@ -120,9 +120,9 @@ TEST_P(SplitMesh, ExactAndAgreesWithTheCleanMesh) {
       split_designer.geometry().mollified_faces, residual, c.energy, d0.connection.energy, agree.median, agree.max, d1.large_turn_edges,
       c.refinements);
   EXPECT_LE(residual, 1e-9 * std::max(1.0, c.rhs_scale));
-  // Iterative refinement brings every solve to within 1e-11 (relative), where one substitution left up to
-  // 6e-10 on these meshes.
-  EXPECT_LE(residual, 1e-11 * std::max(1.0, c.rhs_scale));
+  // Iterative refinement brings every solve within 2.5e-10 (relative; a quarter of the verification limit,
+  // where it starts), where one substitution left up to 6e-10 on these meshes.
+  EXPECT_LE(residual, 2.5e-10 * std::max(1.0, c.rhs_scale));
   EXPECT_LE(d1.transport_mismatch, 1e-9 * std::max(1.0, c.rhs_scale));
   EXPECT_TRUE(d1.unexplained_mismatch_vertices.empty());
   EXPECT_EQ(split_designer.solver().regularized_edges(), 0);

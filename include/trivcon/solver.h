@@ -24,7 +24,7 @@
 // prescription only changes b: nothing is refactored. The forward substitution of the prescription without singularities is stored, so an
 // edit that places a few singularities updates it along their paths in the elimination tree only, then does one full backward substitution,
 // on OpenMP's threads (the top of the elimination tree first, then one set of independent subtrees per thread).
-// Every solve is verified (Connection's residuals); when the largest residual exceeds 1e-11 × max(1, rhs_scale),
+// Every solve is verified (Connection's residuals); when the largest residual exceeds 2.5e-10 × max(1, rhs_scale),
 // up to 3 steps of iterative refinement with the same factor follow (x += W Aᵀ (A W Aᵀ)⁻¹ (b − A x)), each kept
 // only if it lowers the residual (Connection::refinements): one substitution is not enough where the weights
 // span many orders of magnitude.
