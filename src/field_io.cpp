@@ -29,6 +29,16 @@ Eigen::Vector3d direction_k(const Geometry& g, const Field& field, int f, int k)
   return g.direction_in_face(f, field.angle(f) + 2 * kPi * k / field.N);
 }
 
+// The edge joining vertices i and j (either order), or −1: one scan of i's edges.
+int edge_between(const Topology& t, int i, int j) {
+  if (i < 0 || i >= t.num_vertices) return -1;
+  for (int a = t.vertex_edge_offsets[i]; a < t.vertex_edge_offsets[i + 1]; ++a) {
+    const int e = t.vertex_edges[a];
+    if (t.edge_vertices(e, 0) == std::min(i, j) && t.edge_vertices(e, 1) == std::max(i, j)) return e;
+  }
+  return -1;
+}
+
 void put_double(std::ostream& out, double v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); }
 
 // Lines of a text file with their 1-based numbers, comments and blank lines skipped.
@@ -255,14 +265,7 @@ void write_connection(const std::string& path, const Topology& t, const Eigen::V
 
 Eigen::VectorXd read_connection(const std::string& path, const Topology& t) {
   // Edge lookup by (i, j) through the CSR vertex → edges adjacency.
-  auto find_edge = [&](int i, int j) {
-    if (i < 0 || i >= t.num_vertices) return -1;
-    for (int a = t.vertex_edge_offsets[i]; a < t.vertex_edge_offsets[i + 1]; ++a) {
-      const int e = t.vertex_edges[a];
-      if (t.edge_vertices(e, 0) == std::min(i, j) && t.edge_vertices(e, 1) == std::max(i, j)) return e;
-    }
-    return -1;
-  };
+  auto find_edge = [&](int i, int j) { return edge_between(t, i, j); };
   Eigen::VectorXd x = Eigen::VectorXd::Zero(t.num_edges);
   std::vector<char> seen(t.num_edges, 0);
   TextLines lines(read_file_bytes(path), path);
@@ -356,11 +359,7 @@ Eigen::VectorXi read_matching(const std::string& path, const Topology& t, int N)
     const int i = static_cast<int>(whole_number(v[2], lines, 0, t.num_vertices - 1, "vertex"));
     const int j = static_cast<int>(whole_number(v[3], lines, 0, t.num_vertices - 1, "vertex"));
     const long long value = whole_number(v[4], lines, -(1LL << 40), 1LL << 40, "matching");
-    int edge = -1;
-    for (int q = t.vertex_edge_offsets[std::min(i, j)]; q < t.vertex_edge_offsets[std::min(i, j) + 1] && edge < 0; ++q) {
-      const int e = t.vertex_edges[q];
-      if (t.edge_vertices(e, 0) == std::min(i, j) && t.edge_vertices(e, 1) == std::max(i, j)) edge = e;
-    }
+    const int edge = edge_between(t, i, j);
     if (edge < 0 || t.is_boundary_edge(edge))
       throw Error(lines.where() + ": (" + std::to_string(i) + ", " + std::to_string(j) + ") is not an interior edge of the mesh");
     const int L = t.edge_faces(edge, 0), R = t.edge_faces(edge, 1);

@@ -5,6 +5,8 @@
 // ASan + UBSan too). New files in those folders are picked up without rebuilding.
 #include <gtest/gtest.h>
 
+#include "support.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -38,18 +40,11 @@ std::vector<fs::path> files_in(const fs::path& dir) {
   return files;
 }
 
-std::string bytes_of(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
-}
-
 // Runs the target on the file: "" when it read or threw trivcon::Error ("error" in *threw), else what went wrong.
 std::string replay(trivcon::fuzz::Target target, const fs::path& file, bool* threw) {
   *threw = false;
   try {
-    target(bytes_of(file));
+    target(trivcon::test::slurp(file.string()));
     return "";
   } catch (const trivcon::Error&) {
     *threw = true;
