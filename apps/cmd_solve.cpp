@@ -172,6 +172,7 @@ void run_solve(const SolveOptions& o) {
     const AutoTimings& s = r.seconds;
     extra["auto"] = {
         {"found", r.found.size()},
+        {"coincident_removed", r.coincident_removed},
         {"cancelled_pairs", r.pairs.size()},
         {"used", r.vertex.size()},
         {"cancel_distance", o.auto_cancel},
@@ -179,8 +180,8 @@ void run_solve(const SolveOptions& o) {
         {"seconds",
          {{"assemble", s.assemble}, {"factor", s.factor}, {"iterate", s.iterate}, {"indices", s.indices}, {"cancel", s.cancel}}}};
     if (!o.quiet)
-      std::cout << "auto: smoothest field found " << r.found.size() << " singularities, cancelled " << r.pairs.size() << " pairs, using "
-                << r.vertex.size() << "\n";
+      std::cout << "auto: smoothest field found " << r.found.size() << " singularities, " << r.coincident_removed
+                << " removed by summing over coincident vertices, cancelled " << r.pairs.size() << " pairs, using " << r.vertex.size() << "\n";
   }
   if (!o.sing_from_field.empty()) {
     const MatrixX3d directions = o.prescription.read_field_file(o.sing_from_field, designer.topology().num_faces, prescription.N);

@@ -39,11 +39,11 @@ Weights face_weights(const MatrixX3d& V, const Topology& t, const Geometry& g) {
   if (!(total > 0) || !std::isfinite(total))
     throw Error("automatic singularities: every face of the mesh has zero area, so no field can be measured on it");
   const double floor = 1e-12 * total / t.num_faces;
-  k.mass = g.face_area.cwiseMax(floor);
+  k.mass = g.mollified_area.cwiseMax(floor);
   k.w = Eigen::VectorXd::Zero(t.num_edges);
   for (int e = 0; e < t.num_edges; ++e) {
     if (t.is_boundary_edge(e)) continue;
-    const double len = edge_length(V, t, e);
+    const double len = edge_length(V, t, e) + g.component_epsilon[t.face_component[t.edge_faces(e, 0)]];
     k.w[e] = len * len / (k.mass[t.edge_faces(e, 0)] + k.mass[t.edge_faces(e, 1)]);
   }
   return k;
@@ -84,7 +84,10 @@ std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, cons
   Eigen::VectorXd diag = Eigen::VectorXd::Zero(t.num_faces);
   for (int e = 0; e < t.num_edges; ++e)
     if (!t.is_boundary_edge(e)) diag[t.edge_faces(e, 0)] += k.w[e], diag[t.edge_faces(e, 1)] += k.w[e];
-  const double eps = 1e-8 * (diag.array() / k.mass.array()).mean();
+  // The ratio of the sums, not the mean of the ratios: a zero-area face has the floor mass and an ordinary
+  // diagonal, so its ratio is ~1e12 times the others', and a mean over faces would make the shift swamp A
+  // on any mesh with a few such faces (the inverse iteration then barely moves from its random start).
+  const double eps = 1e-8 * diag.sum() / k.mass.sum();
   std::vector<int> outer(n + 1, 0), inner;
   std::vector<double> values;
   inner.reserve(static_cast<size_t>(n) * 3), values.reserve(static_cast<size_t>(n) * 6);
@@ -120,7 +123,10 @@ std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, cons
   detail::CholmodContext context;
   cholmod_common& c = *context;
   c.nmethods = 1;
-  c.method[0].ordering = CHOLMOD_AMD;
+  // METIS nested dissection, not AMD: on the dual graph of a 400k-face sphere it needs 3.3 times fewer
+  // flops (2.1e9 against 7.0e9, CHOLMOD's count) and two thirds of the factor's entries (1.03e7 against
+  // 1.56e7), so the factorization and every iteration's substitutions are cheaper.
+  c.method[0].ordering = CHOLMOD_METIS;
   c.postorder = 1;
   cholmod_sparse A = detail::upper_view_complex(outer, inner, values, n);
   std::unique_ptr<cholmod_factor, FactorDeleter> L(cholmod_analyze(&A, &c), FactorDeleter{&c});
@@ -233,6 +239,35 @@ std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& 
   return left;
 }
 
+std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex) {
+  // Clusters of vertices joined by zero-length edges (union-find with path halving).
+  std::vector<int> parent(t.num_vertices);
+  for (int v = 0; v < t.num_vertices; ++v) parent[v] = v;
+  auto root = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  bool any = false;
+  for (int e = 0; e < t.num_edges; ++e) {
+    const int i = t.edge_vertices(e, 0), j = t.edge_vertices(e, 1);
+    if (V.row(i) != V.row(j)) continue;
+    any = true;
+    const int a = root(i), b = root(j);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the root is the cluster's smallest id
+  }
+  if (!any) return vertex;
+  std::vector<char> touches_boundary(t.num_vertices, 0);
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (t.is_boundary_vertex(v)) touches_boundary[root(v)] = 1;
+  std::map<int, int> merged;
+  for (auto [v, n] : vertex) {
+    const int c = root(v);
+    merged[touches_boundary[c] ? v : c] += n;  // a cluster on the boundary keeps its interior vertices' own
+  }
+  for (auto it = merged.begin(); it != merged.end();) it = it->second == 0 ? merged.erase(it) : std::next(it);
+  return merged;
+}
+
 AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geometry& g, const Cycles& cycles, const AutoOptions& o) {
   if (o.N < 1) throw Error("automatic singularities: invalid N = " + std::to_string(o.N) + " (need N >= 1)");
   if (o.iterations < 1) throw Error("automatic singularities: invalid iterations = " + std::to_string(o.iterations) + " (need at least 1)");
@@ -284,12 +319,14 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
   for (int v = 0; v < t.num_vertices; ++v)
     if (indices.vertex[v] != 0) r.found[v] = indices.vertex[v];
   r.seconds.indices = seconds_since(t0);
+  const std::map<int, int> merged = merge_coincident_singularities(V, t, r.found);
+  r.coincident_removed = static_cast<int>(r.found.size() - merged.size());
 
   t0 = Clock::now();
   if (!(o.cancel_distance >= 0) || !std::isfinite(o.cancel_distance))
     throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
   const double distance = o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
-  r.vertex = cancel_singularity_pairs(V, t, r.found, distance, &r.pairs);
+  r.vertex = cancel_singularity_pairs(V, t, merged, distance, &r.pairs);
   r.seconds.cancel = seconds_since(t0);
   return r;
 }

@@ -19,13 +19,25 @@ using detail::kParallelMinElements;
 // accuracy on needles and slivers ("Miscalculating Area and Angles of a Needle-like Triangle", 2014).
 // The lengths are divided by the longest first (cotangents do not depend on the size), so that the
 // product of four lengths can neither overflow nor underflow.
-Eigen::Vector3d cotangents_from_lengths(const double l_in[3]) {
-  const double longest = std::max({l_in[0], l_in[1], l_in[2]});
-  const double l[3] = {l_in[0] / longest, l_in[1] / longest, l_in[2] / longest};
+// Area of the triangle with edge lengths l[k] / longest (Kahan's Heron on the sorted lengths).
+double scaled_area(const double l[3]) {
   double s[3] = {l[0], l[1], l[2]};
   std::sort(s, s + 3, [](double a, double b) { return a > b; });
   const double a = s[0], b = s[1], c = s[2];
-  const double area = 0.25 * std::sqrt((a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c)));
+  return 0.25 * std::sqrt((a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c)));
+}
+
+// The area of the triangle with edge lengths l_in (satisfying the triangle inequality strictly).
+double area_from_lengths(const double l_in[3]) {
+  const double longest = std::max({l_in[0], l_in[1], l_in[2]});
+  const double l[3] = {l_in[0] / longest, l_in[1] / longest, l_in[2] / longest};
+  return scaled_area(l) * longest * longest;
+}
+
+Eigen::Vector3d cotangents_from_lengths(const double l_in[3]) {
+  const double longest = std::max({l_in[0], l_in[1], l_in[2]});
+  const double l[3] = {l_in[0] / longest, l_in[1] / longest, l_in[2] / longest};
+  const double area = scaled_area(l);
   Eigen::Vector3d cot;
   for (int j = 0; j < 3; ++j) {
     const double opposite = l[(j + 1) % 3], u = l[j], w = l[(j + 2) % 3];
@@ -188,6 +200,8 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
     if (shortfall[f] > 0) component_epsilon[t.face_component[f]] = std::max(component_epsilon[t.face_component[f]], shortfall[f]);
   g.mollified_faces = mollified_faces;
   g.mollify_epsilon = nC > 0 ? *std::max_element(component_epsilon.begin(), component_epsilon.end()) : 0.0;
+  g.component_epsilon = component_epsilon;
+  g.mollified_area = g.face_area;
   if (g.mollify_epsilon > 0) {
 #pragma omp parallel for schedule(static) num_threads(team) if (nF > kParallelMinElements)
     for (int f = 0; f < nF; ++f) {
@@ -200,6 +214,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
       const double l[3] = {length[t.face_edges(f, 0)] + epsilon, length[t.face_edges(f, 1)] + epsilon,
                            length[t.face_edges(f, 2)] + epsilon};
       cot.row(f) = cotangents_from_lengths(l);
+      g.mollified_area(f) = area_from_lengths(l);
     }
   }
 

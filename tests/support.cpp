@@ -177,6 +177,17 @@ std::vector<int> vertices_of_valence(const Mesh& m, int valence) {
   return out;
 }
 
+Mesh jittered_disk(int rings, int segments, double amount) {
+  Mesh m = make_disk(rings, segments);
+  const Topology t = topo(m);
+  for (int v = 0; v < m.V.rows(); ++v) {
+    if (t.is_boundary_vertex(v)) continue;
+    const double angle = 2.399963 * v + 0.7, r = amount * (0.5 + 0.5 * std::sin(12.9898 * v)) / rings;
+    m.V(v, 0) += r * std::cos(angle), m.V(v, 1) += r * std::sin(angle);
+  }
+  return m;
+}
+
 void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const std::string& what) {
   SCOPED_TRACE(what);
   const int nF = static_cast<int>(F_in.rows());

@@ -51,6 +51,10 @@ Topology topo(const Mesh& m);
 MatrixX3i faces(const std::vector<std::array<int, 3>>& list);
 // Vertices of a given valence (e.g. the 8 corners of a cube sphere, the 12 of an icosphere).
 std::vector<int> vertices_of_valence(const Mesh& m, int valence);
+// make_disk(rings, segments) with every interior vertex moved in the plane by up to `amount` × the ring
+// spacing in a pseudo-random direction (deterministic): no symmetry left, so a zero of order k of a field
+// splits into k simple ones as on a generic mesh (on the symmetric disk, zeros sit on the symmetry).
+Mesh jittered_disk(int rings, int segments, double amount);
 
 // Checks every structural invariant of a Topology against F (the input) alone. Cheap: O(F log F).
 void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const std::string& what);

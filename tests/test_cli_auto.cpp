@@ -34,7 +34,7 @@ TEST(CliAuto, CubeGetsEightCornersAndSolvesExactly) {
   const std::string report = temp_file("report.json"), sings = temp_file("auto.sing"), field = temp_file("field.txt");
   const auto r = run_cli("solve " + mesh + " -N 4 --auto --report " + report + " --sing-out " + sings + " --field-out " + field);
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("auto: smoothest field found 8 singularities, cancelled 0 pairs, using 8"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("auto: smoothest field found 8 singularities, 0 removed by summing over coincident vertices, cancelled 0 pairs, using 8"), std::string::npos) << r.out;
   const nlohmann::json j = read_json(report);
   EXPECT_EQ(j["auto"]["found"], 8);
   EXPECT_EQ(j["auto"]["cancelled_pairs"], 0);
@@ -118,17 +118,18 @@ TEST(CliAuto, CancelOptionReportsFoundCancelledAndUsed) {
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = read_json(report);
   const int found = j["auto"]["found"], pairs = j["auto"]["cancelled_pairs"], used = j["auto"]["used"];
+  EXPECT_EQ(j["auto"]["coincident_removed"], 0);
   EXPECT_EQ(found, used + 2 * pairs);
   EXPECT_EQ(static_cast<int>(j["singularities"].size()), used);
-  EXPECT_NE(r.out.find("auto: smoothest field found " + std::to_string(found) + " singularities, cancelled " + std::to_string(pairs) +
-                       " pairs, using " + std::to_string(used)),
+  EXPECT_NE(r.out.find("auto: smoothest field found " + std::to_string(found) + " singularities, 0 removed by summing over coincident " +
+                       "vertices, cancelled " + std::to_string(pairs) + " pairs, using " + std::to_string(used)),
             std::string::npos)
       << r.out;
   EXPECT_TRUE(j["verified"].get<bool>());
 }
 
 TEST(CliAuto, AlignedDiskGetsFourQuarterSingularities) {
-  const std::string mesh = mesh_file(make_disk(12, 8), "disk.obj"), report = temp_file("report.json");
+  const std::string mesh = mesh_file(test::jittered_disk(12, 8, 0.3), "disk.obj"), report = temp_file("report.json");
   const auto r = run_cli("solve " + mesh + " -N 4 --align-boundary --auto --report " + report);
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = read_json(report);

@@ -17,7 +17,7 @@
 // - The smoothest unit field minimises E(u) / ‖u‖²_M: the eigenvector of the smallest eigenvalue of
 //   A u = λ M u. It is computed per component by inverse-power iterations (x ← (A + εM)⁻¹ M x,
 //   normalised per component to ‖x‖_M = 1, from a fixed pseudo-random start) on ONE supernodal CHOLMOD
-//   factorization (AMD ordering) of A + εM, ε = 1e-8 × mean_f(A_ff / m_f) (a tiny shift: A alone is
+//   factorization (METIS ordering) of A + εM, ε = 1e-8 × Σ_f A_ff / Σ_f m_f (a tiny shift: A alone is
 //   singular when the N-th power of the holonomy is trivial, e.g. on a flat torus).
 // - Why face-based: the field lives per face like trivcon's own fields and their indices are read by
 //   the same field_indices (trivcon/field.h), so the singularities are exactly those of the field that
@@ -41,6 +41,13 @@
 //
 // Singularities: the indices of that field at interior vertices (field_indices); being read from a
 // field they satisfy Gauss–Bonnet per closed component. Boundary vertices never carry one.
+//
+// Coincident vertices (joined by edges of length exactly 0, as in meshes with duplicated vertices): the
+// corner angles of a face with a zero-length edge are a convention (trivcon/geometry.h: π/2 at both ends),
+// since the direction from one end to the other is lost, so the curvature of such a cluster is shared among
+// its vertices arbitrarily, and the smoothest field answers with ± pairs on the coincident vertices, which
+// no one can see. The indices of each cluster are therefore summed onto its smallest vertex id (0: removed);
+// a cluster that touches the boundary keeps its vertices' own. `coincident_removed` counts what this removed.
 //
 // Cancellation (AutoOptions::cancel_distance > 0), for fewer singularities on noisy scans: pairs of
 // singular vertices with opposite indices (+n and −n) whose geodesic distance (Dijkstra along mesh
@@ -78,7 +85,8 @@ struct AutoTimings {
 struct AutoResult {
   Field field;                             // the smoothest field, angle = arg(u_f)/N in [0, 2π/N)
   std::map<int, int> found;                // its singularities: vertex → n (index n/N)
-  std::map<int, int> vertex;               // after cancellation: the singularities to prescribe
+  int coincident_removed = 0;              // singularities of `found` that summing over coincident vertices removed
+  std::map<int, int> vertex;               // after that and cancellation: the singularities to prescribe
   std::vector<std::pair<int, int>> pairs;  // cancelled pairs (vertex of index +n, vertex of −n), in order
   double energy = 0;                       // E(u) / ‖u‖²_M over the whole mesh (the Rayleigh quotient without fixed faces)
   int vanishing_faces = 0;                 // faces where |u_f| vanished (see above)
@@ -97,6 +105,9 @@ AutoResult auto_singularities(const MatrixX3d& V, const MatrixX3i& F, const Auto
 // cancelled pairs (positive vertex, negative vertex) appended to `pairs` when not null.
 std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& topology, const std::map<int, int>& vertex, double distance,
                                             std::vector<std::pair<int, int>>* pairs = nullptr);
+
+// The summing over coincident vertices above on its own.
+std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topology& topology, const std::map<int, int>& vertex);
 
 // Mean length of the mesh's edges (the unit of AutoOptions::cancel_distance).
 double mean_edge_length(const MatrixX3d& V, const Topology& topology);

@@ -34,6 +34,7 @@
 //   keeps its exact cotangents (mollify_epsilon = 0, mollified_faces = 0).
 #pragma once
 #include <Eigen/Core>
+#include <vector>
 
 #include "trivcon/topology.h"
 
@@ -55,6 +56,12 @@ struct Geometry {
   int zero_area_faces = 0;             // faces whose extrinsic area is exactly 0
   int mollified_faces = 0;             // faces whose lengths missed the triangle inequality by less than δ
   double mollify_epsilon = 0;          // the largest length ε added to a component's edges for the cotangents (0: none)
+  std::vector<double> component_epsilon;  // per component (Topology::components): its ε (0: not mollified)
+  // Per face: the area of its intrinsic triangle with the component's ε added to its edge lengths (Kahan's
+  // Heron), for the faces whose cotangents were mollified; face_area for every other face (whose margin is at
+  // least 1000 δ, so adding ε would change its area by less than about 1e-3 relative). Positive on every face
+  // of a mollified component, including zero-area faces (trivcon/auto.h measures its field with it).
+  Eigen::VectorXd mollified_area;
 
   // Angle of the world vector `d` in face f's frame (its projection onto the face's plane).
   double angle_in_face(int f, const Eigen::Vector3d& d) const;
