@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <map>
 #include <sstream>
 
@@ -36,6 +37,7 @@ struct SolveOptions {
   std::string sing_batch;
   bool auto_place = false;  // --auto
   double auto_cancel = 0;   // --auto-cancel, in mean edge lengths
+  std::string align;        // --align curvature[:t]
   std::string sing_from_field;
   OutputPaths out;
   bool quiet = false;
@@ -47,6 +49,23 @@ struct SolveOptions {
 constexpr int kMaxSplitRounds = 8;
 
 // --fix takes "F:x,y,z" / "F:angle=A" specs and files; a spec starts with a face id and a colon.
+// The strength T of --align curvature[:T] (0 when not given), or nothing when the text is not of that form.
+std::optional<double> alignment_strength(const std::string& text) {
+  if (text == "curvature") return 0.0;
+  const std::string prefix = "curvature:";
+  if (text.compare(0, prefix.size(), prefix) != 0 || text.size() == prefix.size()) return std::nullopt;
+  const std::string number = text.substr(prefix.size());
+  size_t used = 0;
+  double t = 0;
+  try {
+    t = std::stod(number, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used != number.size() || !std::isfinite(t) || !(t < 1)) return std::nullopt;
+  return t;
+}
+
 bool is_fix_spec(const std::string& s) {
   const size_t colon = s.find(':');
   return colon != std::string::npos && colon > 0 && s.find_first_not_of("0123456789") == colon;
@@ -167,6 +186,7 @@ void run_solve(const SolveOptions& o) {
     ao.N = prescription.N;
     ao.cancel_distance = o.auto_cancel;
     ao.fixed = prescription.fixed;  // --align-boundary and --fix: Dirichlet values of the smoothest field
+    if (!o.align.empty()) ao.align_curvature = true, ao.curvature_t = *alignment_strength(o.align);  // checked by CLI11
     const AutoResult r = auto_singularities(designer, ao);
     prescription.vertex = r.vertex;
     const AutoTimings& s = r.seconds;
@@ -178,7 +198,9 @@ void run_solve(const SolveOptions& o) {
         {"cancel_distance", o.auto_cancel},
         {"vanishing_faces", r.vanishing_faces},
         {"seconds",
-         {{"assemble", s.assemble}, {"factor", s.factor}, {"iterate", s.iterate}, {"indices", s.indices}, {"cancel", s.cancel}}}};
+         {{"assemble", s.assemble}, {"factor", s.factor}, {"iterate", s.iterate}, {"align", s.align}, {"indices", s.indices},
+          {"cancel", s.cancel}}}};
+    if (ao.align_curvature) extra["auto"]["align"] = {{"guidance", "curvature"}, {"t", ao.curvature_t}};
     if (!o.quiet)
       std::cout << "auto: smoothest field found " << r.found.size() << " singularities, " << r.coincident_removed
                 << " removed by summing over coincident vertices, cancelled " << r.pairs.size() << " pairs, using " << r.vertex.size() << "\n";
@@ -305,6 +327,14 @@ void register_solve(CLI::App& app) {
                   "With --auto: cancel pairs of opposite singularities at most D mean edge lengths apart (geodesic, along edges), "
                   "closest first")
       ->check(CLI::NonNegativeNumber)
+      ->needs(auto_flag);
+  auto check_align = [](const std::string& text) -> std::string {
+    return alignment_strength(text) ? "" : "expected curvature or curvature:T with a number T < 1, not '" + text + "'";
+  };
+  cmd->add_option("--align", o.align,
+                  "With --auto: guidance for the smoothest field; 'curvature' or 'curvature:T' follows the principal curvature "
+                  "directions (N even) with strength T < 1 (default 0; toward 1 smoother, negative closer to the curvature)")
+      ->check(CLI::Validator(check_align, "curvature[:T]"))
       ->needs(auto_flag);
   auto* from_field = cmd->add_option("--sing-from-field", o.sing_from_field,
                                      "Use the singularities of a per-face field (.txt, .ply or Directional's .rawfield, as `check` reads)");

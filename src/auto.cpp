@@ -12,6 +12,7 @@
 
 #include "detail/cholmod.h"
 #include "detail/timing.h"
+#include "trivcon/curvature.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
 
@@ -62,7 +63,8 @@ struct FactorDeleter {
 };
 
 // The smoothest field's complex values per face (see trivcon/auto.h).
-std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o, AutoTimings& time) {
+std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o,
+                                      const std::vector<Complex>* guidance, AutoTimings& time) {
   auto t0 = Clock::now();
   const int N = o.N;
   std::vector<Complex> u(t.num_faces, Complex(0, 0));
@@ -169,12 +171,62 @@ std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, cons
     cholmod_free_dense(&X, &c);
     normalise(x);
   }
+  time.iterate = seconds_since(t0);
+  if (guidance) {
+    t0 = Clock::now();
+    // Per component: the Rayleigh quotient λ̂ of the field found so far (the smoothest field's eigenvalue, or the
+    // energy of the Dirichlet solution) and the guidance's scale (area-weighted mean |q| = 1).
+    auto value = [&](int f) { return unknown[f] >= 0 ? Complex(x[2 * unknown[f]], x[2 * unknown[f] + 1]) : u[f]; };
+    std::vector<double> energy(components, 0), norm(components, 0), zsum(components, 0), msum(components, 0);
+    for (int e = 0; e < t.num_edges; ++e) {
+      if (t.is_boundary_edge(e)) continue;
+      const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+      energy[t.face_component[L]] += k.w[e] * std::norm(value(R) - std::polar(1.0, N * g.rho[e]) * value(L));
+    }
+    std::vector<Complex> q(t.num_faces);  // M q, before scaling
+    for (int f = 0; f < t.num_faces; ++f) {
+      const int comp = t.face_component[f];
+      norm[comp] += k.mass[f] * std::norm(value(f)), msum[comp] += k.mass[f];
+      const Complex z = (*guidance)[f];
+      const double a = std::abs(z);
+      q[f] = a > 0 ? a * std::pow(z / a, N / 2) : Complex(0, 0);
+      zsum[comp] += a;
+    }
+    std::vector<char> guided(components, 0);
+    for (int comp = 0; comp < components; ++comp) guided[comp] = zsum[comp] > 0 && std::isfinite(zsum[comp]);
+    if (o.curvature_t != 0) {
+      // A − λ_t M with λ_t = t λ̂ per component (the shift ε kept), refactored on the same analysis.
+      for (int j = 0; j < n; ++j) {
+        const int f = face_of[j], comp = t.face_component[f];
+        const double lambda = norm[comp] > 0 ? energy[comp] / norm[comp] : 0.0;
+        values[2 * (outer[j + 1] - 1)] = diag[f] + (eps - o.curvature_t * lambda) * k.mass[f];
+      }
+      const int refactored = cholmod_factorize(&A, L.get(), &c);
+      if (c.status == CHOLMOD_NOT_POSDEF)
+        throw Error("automatic singularities: curvature alignment with t = " + std::to_string(o.curvature_t) +
+                    " makes the system indefinite (t must be below 1, and a little below 1 can already exceed the smallest "
+                    "eigenvalue's estimate): use a smaller t");
+      detail::require(refactored && c.status == CHOLMOD_OK, "automatic singularities: CHOLMOD could not factor the alignment matrix", c);
+    }
+    for (int j = 0; j < n; ++j) {
+      const int f = face_of[j], comp = t.face_component[f];
+      const Complex mq = guided[comp] ? q[f] * (msum[comp] / zsum[comp]) : Complex(0, 0);
+      b[2 * j] = mq.real() + dirichlet[2 * j], b[2 * j + 1] = mq.imag() + dirichlet[2 * j + 1];
+    }
+    cholmod_dense B = detail::dense_view_complex(b);
+    cholmod_dense* X = cholmod_solve(CHOLMOD_A, L.get(), &B, &c);
+    detail::require(X != nullptr, "automatic singularities: CHOLMOD could not solve with the alignment matrix", c);
+    const double* aligned = static_cast<const double*>(X->x);
+    for (int j = 0; j < n; ++j)  // components without curvature (flat, umbilic) keep the smoothest field
+      if (guided[t.face_component[face_of[j]]]) x[2 * j] = aligned[2 * j], x[2 * j + 1] = aligned[2 * j + 1];
+    cholmod_free_dense(&X, &c);
+    time.align = seconds_since(t0);
+  }
   for (int j = 0; j < n; ++j) {
     if (!std::isfinite(x[2 * j]) || !std::isfinite(x[2 * j + 1]))
       throw Error("automatic singularities: the smoothest field is not finite at face " + std::to_string(face_of[j]));
     u[face_of[j]] = Complex(x[2 * j], x[2 * j + 1]);
   }
-  time.iterate = seconds_since(t0);
   return u;
 }
 
@@ -278,8 +330,15 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
   r.field.N = o.N;
   r.field.angle = Eigen::VectorXd::Zero(t.num_faces);
   if (t.num_faces == 0) return r;
+  if (o.align_curvature && o.N % 2 != 0)
+    throw Error("automatic singularities: curvature alignment needs an even N (principal directions are lines), not N = " +
+                std::to_string(o.N));
+  if (o.align_curvature && !(o.curvature_t < 1))
+    throw Error("automatic singularities: invalid curvature alignment strength t = " + std::to_string(o.curvature_t) + " (need t < 1)");
   const Weights k = face_weights(V, t, g);
-  std::vector<Complex> u = smoothest_values(t, g, k, o, r.seconds);
+  std::vector<Complex> guidance;
+  if (o.align_curvature) guidance = curvature_tensors(V, t, g);
+  std::vector<Complex> u = smoothest_values(t, g, k, o, o.align_curvature ? &guidance : nullptr, r.seconds);
 
   auto t0 = Clock::now();
   // Energy (the Rayleigh quotient), then faces where the field vanishes (trivcon/auto.h).

@@ -1,8 +1,11 @@
 // Automatic singularities (trivcon/auto.h): the smoothest field's singularities, cancellation, and the
 // exact solve with them.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <set>
+
+#include <Eigen/Geometry>
 
 #include "support.h"
 #include "trivcon/auto.h"
@@ -315,6 +318,53 @@ TEST(Auto, AlignedDiskGetsFourQuarterSingularities) {
   for (auto [v, n] : r.found) EXPECT_EQ(n, 1) << "vertex " << v;
   // The field holds the fixed faces.
   for (auto [f, angle] : o.fixed) EXPECT_NEAR(std::abs(reduce_angle(r.field.angle[f] - angle, 4)), 0.0, 1e-9) << "face " << f;
+}
+
+// Curvature alignment: on a fat torus of revolution the smoothest cross field has singularities (12, see
+// above), while the principal directions (meridians and parallels) make a cross field without any; the field
+// follows them to within a few hundredths of a radian on every face.
+TEST(Auto, CurvatureAlignedTorusFollowsMeridians) {
+  const Mesh m = make_torus(96, 24, 1.0, 0.4);
+  FieldDesigner designer(m.V, m.F);
+  AutoOptions o;
+  o.N = 4;
+  EXPECT_FALSE(auto_singularities(designer, o).found.empty());
+  o.align_curvature = true;
+  std::vector<double> medians;
+  for (double t : {-5.0, 0.0, 0.5}) {
+    o.curvature_t = t;
+    const AutoResult r = auto_singularities(designer, o);
+    EXPECT_TRUE(r.found.empty()) << "t " << t << ": " << r.found.size();
+    EXPECT_GT(r.seconds.align, 0.0);
+    // The meridian direction at each face's centroid: the circle around the tube through it.
+    std::vector<double> error;
+    for (int f = 0; f < m.F.rows(); ++f) {
+      const Eigen::Vector3d c = (m.V.row(m.F(f, 0)) + m.V.row(m.F(f, 1)) + m.V.row(m.F(f, 2))).transpose() / 3;
+      const Eigen::Vector3d axis_point = Eigen::Vector3d(c.x(), c.y(), 0).normalized();  // tube centre, R = 1
+      const Eigen::Vector3d meridian = axis_point.cross(Eigen::Vector3d::UnitZ()).cross(c - axis_point).normalized();
+      const double a = designer.geometry().angle_in_face(f, meridian);
+      error.push_back(std::abs(reduce_angle(r.field.angle[f] - a, 4)));
+    }
+    std::sort(error.begin(), error.end());
+    medians.push_back(error[error.size() / 2]);
+    EXPECT_LT(medians.back(), t < 0 ? 0.02 : 0.06) << "t " << t << ": median";
+    EXPECT_LT(error.back(), 0.1) << "t " << t << ": largest";
+    expect_exact(designer, r.vertex, 4, "aligned torus");
+  }
+  // Closer to the curvature for smaller t.
+  EXPECT_LT(medians[0], medians[1]);
+  EXPECT_LT(medians[1], medians[2]);
+  o.curvature_t = 1;
+  EXPECT_EQ(error_of([&] { auto_singularities(designer, o); }),
+            "automatic singularities: invalid curvature alignment strength t = 1.000000 (need t < 1)");
+  o.curvature_t = 0, o.N = 3;
+  EXPECT_EQ(error_of([&] { auto_singularities(designer, o); }),
+            "automatic singularities: curvature alignment needs an even N (principal directions are lines), not N = 3");
+  // A flat disk has no curvature: it keeps its smoothest field (no singularity in the interior, free boundary).
+  const Mesh disk = test::jittered_disk(8, 8, 0.2);
+  o.N = 4;
+  const AutoResult flat = auto_singularities(disk.V, disk.F, o);
+  EXPECT_TRUE(flat.found.empty()) << flat.found.size();
 }
 
 // The shared real meshes: counts of singularities found (printed), Gauss–Bonnet on closed components, and

@@ -153,6 +153,17 @@ TEST(CliAuto, FixedFacesAreHonoured) {
   EXPECT_TRUE(j["verified"].get<bool>());
 }
 
+TEST(CliAuto, CurvatureAlignmentOnAFatTorusHasNoSingularities) {
+  const std::string mesh = mesh_file(make_torus(96, 24, 1.0, 0.4), "torus.obj"), report = temp_file("report.json");
+  const auto r = run_cli("solve " + mesh + " -N 4 --auto --align curvature:-2 --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = read_json(report);
+  EXPECT_EQ(j["auto"]["align"]["guidance"], "curvature");
+  EXPECT_EQ(j["auto"]["align"]["t"], -2.0);
+  EXPECT_EQ(j["auto"]["used"], 0);
+  EXPECT_TRUE(j["verified"].get<bool>());
+}
+
 TEST(CliAuto, UsageErrors) {
   const std::string mesh = mesh_file(make_icosphere(1), "sphere.obj"), sings = temp_file("s.sing");
   test::write_text(sings, "0 1\n1 1\n");
@@ -161,6 +172,16 @@ TEST(CliAuto, UsageErrors) {
   EXPECT_EQ(run_cli("solve " + mesh + " --auto-cancel 2").status, 2);
   EXPECT_EQ(run_cli("solve " + mesh + " --auto --auto-cancel -1").status, 2);
   EXPECT_EQ(run_cli("solve " + mesh + " --sing-from-field f.txt -s " + sings).status, 2);
+  EXPECT_EQ(run_cli("solve " + mesh + " --align curvature").status, 2);  // needs --auto
+  for (const std::string bad : {"bumps", "curvature:", "curvature:1", "curvature:x", "curvature:0.5x"}) {
+    const auto u = run_cli("solve " + mesh + " --auto --align " + bad);
+    EXPECT_EQ(u.status, 2) << bad;
+    EXPECT_NE(u.err.find("expected curvature or curvature:T with a number T < 1, not '" + bad + "'"), std::string::npos) << u.err;
+  }
+  // N odd: principal directions are lines.
+  const auto odd = run_cli("solve " + mesh + " -N 3 --auto --align curvature");
+  EXPECT_EQ(odd.status, 1);
+  EXPECT_NE(odd.err.find("curvature alignment needs an even N (principal directions are lines), not N = 3"), std::string::npos) << odd.err;
   // A field file that does not exist is bad input, named.
   const auto r = run_cli("solve " + mesh + " --sing-from-field " + temp_file("missing.txt"));
   EXPECT_EQ(r.status, 1);

@@ -12,8 +12,13 @@
 //   (≈ (m_L + m_R) / |e| up to a constant, which does not change the field). Unlike the cotan-like
 //   face-Laplacian weight 2 / (cot α + cot β) it is positive and finite on every mesh (no clamping, no
 //   blow-up where the circumcentres of L and R coincide).
-// - Mass m_f = the face's area, at least 1e-12 × the mean face area (degenerate and zero-area faces get
-//   that tiny positive mass, so the matrices stay positive definite and nothing is NaN).
+// - Mass m_f = the face's area. On a component with slivers, zero-area faces or zero-length edges, the
+//   lengths in w_e (|e| + ε) and the masses are those of the mollified intrinsic triangles of
+//   trivcon/geometry.h (Geometry::component_epsilon, mollified_area): every face keeps a positive mass and
+//   positive weights to its neighbours. (With the raw lengths a face whose three corners coincide has three
+//   zero weights: it is cut off, an eigenvector of eigenvalue ~0 lives on it alone, and the inverse iteration
+//   converges to it, leaving every other face "vanishing"; the dragon's collapsed faces did that.) A floor of
+//   1e-12 × the mean face area stays as a last guard.
 // - The smoothest unit field minimises E(u) / ‖u‖²_M: the eigenvector of the smallest eigenvalue of
 //   A u = λ M u. It is computed per component by inverse-power iterations (x ← (A + εM)⁻¹ M x,
 //   normalised per component to ‖x‖_M = 1, from a fixed pseudo-random start) on ONE supernodal CHOLMOD
@@ -38,6 +43,16 @@
 // - Fixed faces (AutoOptions::fixed, e.g. trivcon::boundary_alignment): their u_f = e^{iNγ_f} are
 //   Dirichlet values (Knöppel Sec. 5), and on each component that has any the field is the one solve
 //   (A_II + εM_II) u_I = −A_IB u_B instead of an eigenvector.
+//
+// Curvature alignment (AutoOptions::align_curvature; Knöppel et al. 2013, Sec. 5): the guidance q_f is the
+// face's principal curvature direction as an N-field (trivcon/curvature.h: z_f^{N/2} / |z_f|^{N/2−1}, for N
+// even), scaled per component so that its area-weighted mean |q| is 1, and the field solves
+// (A − λ_t M) u = M q (+ the Dirichlet values of fixed faces) with λ_t = t·λ̂, λ̂ the Rayleigh quotient of the
+// field the iterations above found on that component (the smallest eigenvalue's estimate). t = 0 (the default,
+// geometry-central's choice) solves A u = M q with the factor already there; t → 1 approaches the smoothest
+// field (q matters less and less); t < 0 follows the curvature more closely (the system is refactored for
+// t ≠ 0, with the same ordering). |q| is the anisotropy |κ_max − κ_min|, so umbilic and flat regions are
+// guided by the smoothness alone; a component without any curvature (flat) keeps its smoothest field.
 //
 // Singularities: the indices of that field at interior vertices (field_indices); being read from a
 // field they satisfy Gauss–Bonnet per closed component. Boundary vertices never carry one.
@@ -76,10 +91,12 @@ struct AutoOptions {
   double cancel_distance = 0;    // cancel ± pairs at most this far apart; 0: none
   bool cancel_absolute = false;  // cancel_distance in mesh units instead of mean edge lengths
   std::map<int, double> fixed;   // face → angle in its frame (radians), held as Dirichlet values
+  bool align_curvature = false;  // follow the principal curvature directions (see above); N even
+  double curvature_t = 0;        // its strength t < 1: 0 as geometry-central, → 1 smoother, < 0 closer to the curvature
 };
 
 struct AutoTimings {
-  double assemble = 0, factor = 0, iterate = 0, indices = 0, cancel = 0;  // seconds
+  double assemble = 0, factor = 0, iterate = 0, align = 0, indices = 0, cancel = 0;  // seconds
 };
 
 struct AutoResult {
