@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "edits.h"
+#include "trivcon/auto.h"
 #include "trivcon/blas.h"
 #include "trivcon/cycles.h"
 #include "trivcon/design.h"
@@ -337,6 +338,24 @@ int child_run(const RunOptions& o) {
   }
   log("  " + o.name + ": edit solve " + std::to_string(solve.median() * 1e3) + " ms, field " + std::to_string(field.median() * 1e3) +
       " ms, whole " + std::to_string(whole.median() * 1e3) + " ms");
+  // Automatic placement (solve --auto) on the prepared mesh: the smoothest field and its singularities,
+  // `reps` times (after one warm-up).
+  Samples auto_total, auto_assemble, auto_factor, auto_iterate, auto_indices;
+  size_t auto_found = 0;
+  for (int r = 0; r < 1 + reps; ++r) {
+    AutoOptions ao;
+    ao.N = o.N;
+    auto t0 = Clock::now();
+    const AutoResult a = auto_singularities(*p.designer, ao);
+    const double t = seconds_since(t0);
+    auto_found = a.vertex.size();
+    if (r == 0) continue;
+    auto_total.add(t), auto_assemble.add(a.seconds.assemble), auto_factor.add(a.seconds.factor), auto_iterate.add(a.seconds.iterate);
+    auto_indices.add(a.seconds.indices);
+  }
+  log("  " + o.name + ": auto " + std::to_string(auto_total.median()) + " s, " + std::to_string(auto_found) + " singularities");
+  result["auto"] = json{{"total", auto_total.to_json()},     {"assemble", auto_assemble.to_json()}, {"factor", auto_factor.to_json()},
+                        {"iterate", auto_iterate.to_json()}, {"indices", auto_indices.to_json()},   {"singularities", auto_found}};
   rss["peak"] = peak_rss();
   result["rss"] = rss;
   result["N"] = o.N;
@@ -564,7 +583,24 @@ std::string label(const json& r) {
   return name;
 }
 
+void print_auto_table(const json& runs) {
+  std::ostream& out = std::cout;
+  out << "\n### Automatic placement (`solve --auto`: the smoothest field, trivcon/auto.h), medians\n\n";
+  out << "| mesh | faces | prepare (wall) | auto (assemble / factor / iterate / indices) | auto ÷ prepare | singularities |\n";
+  out << "|---|---:|---:|---:|---:|---:|\n";
+  for (const json& r : runs) {
+    if (r.value("status", "") != "ok" || !r["auto"].is_object()) continue;
+    const json& a = r["auto"];
+    const double prepare = med(r["stages"], "prepare"), total = med(a, "total");
+    out << "| " << label(r) << " | " << r["mesh"]["faces"].get<long>() << " | " << sec(prepare) << " | " << sec(total) << " ("
+        << fmt(med(a, "assemble")) << " / " << fmt(med(a, "factor")) << " / " << fmt(med(a, "iterate")) << " / " << fmt(med(a, "indices"))
+        << ") | " << fmt(total / prepare, 2) << " | " << a["singularities"].get<long>() << " |\n";
+  }
+  out << "\n";
+}
+
 void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool quick) {
+  print_auto_table(runs);
   std::ostream& out = std::cout;
   out << "### Per mesh (medians; " << o.reps << " runs after " << o.warmup << " warm-up for the stages, " << o.edits << " edits after "
       << o.edit_warmup << " warm-up; above 2M faces at most 3 runs and 10 edits)\n\n";
@@ -716,6 +752,7 @@ void print_tables(const json& runs, const json& qrs, const RunOptions& o, bool q
       row("set-up after reading (FieldDesigner: topology, geometry, cycles, field plan, solver)", name, med(s, "prepare"), 1.0, false);
       row("one edit", name, med(e, "whole"), 0.060, true);
       row("read OBJ", name, med(s, "read_obj"), 0.6, false);
+      if (r["auto"].is_object()) row("automatic placement (--auto) beyond the set-up", name, med(r["auto"], "total"), 1.0, false);
     } else if (r.value("target_class", "") == "dragon") {
       row("set-up after reading", name, med(s, "prepare"), 2.5, false);
       row("one edit", name, med(e, "whole"), 0.150, true);

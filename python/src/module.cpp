@@ -524,9 +524,11 @@ PYBIND11_MODULE(_core, m) {
           "A Design of the prescription (n = index·N per id; fixed: face -> angle).")
       .def(
           "auto_singularities",
-          [](const DesignerPtr& s, int N, int iterations, double cancel, bool cancel_absolute, const std::map<int, double>& fixed) {
+          [](const DesignerPtr& s, int N, int iterations, double cancel, bool cancel_absolute, const std::map<int, double>& fixed,
+             bool align_curvature, double curvature_t) {
             AutoOptions o;
             o.N = N, o.iterations = iterations, o.cancel_distance = cancel, o.cancel_absolute = cancel_absolute, o.fixed = fixed;
+            o.align_curvature = align_curvature, o.curvature_t = curvature_t;
             auto out = std::make_unique<AutoOut>();
             out->state = s;
             {
@@ -537,8 +539,8 @@ PYBIND11_MODULE(_core, m) {
             }
             return out;
           },
-          py::arg("N"), py::arg("iterations"), py::arg("cancel"), py::arg("cancel_absolute"), py::arg("fixed"),
-          "Singularities of the smoothest field (trivcon/auto.h).")
+          py::arg("N"), py::arg("iterations"), py::arg("cancel"), py::arg("cancel_absolute"), py::arg("fixed"), py::arg("align_curvature"),
+          py::arg("curvature_t"), "Singularities of the smoothest field (trivcon/auto.h).")
       .def(
           "field_indices",
           [](const DesignerState& s, const MatrixX3d& directions, int N) {
@@ -644,6 +646,7 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("found", [](const AutoOut& a) { return a.result.found; })
       .def_property_readonly("vertex", [](const AutoOut& a) { return a.result.vertex; })
       .def_property_readonly("pairs", [](const AutoOut& a) { return a.result.pairs; })
+      .def_property_readonly("coincident_removed", [](const AutoOut& a) { return a.result.coincident_removed; })
       .def_property_readonly("energy", [](const AutoOut& a) { return a.result.energy; })
       .def_property_readonly("vanishing_faces", [](const AutoOut& a) { return a.result.vanishing_faces; })
       .def_property_readonly("angles", [](const AutoOut& a) { return double_vector(a.result.field.angle); })
@@ -652,7 +655,8 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("seconds", [](const AutoOut& a) {
         const AutoTimings& s = a.result.seconds;
         py::dict d;
-        d["assemble"] = s.assemble, d["factor"] = s.factor, d["iterate"] = s.iterate, d["indices"] = s.indices, d["cancel"] = s.cancel;
+        d["assemble"] = s.assemble, d["factor"] = s.factor, d["iterate"] = s.iterate, d["align"] = s.align, d["indices"] = s.indices;
+        d["cancel"] = s.cancel;
         return d;
       });
 }

@@ -222,7 +222,28 @@ def test_auto_cube():
     r = d.solve(N=4, singularities="auto")
     check_result(V, d, r, a.singularities)
     assert r.auto is not None and r.auto.singularities == a.singularities
-    assert set(r.auto.seconds) == {"assemble", "factor", "iterate", "indices", "cancel"}
+    assert set(r.auto.seconds) == {"assemble", "factor", "iterate", "align", "indices", "cancel"}
+    assert r.auto.coincident_removed == 0
+
+
+def test_auto_align_curvature():
+    # A fat torus: the smoothest cross field has singularities, the one that follows the principal
+    # directions (meridians and parallels) has none, and is solved exactly with none.
+    V, F = trivcon.make_torus(96, 24, R=1.0, r=0.4)
+    d = trivcon.FieldDesigner(V, F)
+    assert len(d.auto_singularities(N=4).singularities) > 0
+    a = d.auto_singularities(N=4, align_curvature=-2)
+    assert a.singularities == {} and a.seconds["align"] > 0
+    r = d.solve(N=4, singularities="auto", align_curvature=0)
+    assert r.singularities == {} and r.verified
+    with pytest.raises(trivcon.Error, match="need t < 1"):
+        d.auto_singularities(N=4, align_curvature=1)
+    with pytest.raises(trivcon.Error, match="needs an even N"):
+        d.auto_singularities(N=3, align_curvature=0)
+    with pytest.raises(trivcon.Error, match="align_curvature must be None or a number"):
+        d.auto_singularities(N=4, align_curvature="strong")
+    with pytest.raises(trivcon.Error, match="align_curvature needs singularities='auto'"):
+        d.solve(N=4, align_curvature=0)
 
 
 def test_auto_cancel_planted_pair():

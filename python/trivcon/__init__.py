@@ -554,7 +554,7 @@ class FieldDesigner:
         return out
 
     def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False, roots=None,
-              auto_cancel=0.0):
+              auto_cancel=0.0, align_curvature=None):
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
@@ -562,7 +562,8 @@ class FieldDesigner:
           multiple of 1/N), fractions.Fraction or "p/q" strings; vertices not listed have index 0. On
           every closed component the indices must sum to chi (Gauss-Bonnet). Boundary vertices cannot
           be singular. Or "auto": those of the globally smoothest field (auto_singularities, with
-          auto_cancel as its cancel distance and the same fixed faces), then the exact solve.
+          auto_cancel as its cancel distance, align_curvature as its curvature guidance and the same fixed
+          faces), then the exact solve.
         generators, boundary: {id: index} for generators and boundary loops (ids as num_generators and
           boundary_loops); those not given are chosen to make the field smoothest.
         fixed: {face: direction}, an angle in radians in the face's frame or a world vector (x, y, z)
@@ -578,11 +579,14 @@ class FieldDesigner:
         fixed_angles = self._fixed(fixed, align_boundary)
         auto = None
         if isinstance(singularities, str) and singularities == "auto":
-            auto = self.auto_singularities(N=N, cancel=auto_cancel, fixed=fixed, align_boundary=align_boundary)
+            auto = self.auto_singularities(N=N, cancel=auto_cancel, fixed=fixed, align_boundary=align_boundary,
+                                           align_curvature=align_curvature)
             vertex = dict(auto._a.vertex)
         else:
             if auto_cancel:
                 raise Error("auto_cancel needs singularities='auto'")
+            if align_curvature is not None:
+                raise Error("align_curvature needs singularities='auto'")
             vertex = _indices(singularities, N, "singularities")
         root_list = []
         for key, angle in _items(roots, "roots"):
@@ -594,16 +598,25 @@ class FieldDesigner:
                            root_list)
         return Result(self, r, auto)
 
-    def auto_singularities(self, N=1, cancel=0.0, cancel_absolute=False, iterations=8, fixed=None, align_boundary=False):
+    def auto_singularities(self, N=1, cancel=0.0, cancel_absolute=False, iterations=8, fixed=None, align_boundary=False,
+                           align_curvature=None):
         """Singularities found automatically: those of the globally smoothest N-field (Knoeppel et al. 2013).
 
         cancel: remove pairs of opposite singularities (+n, -n) at most this far apart along edges, closest
           first, in mean edge lengths (or in the mesh's units with cancel_absolute=True); 0: none.
         iterations: inverse-power iterations (default 8).
         fixed, align_boundary: faces held as in solve (Dirichlet values of the smoothest field).
+        align_curvature: None (no guidance), or the strength t < 1 with which the field follows the principal
+          curvature directions (N even; 0 as geometry-central, toward 1 smoother, negative closer to the
+          curvature), as `solve --auto --align curvature:t`.
         Returns an AutoResult; AutoResult.singularities go straight into solve(singularities=...).
         """
         N = _symmetry(N)
+        curvature_t = 0.0
+        if align_curvature is not None:
+            if isinstance(align_curvature, bool) or not isinstance(align_curvature, numbers.Real):
+                raise Error(f"align_curvature must be None or a number t < 1, got {align_curvature!r}")
+            curvature_t = float(align_curvature)
         try:
             cancel = float(cancel)
         except (TypeError, ValueError):
@@ -611,7 +624,8 @@ class FieldDesigner:
         if not (math.isfinite(cancel) and cancel >= 0):
             raise Error(f"singularity cancellation: invalid distance {cancel!r} (need a finite number >= 0)")
         fixed_angles = self._fixed(fixed, align_boundary)
-        return AutoResult(self._d.auto_singularities(N, int(iterations), cancel, bool(cancel_absolute), fixed_angles))
+        return AutoResult(self._d.auto_singularities(N, int(iterations), cancel, bool(cancel_absolute), fixed_angles,
+                                                     align_curvature is not None, curvature_t))
 
     def field_indices(self, directions, N=1):
         """{vertex: Fraction} of a per-face field (m, 3) on this mesh (as trivcon.field_indices)."""
@@ -817,9 +831,10 @@ class AutoResult:
       singularities  {vertex: Fraction} to prescribe (after cancellation)
       found          {vertex: Fraction} of the smoothest field, before cancellation
       pairs          [(vertex of +n, vertex of -n)] cancelled, in order
+      coincident_removed  singularities removed by summing over coincident vertices (auto.h)
       directions     float64 (m, 3), angles float64 (m,): the smoothest field itself (not the exact solve)
       energy         its Rayleigh quotient E(u) / |u|^2_M; vanishing_faces: faces where it vanished
-      seconds        per stage (assemble, factor, iterate, indices, cancel)
+      seconds        per stage (assemble, factor, iterate, align, indices, cancel)
     """
 
     def __init__(self, a):
@@ -843,6 +858,11 @@ class AutoResult:
     def found(self):
         """{vertex: Fraction}: the singularities of the smoothest field, before cancellation."""
         return _fractions(self._a.found, self.N)
+
+    @property
+    def coincident_removed(self):
+        """Singularities of `found` that summing the indices over coincident vertices removed."""
+        return self._a.coincident_removed
 
     @property
     def pairs(self):
