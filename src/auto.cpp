@@ -11,6 +11,7 @@
 #include <string>
 
 #include "detail/cholmod.h"
+#include "detail/supernodal.h"
 #include "detail/timing.h"
 #include "trivcon/curvature.h"
 #include "trivcon/design.h"
@@ -125,16 +126,23 @@ std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, cons
   detail::CholmodContext context;
   cholmod_common& c = *context;
   c.nmethods = 1;
-  // METIS nested dissection, not AMD: on the dual graph of a 400k-face sphere it needs 3.3 times fewer
-  // flops (2.1e9 against 7.0e9, CHOLMOD's count) and two thirds of the factor's entries (1.03e7 against
-  // 1.56e7), so the factorization and every iteration's substitutions are cheaper.
-  c.method[0].ordering = CHOLMOD_METIS;
+  // AMD, not METIS: on the dual graph of a 400k-face sphere METIS needs 3.3 times fewer flops (2.1e9 against
+  // 7.0e9, CHOLMOD's count) and two thirds of the factor's entries, but METIS_NodeND alone takes 1.7-2.1 s
+  // there, against 0.27 s for the whole AMD analysis; with the numeric factorization below (0.75 s after
+  // METIS, 1.5 s after AMD) and the 8 iterations, AMD's total was 2.8 s and METIS's 3.2 s (measured on a
+  // loaded machine whose set-up took 1.25 s).
+  c.method[0].ordering = CHOLMOD_AMD;
   c.postorder = 1;
+  c.supernodal = CHOLMOD_SUPERNODAL;  // the numeric factorization below fills a supernodal factor
   cholmod_sparse A = detail::upper_view_complex(outer, inner, values, n);
   std::unique_ptr<cholmod_factor, FactorDeleter> L(cholmod_analyze(&A, &c), FactorDeleter{&c});
   detail::require(L != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix", c);
-  const int ok = cholmod_factorize(&A, L.get(), &c);
-  detail::require(ok && c.status == CHOLMOD_OK, "automatic singularities: CHOLMOD could not factor the smoothest-field matrix", c);
+  // The numeric factor by trivcon's own supernodal code (src/detail/supernodal.h, the same that factors the
+  // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another,
+  // and took 3-4 times as long on the 400k-face sphere (2.8-3.1 s against 0.73-1.06 s after METIS).
+  if (const int minor = supernodal::factorize_complex(*L, outer, inner, values, c); minor < n)
+    throw Error("automatic singularities: the smoothest-field matrix is not positive definite (column " + std::to_string(minor) +
+                " of " + std::to_string(n) + "): a non-finite or degenerate weight");
   time.factor = seconds_since(t0);
 
   t0 = Clock::now();
@@ -201,12 +209,10 @@ std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, cons
         const double lambda = norm[comp] > 0 ? energy[comp] / norm[comp] : 0.0;
         values[2 * (outer[j + 1] - 1)] = diag[f] + (eps - o.curvature_t * lambda) * k.mass[f];
       }
-      const int refactored = cholmod_factorize(&A, L.get(), &c);
-      if (c.status == CHOLMOD_NOT_POSDEF)
+      if (supernodal::factorize_complex(*L, outer, inner, values, c) < n)
         throw Error("automatic singularities: curvature alignment with t = " + std::to_string(o.curvature_t) +
                     " makes the system indefinite (t must be below 1, and a little below 1 can already exceed the smallest "
                     "eigenvalue's estimate): use a smaller t");
-      detail::require(refactored && c.status == CHOLMOD_OK, "automatic singularities: CHOLMOD could not factor the alignment matrix", c);
     }
     for (int j = 0; j < n; ++j) {
       const int f = face_of[j], comp = t.face_component[f];

@@ -5,10 +5,12 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <exception>
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 
 #include "detail/parallel.h"
 #include "trivcon/blas.h"
@@ -23,6 +25,16 @@ void dgemm_(const char* transa, const char* transb, const int* m, const int* n, 
 void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n, const double* alpha,
             const double* a, const int* lda, double* b, const int* ldb);
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+// Complex (the smoothest-field matrix of trivcon/auto.h): std::complex<double> is layout-compatible with
+// Fortran's COMPLEX*16.
+void zherk_(const char* uplo, const char* trans, const int* n, const int* k, const double* alpha, const std::complex<double>* a,
+            const int* lda, const double* beta, std::complex<double>* c, const int* ldc);
+void zgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const std::complex<double>* alpha,
+            const std::complex<double>* a, const int* lda, const std::complex<double>* b, const int* ldb, const std::complex<double>* beta,
+            std::complex<double>* c, const int* ldc);
+void ztrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n,
+            const std::complex<double>* alpha, const std::complex<double>* a, const int* lda, std::complex<double>* b, const int* ldb);
+void zpotrf_(const char* uplo, const int* n, std::complex<double>* a, const int* lda, int* info);
 }
 
 namespace trivcon::supernodal {
@@ -36,19 +48,52 @@ namespace {
 constexpr double kBlasUpdateFlops = 8192;  // ndrow2 · ndrow1 · ndcol of one descendant's update
 constexpr int kBlasColumns = 24;           // columns of a supernode's own factorization
 
-using Block = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
-using ConstBlock = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+using Complex = std::complex<double>;
+double conj_if_complex(double a) { return a; }
+Complex conj_if_complex(Complex a) { return std::conj(a); }
 
-// The matrix permuted to factor order, lower triangle, by columns: column k holds its rows ≥ k.
+// The BLAS calls of one scalar type: the real symmetric (dsyrk, dgemm "T", dpotrf, dtrsm "T") or the complex
+// Hermitian ones (zherk, zgemm "C", zpotrf, ztrsm "C"), for LLᵀ and LLᴴ respectively.
+void blas_rank_update(int n, int k, const double* a, int lda, double* c, int ldc) {
+  const double one = 1, zero = 0;
+  dsyrk_("L", "N", &n, &k, &one, a, &lda, &zero, c, &ldc);
+}
+void blas_rank_update(int n, int k, const Complex* a, int lda, Complex* c, int ldc) {
+  const double one = 1, zero = 0;
+  zherk_("L", "N", &n, &k, &one, a, &lda, &zero, c, &ldc);
+}
+void blas_product(int m, int n, int k, const double* a, int lda, const double* b, int ldb, double* c, int ldc) {
+  const double one = 1, zero = 0;
+  dgemm_("N", "T", &m, &n, &k, &one, a, &lda, b, &ldb, &zero, c, &ldc);
+}
+void blas_product(int m, int n, int k, const Complex* a, int lda, const Complex* b, int ldb, Complex* c, int ldc) {
+  const Complex one = 1, zero = 0;
+  zgemm_("N", "C", &m, &n, &k, &one, a, &lda, b, &ldb, &zero, c, &ldc);
+}
+void lapack_cholesky(int n, double* a, int lda, int* info) { dpotrf_("L", &n, a, &lda, info); }
+void lapack_cholesky(int n, Complex* a, int lda, int* info) { zpotrf_("L", &n, a, &lda, info); }
+void blas_triangular_solve(int m, int n, const double* a, int lda, double* b, int ldb) {
+  const double one = 1;
+  dtrsm_("R", "L", "T", "N", &m, &n, &one, a, &lda, b, &ldb);
+}
+void blas_triangular_solve(int m, int n, const Complex* a, int lda, Complex* b, int ldb) {
+  const Complex one = 1;
+  ztrsm_("R", "L", "C", "N", &m, &n, &one, a, &lda, b, &ldb);
+}
+
+// The matrix permuted to factor order, lower triangle, by columns: column k holds its rows ≥ k (for a
+// Hermitian matrix, an upper entry that lands above the diagonal after the permutation is conjugated).
+template <class T>
 struct PermutedLower {
   std::vector<int> start, row;
-  std::vector<double> value;
+  std::vector<T> value;
 };
 
-PermutedLower permuted_lower(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
-                             const std::vector<int>& position) {
+template <class T>
+PermutedLower<T> permuted_lower(const std::vector<int>& outer, const std::vector<int>& inner, const T* values,
+                                const std::vector<int>& position) {
   const int n = static_cast<int>(position.size());
-  PermutedLower A;
+  PermutedLower<T> A;
   A.start.assign(static_cast<size_t>(n) + 1, 0);
   for (int c = 0; c < n; ++c)
     for (int k = outer[c]; k < outer[c + 1]; ++k) ++A.start[std::min(position[inner[k]], position[c]) + 1];
@@ -59,25 +104,31 @@ PermutedLower permuted_lower(const std::vector<int>& outer, const std::vector<in
     for (int k = outer[c]; k < outer[c + 1]; ++k) {
       const int i = position[inner[k]], j = position[c];
       const int q = fill[std::min(i, j)]++;
-      A.row[q] = std::max(i, j), A.value[q] = values[k];
+      A.row[q] = std::max(i, j), A.value[q] = i >= j ? values[k] : conj_if_complex(values[k]);
     }
   return A;
 }
 
 // Per thread: where each factor row sits in the supernode being computed, and the update buffer.
+template <class T>
 struct Workspace {
   std::vector<int> map, relative;
-  std::unique_ptr<double[]> update;  // not initialised: every update overwrites what it reads
+  std::unique_ptr<T[]> update;  // not initialised: every update overwrites what it reads
   size_t update_size = 0;
 };
 
+template <class T>
 class Numeric {
  public:
-  Numeric(const Supernodes& L, const std::vector<int>& owner, double* x, const PermutedLower& A)
+  using Matrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
+  using Block = Eigen::Map<Matrix, 0, Eigen::OuterStride<>>;
+  using ConstBlock = Eigen::Map<const Matrix, 0, Eigen::OuterStride<>>;
+
+  Numeric(const Supernodes& L, const std::vector<int>& owner, T* x, const PermutedLower<T>& A)
       : A_(A), L_(L), owner_(owner), x_(x), next_(L.count, -1), lpos_(L.count, 0) {}
 
-  Workspace workspace() const {
-    Workspace w;
+  Workspace<T> workspace() const {
+    Workspace<T> w;
     w.map.assign(owner_.size(), -1);
     int height = 0;
     for (int s = 0; s < L_.count; ++s) height = std::max(height, L_.height(s));
@@ -89,13 +140,13 @@ class Numeric {
   // then the Cholesky factor of its diagonal block and the triangular solve of the rows below; then
   // links s, in `head`, to the supernode of its first row below (its next update). Returns the factor
   // column where the matrix was found not positive definite, or −1.
-  int compute(int s, Workspace& w, std::vector<int>& head) {
+  int compute(int s, Workspace<T>& w, std::vector<int>& head) {
     const int k1 = L_.first(s), ncol = L_.cols(s), nrow = L_.height(s);
-    double* Ls = x_ + L_.px[s];
-    std::fill(Ls, Ls + static_cast<size_t>(nrow) * ncol, 0.0);
+    T* Ls = x_ + L_.px[s];
+    std::fill(Ls, Ls + static_cast<size_t>(nrow) * ncol, T(0));
     for (int i = 0; i < nrow; ++i) w.map[L_.row(s, i)] = i;
     for (int k = k1; k < k1 + ncol; ++k) {
-      double* column = Ls + static_cast<size_t>(k - k1) * nrow;
+      T* column = Ls + static_cast<size_t>(k - k1) * nrow;
       for (int q = A_.start[k]; q < A_.start[k + 1]; ++q) column[w.map[A_.row[q]]] += A_.value[q];
     }
     for (int d = head[s]; d != -1;) {
@@ -125,7 +176,7 @@ class Numeric {
  private:
   // Ls −= the part of descendant d's columns that falls in supernode s (columns up to k2 − 1, from the
   // row where d's last update stopped).
-  void update_from(int d, int k2, double* Ls, int nrow, Workspace& w) {
+  void update_from(int d, int k2, T* Ls, int nrow, Workspace<T>& w) {
     const int ndcol = L_.cols(d), ndrow = L_.height(d);
     const int first = lpos_[d];
     int last = first;
@@ -137,25 +188,25 @@ class Numeric {
     const size_t size = static_cast<size_t>(ndrow2) * ndrow1;
     if (size > w.update_size) {
       w.update.reset();
-      w.update.reset(new double[size]);
+      w.update.reset(new T[size]);
       w.update_size = size;
     }
-    const double* Ld = x_ + L_.px[d] + first;  // rows first … ndrow − 1 of d, leading dimension ndrow
-    double* C = w.update.get();                // ndrow2 × ndrow1, leading dimension ndrow2
+    const T* Ld = x_ + L_.px[d] + first;  // rows first … ndrow − 1 of d, leading dimension ndrow
+    T* C = w.update.get();                // ndrow2 × ndrow1, leading dimension ndrow2
     if (static_cast<double>(ndrow2) * ndrow1 * ndcol < kBlasUpdateFlops) {
       const ConstBlock below(Ld, ndrow2, ndcol, Eigen::OuterStride<>(ndrow));
-      Block(C, ndrow2, ndrow1, Eigen::OuterStride<>(ndrow2)).noalias() = below * below.topRows(ndrow1).transpose();
+      Block(C, ndrow2, ndrow1, Eigen::OuterStride<>(ndrow2)).noalias() = below * below.topRows(ndrow1).adjoint();
     } else {
-      const double one = 1, zero = 0;
-      dsyrk_("L", "N", &ndrow1, &ndcol, &one, Ld, &ndrow, &zero, C, &ndrow2);
+      // The Hermitian rank update fills the lower triangle of the top ndrow1 rows (its diagonal real).
+      blas_rank_update(ndrow1, ndcol, Ld, ndrow, C, ndrow2);
       const int ndrow3 = ndrow2 - ndrow1;
-      if (ndrow3 > 0) dgemm_("N", "T", &ndrow3, &ndrow1, &ndcol, &one, Ld + ndrow1, &ndrow, Ld, &ndrow, &zero, C + ndrow1, &ndrow2);
+      if (ndrow3 > 0) blas_product(ndrow3, ndrow1, ndcol, Ld + ndrow1, ndrow, Ld, ndrow, C + ndrow1, ndrow2);
     }
     int* relative = w.relative.data();
     for (int i = 0; i < ndrow2; ++i) relative[i] = w.map[L_.row(d, first + i)];
     for (int j = 0; j < ndrow1; ++j) {
-      double* column = Ls + static_cast<size_t>(relative[j]) * nrow;  // rows k1 … k2 − 1 are s's own columns
-      const double* c = C + static_cast<size_t>(j) * ndrow2;
+      T* column = Ls + static_cast<size_t>(relative[j]) * nrow;  // rows k1 … k2 − 1 are s's own columns
+      const T* c = C + static_cast<size_t>(j) * ndrow2;
       for (int i = j; i < ndrow2; ++i) column[relative[i]] -= c[i];
     }
   }
@@ -170,40 +221,42 @@ class Numeric {
 
   // Cholesky factor of the ncol × ncol diagonal block of the nrow × ncol panel, and the rows below
   // divided by it. Returns the panel column that is not positive, or −1.
-  static int factor_panel(double* panel, int nrow, int ncol) {
+  // (For a Hermitian matrix the diagonal's real part is what is tested and factored; its imaginary part is
+  // zero in exact arithmetic and is dropped.)
+  static int factor_panel(T* panel, int nrow, int ncol) {
     if (ncol < kBlasColumns) {
       for (int j = 0; j < ncol; ++j) {
-        double* cj = panel + static_cast<size_t>(j) * nrow;
-        if (!(cj[j] > 0) || !std::isfinite(cj[j])) return j;
-        const double d = std::sqrt(cj[j]);
+        T* cj = panel + static_cast<size_t>(j) * nrow;
+        const double pivot = std::real(cj[j]);
+        if (!(pivot > 0) || !std::isfinite(pivot)) return j;
+        const double d = std::sqrt(pivot);
         cj[j] = d;
         const double inv = 1 / d;
         for (int i = j + 1; i < nrow; ++i) cj[i] *= inv;
         for (int k = j + 1; k < ncol; ++k) {
-          double* ck = panel + static_cast<size_t>(k) * nrow;
-          const double f = cj[k];
+          T* ck = panel + static_cast<size_t>(k) * nrow;
+          const T f = conj_if_complex(cj[k]);
           for (int i = k; i < nrow; ++i) ck[i] -= cj[i] * f;
         }
       }
       return -1;
     }
     int info = 0;
-    dpotrf_("L", &ncol, panel, &nrow, &info);
+    lapack_cholesky(ncol, panel, nrow, &info);
     if (info > 0) return info - 1;
     for (int j = 0; j < ncol; ++j) {
-      const double d = panel[static_cast<size_t>(j) * nrow + j];
+      const double d = std::real(panel[static_cast<size_t>(j) * nrow + j]);
       if (!(d > 0) || !std::isfinite(d)) return j;
     }
     const int below = nrow - ncol;
-    const double one = 1;
-    if (below > 0) dtrsm_("R", "L", "T", "N", &below, &ncol, &one, panel, &nrow, panel + ncol, &nrow);
+    if (below > 0) blas_triangular_solve(below, ncol, panel, nrow, panel + ncol, nrow);
     return -1;
   }
 
-  const PermutedLower& A_;
+  const PermutedLower<T>& A_;
   const Supernodes& L_;
   const std::vector<int>& owner_;
-  double* x_;                     // L_.x, written
+  T* x_;                          // L_.x, written
   std::vector<int> next_, lpos_;  // a linked list's next, and where each supernode's next update starts
 };
 
@@ -267,19 +320,23 @@ std::vector<int> supernode_parents(const Supernodes& L, const std::vector<int>& 
   return parent;
 }
 
-int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
-              cholmod_common& c) {
+namespace {
+
+template <class T>
+int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const T* values, cholmod_common& c) {
   const int n = static_cast<int>(L.n);
   if (!L.is_super) throw Error("internal: the numeric factorization needs a supernodal symbolic factor");
   // The super, pi, px and s arrays are read as int (CHOLMOD's int API; src/detail/cholmod.h checks the version).
   if (L.itype != CHOLMOD_INT) throw Error("internal: the numeric factorization needs a factor of CHOLMOD's int API");
-  // Allocates the values (L.xsize) and marks L numeric LLᵀ, as cholmod_super_numeric does.
-  if (!cholmod_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, &L, &c) || L.x == nullptr)
+  // Allocates the values (L.xsize entries of T, interleaved for complex) and marks L numeric LLᵀ (LLᴴ), as
+  // cholmod_super_numeric does.
+  const int xtype = std::is_same<T, double>::value ? CHOLMOD_REAL : CHOLMOD_COMPLEX;
+  if (!cholmod_change_factor(xtype, 1, 1, 1, 1, &L, &c) || L.x == nullptr)
     throw Error("CHOLMOD could not allocate the factor (status " + std::to_string(c.status) + ")");
   const int* perm = static_cast<const int*>(L.Perm);
   std::vector<int> position(n);
   for (int k = 0; k < n; ++k) position[perm[k]] = k;
-  const PermutedLower A = permuted_lower(outer, inner, values, position);
+  const PermutedLower<T> A = permuted_lower(outer, inner, values, position);
 
   const Supernodes S(&L);
   const std::vector<int> owner = S.owners();
@@ -290,7 +347,7 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
   }
   const TreeSplit split = split_tree(supernode_parents(S, owner), work, 1e5, detail::max_threads());
   const int parts = static_cast<int>(split.part.size());
-  Numeric numeric(S, owner, static_cast<double*>(L.x), A);
+  Numeric<T> numeric(S, owner, static_cast<T*>(L.x), A);
   // Below the top, one thread per part (OpenMP's thread count): a subtree needs only its own descendants. Each thread keeps its own
   // lists of pending updates (`head`); its lists for the supernodes of the top are handed over when both
   // are done. Then the top, one supernode at a time, with OpenBLAS's threads inside the large dense
@@ -309,7 +366,7 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
     for (int k = 0; k < parts; ++k) {
       try {
         head[k].assign(L.nsuper, -1);
-        Workspace w = numeric.workspace();
+        Workspace<T> w = numeric.workspace();
         for (int s : split.part[k])
           if ((failed[k] = numeric.compute(s, w, head[k])) >= 0) break;
       } catch (...) {  // an exception must not leave an OpenMP region
@@ -326,7 +383,7 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
     std::vector<int> top_head(L.nsuper, -1);
     for (int t : split.top)
       for (auto& h : head) numeric.move_list(t, h, top_head);
-    Workspace w = numeric.workspace();
+    Workspace<T> w = numeric.workspace();
     for (int t : split.top)
       if (const int f = numeric.compute(t, w, top_head); f >= 0) {
         minor = f;
@@ -335,6 +392,18 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
   }
   L.minor = static_cast<size_t>(minor);
   return minor;
+}
+
+}  // namespace
+
+int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
+              cholmod_common& c) {
+  return factorize_as<double>(L, outer, inner, values.data(), c);
+}
+
+int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
+                      cholmod_common& c) {
+  return factorize_as<Complex>(L, outer, inner, reinterpret_cast<const Complex*>(values.data()), c);
 }
 
 }  // namespace trivcon::supernodal

@@ -22,7 +22,8 @@
 // - The smoothest unit field minimises E(u) / ‖u‖²_M: the eigenvector of the smallest eigenvalue of
 //   A u = λ M u. It is computed per component by inverse-power iterations (x ← (A + εM)⁻¹ M x,
 //   normalised per component to ‖x‖_M = 1, from a fixed pseudo-random start) on ONE supernodal CHOLMOD
-//   factorization (METIS ordering) of A + εM, ε = 1e-8 × Σ_f A_ff / Σ_f m_f (a tiny shift: A alone is
+//   factorization (AMD ordering; the numeric factor by trivcon's own supernodal code on
+//   all threads) of A + εM, ε = 1e-8 × Σ_f A_ff / Σ_f m_f (a tiny shift: A alone is
 //   singular when the N-th power of the holonomy is trivial, e.g. on a flat torus).
 // - Why face-based: the field lives per face like trivcon's own fields and their indices are read by
 //   the same field_indices (trivcon/field.h), so the singularities are exactly those of the field that

@@ -63,5 +63,10 @@ std::vector<int> supernode_parents(const Supernodes& L, const std::vector<int>& 
 // CHOLMOD cannot allocate the factor.
 int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
               cholmod_common& c);
+// The same for a Hermitian matrix (LLᴴ): `values` holds (real, imaginary) pairs, entry k at 2k, 2k + 1, as
+// CHOLMOD's complex (interleaved) storage; the factor becomes CHOLMOD_COMPLEX, so cholmod_solve reads it.
+// Used by the smoothest field of trivcon/auto.h.
+int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
+                      cholmod_common& c);
 
 }  // namespace trivcon::supernodal
