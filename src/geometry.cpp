@@ -182,7 +182,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   std::vector<double> component_length(nC, 0), component_epsilon(nC, 0);
   std::vector<int> component_edges(nC, 0);
   for (int e = 0; e < nE; ++e) {
-    const int c = t.face_component[t.edge_faces(e, 0)];
+    const int c = t.face_component[t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1)];  // a boundary edge may have no L
     component_length[c] += length[e], ++component_edges[c];
   }
   // Each face's shortfall from the margin (in parallel), then the largest per component.
