@@ -37,6 +37,7 @@
 #include "trivcon/generate.h"
 #include "trivcon/indices.h"
 #include "trivcon/io.h"
+#include "trivcon/matching.h"
 #include "trivcon/render.h"
 
 namespace py = pybind11;
@@ -223,6 +224,23 @@ struct DesignResult {
       X(k) = design.connection.x(interior[k]);
     }
     return py::make_tuple(edges, x);
+  }
+
+  // The connection's matching (trivcon/matching.h) per interior edge, in the same order as connection().
+  Int64Array matching() const {
+    const Topology& t = state->topology();
+    Eigen::VectorXi m;
+    {
+      py::gil_scoped_release release;
+      m = connection_matching(t, state->geometry(), design.field, design.connection.x);
+    }
+    std::vector<int> interior;
+    for (int e : state->sorted_edges)
+      if (!t.is_boundary_edge(e)) interior.push_back(e);
+    Int64Array out(static_cast<py::ssize_t>(interior.size()));
+    auto M = out.mutable_unchecked<1>();
+    for (size_t k = 0; k < interior.size(); ++k) M(k) = m[interior[k]];
+    return out;
   }
 };
 
@@ -613,6 +631,15 @@ PYBIND11_MODULE(_core, m) {
           [](const DesignResult& r, const std::string& path) {
             py::gil_scoped_release release;
             write_connection(path, r.state->topology(), r.design.connection.x, r.prescription.N);
+          },
+          py::arg("path"))
+      .def("matching", &DesignResult::matching)
+      .def(
+          "write_matching",
+          [](const DesignResult& r, const std::string& path) {
+            py::gil_scoped_release release;
+            const Topology& t = r.state->topology();
+            write_matching(path, t, connection_matching(t, r.state->geometry(), r.design.field, r.design.connection.x), r.prescription.N);
           },
           py::arg("path"))
       .def(

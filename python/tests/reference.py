@@ -113,6 +113,22 @@ class Mesh:
         return {int(v): Fraction(int(n[v]), N) for v in np.flatnonzero(self.interior_vertex & (n != 0))}
 
 
+def indices_with_matching(mesh, directions, N, edges, matching):
+    """{vertex: Fraction} of a per-face field read with a given matching (trivcon/matching.h): per interior
+    edge (rows of `edges`), d = beta_R + 2 pi m / N - beta_L - rho in (-pi, pi]; index (K + sum s d) / 2 pi."""
+    beta = mesh.angles_of(directions)
+    index = {tuple(e): k for k, e in enumerate(np.asarray(edges))}
+    m = np.array([matching[index[tuple(e)]] for e in mesh.interior_edges], dtype=float)
+    d = wrap(beta[mesh.R] + TWO_PI * m / N - beta[mesh.L] - mesh.rho)
+    total = np.zeros(mesh.V.shape[0])
+    np.add.at(total, mesh.interior_edges[:, 1], d)
+    np.add.at(total, mesh.interior_edges[:, 0], -d)
+    raw = (mesh.defect + total) / TWO_PI * N
+    n = np.rint(raw)
+    assert np.abs(raw - n)[mesh.interior_vertex].max() < 1e-6
+    return {int(v): Fraction(int(n[v]), N) for v in np.flatnonzero(mesh.interior_vertex & (n != 0))}
+
+
 def valence(F, num_vertices):
     count = np.zeros(num_vertices, dtype=np.int64)
     np.add.at(count, np.asarray(F).ravel(), 1)

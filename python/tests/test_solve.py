@@ -293,3 +293,28 @@ def test_designer_arrays(cube):
     assert np.array_equal(d.V, V)
     assert "FieldDesigner" in repr(d) and "verified" in repr(d.solve(N=4, singularities={v: "1/4" for v in corners}))
     assert set(d.timings) >= {"topology", "geometry", "setup", "prepare"}
+
+
+def test_matching_reads_exactly_the_prescription(tmp_path):
+    # A coarse sphere with all of its index at one vertex: the connection turns by pi/N or more next to it,
+    # so the closest (principal) matching misreads the field there; our matching reads the prescription.
+    V, F = trivcon.make_icosphere(1)
+    d = trivcon.FieldDesigner(V, F)
+    r = d.solve(N=4, singularities={0: 2})
+    assert r.large_turn_edges > 0
+    ref = reference.Mesh(V, F)
+    assert ref.field_indices(r.directions, 4) != {0: Fraction(2)}
+    m = r.matching
+    assert m.dtype == np.int64 and m.shape == (len(r.edges),) and ((m >= 0) & (m < 4)).all()
+    assert reference.indices_with_matching(ref, r.directions, 4, r.edges, m) == {0: Fraction(2)}
+    # The file: Directional's .matching ("N E" then "L R i j m" rows), the same numbers.
+    path = tmp_path / "field.matching"
+    r.write_matching(path)
+    lines = path.read_text().split("\n")
+    assert lines[0].split()[0] == "4"
+    rows = {}
+    for line in lines[1:]:
+        parts = line.split()
+        if len(parts) == 5:
+            rows[(int(parts[2]), int(parts[3]))] = int(parts[4])
+    assert rows == {(int(i), int(j)): int(k) for (i, j), k in zip(r.edges, m)}

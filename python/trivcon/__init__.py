@@ -809,6 +809,17 @@ class Result:
         """Write the connection as --connection-out does ("i j x" per interior edge, sorted)."""
         self._r.write_connection(str(path))
 
+    @property
+    def matching(self):
+        """int64 (E,): per edge of `edges`, the whole number m in [0, N) of 2 pi / N turns our connection uses
+        between the two faces' first directions (trivcon/matching.h; what --matching-out writes): a tool
+        given this matching instead of computing the closest one reads exactly our singularities."""
+        return self._r.matching()
+
+    def write_matching(self, path):
+        """Write the matching as --matching-out does (Directional's .matching format)."""
+        self._r.write_matching(str(path))
+
     def write_lines(self, path):
         """Write an OBJ with a segment per face and direction, as --lines-out does."""
         self._r.write_lines(str(path))
