@@ -103,7 +103,10 @@ class Mesh:
     def field_indices(self, directions, N):
         """{vertex: Fraction} of a per-face field: jumps reduced to (-pi/N, pi/N], index (K + sum s d) / 2 pi."""
         beta = self.angles_of(directions)
-        jump = reduce(beta[self.R] - beta[self.L] - self.rho, N)
+        return self.indices_from_jumps(reduce(beta[self.R] - beta[self.L] - self.rho, N), N)
+
+    def indices_from_jumps(self, jump, N):
+        """{vertex: Fraction}: (K + sum s d) / 2 pi from the jumps d per interior edge (a whole multiple of 1/N)."""
         total = np.zeros(self.V.shape[0])
         np.add.at(total, self.interior_edges[:, 1], jump)
         np.add.at(total, self.interior_edges[:, 0], -jump)
@@ -119,14 +122,7 @@ def indices_with_matching(mesh, directions, N, edges, matching):
     beta = mesh.angles_of(directions)
     index = {tuple(e): k for k, e in enumerate(np.asarray(edges))}
     m = np.array([matching[index[tuple(e)]] for e in mesh.interior_edges], dtype=float)
-    d = wrap(beta[mesh.R] + TWO_PI * m / N - beta[mesh.L] - mesh.rho)
-    total = np.zeros(mesh.V.shape[0])
-    np.add.at(total, mesh.interior_edges[:, 1], d)
-    np.add.at(total, mesh.interior_edges[:, 0], -d)
-    raw = (mesh.defect + total) / TWO_PI * N
-    n = np.rint(raw)
-    assert np.abs(raw - n)[mesh.interior_vertex].max() < 1e-6
-    return {int(v): Fraction(int(n[v]), N) for v in np.flatnonzero(mesh.interior_vertex & (n != 0))}
+    return mesh.indices_from_jumps(wrap(beta[mesh.R] + TWO_PI * m / N - beta[mesh.L] - mesh.rho), N)
 
 
 def valence(F, num_vertices):
