@@ -79,7 +79,7 @@ void register_check(CLI::App& app) {
   auto* check = app.add_subcommand(
       "check", "Compute the indices of a per-face field (any tool's); with -s/--sing, compare them with that prescription");
   check->add_option("mesh", c.mesh, "Mesh file")->required();
-  check->add_option("field", c.field, "Field: trivcon's .txt or .ply, or Directional's .rawfield")->required();
+  check->add_option("field", c.field, "Field: trivcon's .txt or .ply, Directional's .rawfield or QuadWild's .rosy")->required();
   c.prescription.add_to(check, false);
   check->add_option("--matching", c.matching,
                     "Matching file (.matching, as solve --matching-out writes): pair the faces' directions as it says instead of by the "

@@ -3,6 +3,7 @@
 #include <tuple>
 
 #include "commands.h"
+#include "feature_options.h"
 #include "trivcon/cycles.h"
 #include "trivcon/error.h"
 #include "trivcon/field_io.h"
@@ -19,6 +20,7 @@ struct RenderCommand {
   std::vector<std::string> sing_files, sings;
   double spacing = 11;
   bool flat = false, no_legend = false;
+  FeatureOptions features;  // sharp edges to draw
 };
 
 // Two numbers separated by `separator` ("1200x900", "30,20"), each parsed whole by `parse` (std::stoi,
@@ -86,6 +88,7 @@ void run_render(const RenderCommand& c) {
   o.glyph_spacing = c.spacing;
   o.smooth_shading = !c.flat;
   o.legend = !c.no_legend;
+  o.sharp_edges = c.features.edges(mesh.V, t, g);
   if (o.style == FieldStyle::Streamlines || !c.streamlines_out.empty()) {
     const std::vector<Streamline> lines = trace_streamlines(mesh.V, t, g, field, singularities, render_streamline_options(mesh.V, t, o));
     if (!c.streamlines_out.empty()) write_streamlines_obj(c.streamlines_out, lines);
@@ -103,7 +106,7 @@ void register_render(CLI::App& app) {
   static RenderCommand c;
   auto* cmd = app.add_subcommand("render", "Draw a field on its surface to a PNG (hedgehog glyphs or streamlines)");
   cmd->add_option("mesh", c.mesh, "Mesh file: .obj .off .ply, optionally .gz")->required();
-  cmd->add_option("--field", c.field, "Field: trivcon's .txt or .ply, or Directional's .rawfield")->required();
+  cmd->add_option("--field", c.field, "Field: trivcon's .txt or .ply, Directional's .rawfield or QuadWild's .rosy")->required();
   cmd->add_option("-o,--output", c.output, "PNG to write")->required();
   cmd->add_option("-N,--symmetry", c.N, "Symmetry N (default: the field file's)")->check(CLI::Range(1, 1000));
   cmd->add_option("-s,--singularities", c.sing_files, "Singularity file to mark (default: the field's own singular vertices)");
@@ -116,6 +119,7 @@ void register_render(CLI::App& app) {
   cmd->add_option("--streamlines-out", c.streamlines_out, "Also write the streamlines as OBJ polylines");
   cmd->add_flag("--flat", c.flat, "Flat shading (one normal per face)");
   cmd->add_flag("--no-legend", c.no_legend, "Leave out the legend");
+  c.features.add_to(cmd, "drawn as lines");
   cmd->callback([] { run_render(c); });
 }
 

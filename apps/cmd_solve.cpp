@@ -10,6 +10,7 @@
 
 #include "batch.h"
 #include "commands.h"
+#include "feature_options.h"
 #include "outputs.h"
 #include "prescription_options.h"
 #include "report.h"
@@ -18,6 +19,7 @@
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
+#include "trivcon/features.h"
 #include "trivcon/generate.h"
 #include "trivcon/matching.h"
 #include "trivcon/field_io.h"
@@ -34,6 +36,7 @@ struct SolveOptions {
   std::vector<double> root_angles;
   std::vector<std::string> fixes;
   bool align_boundary = false;
+  FeatureOptions features;  // --align-features, --features
   std::string sing_batch;
   bool auto_place = false;  // --auto
   double auto_cancel = 0;   // --auto-cancel, in mean edge lengths
@@ -77,12 +80,61 @@ std::string fmt(double v) {
   return s.str();
 }
 
+// --align-features / --features: every face beside a sharp edge fixed to it (trivcon/features.h), over
+// --align-boundary on the same face (--fix, merged later, wins over both). Returns the sharp edges; when
+// `extra` is given, reports what was fixed there and in `summary` (printed after the mesh's lines), and
+// warns of every corner conflict.
+std::vector<int> apply_features(const SolveOptions& o, const FieldDesigner& designer, IndexPrescription& prescription,
+                                nlohmann::ordered_json* extra, std::string* summary) {
+  if (!o.features.given()) return {};
+  const Topology& t = designer.topology();
+  const std::vector<int> edges = o.features.edges(designer.V(), t, designer.geometry());
+  const FeatureAlignment a = feature_alignment(designer.V(), t, designer.geometry(), edges, prescription.N);
+  int boundary_overridden = 0;  // faces --align-boundary fixed to another direction (modulo 2π/N)
+  for (auto [f, angle] : a.fixed) {
+    const auto it = prescription.fixed.find(f);
+    if (it != prescription.fixed.end() && std::abs(reduce_angle(it->second - angle, prescription.N)) > kFeatureAngleTolerance)
+      ++boundary_overridden;
+    prescription.fixed[f] = angle;
+  }
+  if (!extra) return edges;
+  int convex = 0;
+  for (int e : edges) convex += is_convex_edge(designer.V(), t, designer.geometry(), e);
+  nlohmann::ordered_json conflicts = nlohmann::ordered_json::array();
+  for (const FeatureConflict& c : a.conflicts)
+    conflicts.push_back({{"face", c.face},
+                         {"followed", {t.edge_vertices(c.followed, 0), t.edge_vertices(c.followed, 1)}},
+                         {"other", {t.edge_vertices(c.other, 0), t.edge_vertices(c.other, 1)}},
+                         {"difference", c.difference}});
+  (*extra)["features"] = {{"sharp_edges", edges.size()},    {"convex", convex},       {"fixed_faces", a.fixed.size()},
+                          {"corner_faces", a.corner_faces}, {"conflicts", conflicts}, {"boundary_overridden", boundary_overridden}};
+  if (o.features.degrees_option->count() > 0) (*extra)["features"]["degrees"] = o.features.degrees;
+  if (o.features.file_option->count() > 0) (*extra)["features"]["file"] = o.features.file;
+  std::ostringstream text;
+  text << "features: " << edges.size() << " sharp edges (" << convex << " convex), " << a.fixed.size() << " faces fixed beside them, "
+       << a.corner_faces << " beside two or more\n";
+  if (boundary_overridden > 0)
+    text << "features: " << boundary_overridden << " faces beside both a boundary edge and a sharp edge follow the sharp edge\n";
+  *summary = text.str();
+  if (!a.conflicts.empty()) {
+    double worst = 0;
+    for (const FeatureConflict& c : a.conflicts) worst = std::max(worst, c.difference);
+    std::cerr << "trivcon: warning: " << a.conflicts.size()
+              << " face-edge pairs at corners where sharp edges meet that a field of N = " << prescription.N
+              << " cannot follow both (largest difference " << fmt(worst) << " rad); each such face follows its longest sharp edge";
+    const FeatureConflict& c = a.conflicts.front();
+    std::cerr << " (e.g. face " << c.face << " follows (" << t.edge_vertices(c.followed, 0) << ", " << t.edge_vertices(c.followed, 1)
+              << "), not (" << t.edge_vertices(c.other, 0) << ", " << t.edge_vertices(c.other, 1) << "); report: features.conflicts)\n";
+  }
+  return edges;
+}
+
 // Solves one prescription on the prepared designer, writes its outputs, prints its summary; returns
 // whether verification passed.
 // `extra` holds report entries of the whole run (the "auto" or "sing_from_field" object), added to the report.
 bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& designer, const IndexPrescription& prescription,
                const std::vector<std::pair<int, double>>& roots, const std::string& name, double read_seconds,
-               const nlohmann::ordered_json& extra) {
+               const nlohmann::ordered_json& extra, const std::vector<int>& sharp) {
   const Design d = designer.design(prescription, roots);
   const Connection& c = d.connection;
 
@@ -93,7 +145,7 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
 
   auto t1 = Clock::now();
   StagedOutputs staged;
-  stage_design_outputs(staged, o.out, name, mesh, designer, prescription, d);
+  stage_design_outputs(staged, o.out, name, mesh, designer, prescription, d, sharp);
   const ReportRun run{o.mesh, name, o.weights, o.solver, o.align_boundary, read_seconds, seconds_since(t1), ok};
   if (!o.out.report.empty()) {
     nlohmann::ordered_json report = solve_report(run, mesh, designer, prescription, d);
@@ -158,6 +210,9 @@ void run_solve(const SolveOptions& o) {
   options.factorization = o.factorization == "cholmod" ? Factorization::Cholmod : Factorization::Parallel;
   FieldDesigner designer(mesh.V, mesh.F, options);
   if (o.align_boundary) prescription.fixed = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
+  nlohmann::ordered_json extra = nlohmann::ordered_json::object();
+  std::string features_summary;
+  std::vector<int> sharp = apply_features(o, designer, prescription, &extra, &features_summary);
   std::map<int, double> explicit_fixed;  // --fix wins over --align-boundary on the same face
   for (const auto& f : o.fixes) {
     if (is_fix_spec(f))
@@ -178,14 +233,14 @@ void run_solve(const SolveOptions& o) {
               << t.boundary_loops.size() << " boundary loop(s)\n"
               << "time: read " << fmt(read_seconds) << " s, prepared in " << fmt(pt.prepare) << " s (topology " << fmt(pt.topology)
               << " s, geometry " << fmt(pt.geometry) << " s, cycles " << fmt(pt.cycles) << " s, plan " << fmt(pt.plan) << " s, setup "
-              << fmt(pt.setup) << " s)\n";
+              << fmt(pt.setup) << " s)\n"
+              << features_summary;
   // Singularities found for the user: from the smoothest field (--auto), or from another field's indices.
-  nlohmann::ordered_json extra = nlohmann::ordered_json::object();
   if (o.auto_place) {
     AutoOptions ao;
     ao.N = prescription.N;
     ao.cancel_distance = o.auto_cancel;
-    ao.fixed = prescription.fixed;  // --align-boundary and --fix: Dirichlet values of the smoothest field
+    ao.fixed = prescription.fixed;  // --align-boundary, --align-features and --fix: Dirichlet values of the smoothest field
     if (!o.align.empty()) ao.align_curvature = true, ao.curvature_t = *alignment_strength(o.align);  // checked by CLI11
     const AutoResult r = auto_singularities(designer, ao);
     prescription.vertex = r.vertex;
@@ -224,6 +279,8 @@ void run_solve(const SolveOptions& o) {
     if (!prescription.generator.empty() || !prescription.loop.empty())
       throw Error(
           "--split-large-turns makes new generators and boundary loops: leave their indices to be chosen (no --generator, --boundary)");
+    if (o.features.file_option->count() > 0)
+      throw Error("--split-large-turns splits edges, which a --features file names by their vertices: use --align-features instead");
     std::map<int, Eigen::Vector3d> fixed_world;  // --fix directions in world space, per input face
     for (auto [f, angle] : explicit_fixed) fixed_world[f] = designer.geometry().direction_in_face(f, angle);
     const FieldDesigner* current = &designer;
@@ -258,6 +315,7 @@ void run_solve(const SolveOptions& o) {
       current = refined_designer.get();
       p.fixed.clear();
       if (o.align_boundary) p.fixed = boundary_alignment(current->V(), current->topology(), current->geometry());
+      sharp = apply_features(o, *current, p, nullptr, nullptr);  // the split faces beside a sharp edge are fixed to it again
       for (int f = 0; f < static_cast<int>(parent.size()); ++f) {
         const auto it = fixed_world.find(parent[f]);
         if (it != fixed_world.end()) p.fixed[f] = current->geometry().angle_in_face(f, it->second);
@@ -284,7 +342,7 @@ void run_solve(const SolveOptions& o) {
 
   bool ok = true;
   if (batch.empty()) {
-    ok = solve_one(o, out_mesh, out_designer, prescription, roots, "", read_seconds, extra);
+    ok = solve_one(o, out_mesh, out_designer, prescription, roots, "", read_seconds, extra, sharp);
   } else {
     for (BatchItem& item : batch) {  // check every item before writing anything
       item.prescription.fixed = prescription.fixed;
@@ -294,7 +352,7 @@ void run_solve(const SolveOptions& o) {
         throw Error("batch item '" + item.name + "': " + e.what());
       }
     }
-    for (const BatchItem& item : batch) ok &= solve_one(o, mesh, designer, item.prescription, roots, item.name, read_seconds, extra);
+    for (const BatchItem& item : batch) ok &= solve_one(o, mesh, designer, item.prescription, roots, item.name, read_seconds, extra, sharp);
   }
   if (!ok) exit_code = kVerificationFailed;
 }
@@ -316,6 +374,7 @@ void register_solve(CLI::App& app) {
                   "Fixed direction: F:x,y,z (world, projected to the face), F:angle=A (radians, face frame), or a file with "
                   "'FACE x y z' / 'FACE angle=A' lines; repeatable");
   cmd->add_flag("--align-boundary", o.align_boundary, "Fix every face with a boundary edge to that edge's direction");
+  o.features.add_to(cmd, "every face beside one is fixed to its direction (with --auto too)");
   auto* batch =
       cmd->add_option("--sing-batch", o.sing_batch,
                       "Solve many singularity sets with one factorization: a directory of singularity files, or a JSON-lines file; "
@@ -342,7 +401,11 @@ void register_solve(CLI::App& app) {
   from_field->excludes(o.prescription.files_option)->excludes(o.prescription.sing_option)->excludes(batch);
   cmd->add_option("--root-face", o.root_faces, "Face where propagation starts (one per component at most; repeatable)");
   cmd->add_option("--root-angle", o.root_angles, "Angle (radians, in the root face's frame) of the field at the matching --root-face");
-  cmd->add_option("--field-out", o.out.field, "Field file: .txt (x y z per face), .rawfield (Directional) or .ply");
+  cmd->add_option("--field-out", o.out.field,
+                  "Field file: .txt (x y z per face), .rawfield (Directional), .rosy (QuadWild, N = 4) or .ply");
+  cmd->add_option(
+      "--sharp-out", o.out.sharp,
+      "QuadWild .sharp file of the sharp edges (--align-features / --features): 'convexity,face,edge' for each face beside one");
   cmd->add_option("--connection-out", o.out.connection, "Connection file: 'i j x' per interior edge");
   cmd->add_option("--lines-out", o.out.lines, "OBJ with a short segment per face and direction");
   cmd->add_flag("--split-large-turns", o.split_large_turns,
@@ -362,7 +425,14 @@ void register_solve(CLI::App& app) {
                   "Verification limit on the holonomy residuals, transport and fixed faces, relative to max(1, right-hand sides) "
                   "(default 1e-9); a solve that misses it exits 3 and says why")
       ->check(CLI::PositiveNumber);
-  cmd->callback([] { run_solve(o); });
+  cmd->callback([] {
+    // Usage errors (exit 2) found before any work.
+    if (!o.out.sharp.empty() && !o.features.given()) throw CLI::ValidationError("--sharp-out", "needs --align-features or --features");
+    const std::string& field = o.out.field;
+    if (field.size() >= 5 && field.compare(field.size() - 5, 5, ".rosy") == 0 && o.prescription.N != 4)
+      throw CLI::ValidationError("--field-out", "a .rosy field (QuadWild) is a cross field: give -N 4");
+    run_solve(o);
+  });
 }
 
 }  // namespace trivcon::cli

@@ -7,6 +7,7 @@
 #include <system_error>
 
 #include "trivcon/error.h"
+#include "trivcon/features.h"
 #include "trivcon/field_io.h"
 #include "trivcon/render.h"
 
@@ -54,7 +55,8 @@ StagedOutputs::~StagedOutputs() {
 }
 
 void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const std::string& name, const MeshData& mesh,
-                          const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d) {
+                          const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d,
+                          const std::vector<int>& sharp) {
   const Geometry& g = designer.geometry();
   if (!paths.field.empty())
     staged.write(output_path(paths.field, name), [&](const std::string& path) { write_field(path, mesh.V, mesh.F, g, d.field); });
@@ -79,10 +81,18 @@ void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const
   if (!paths.singularities.empty())
     staged.write(output_path(paths.singularities, name),
                  [&](const std::string& path) { write_singularities(path, prescription.vertex, prescription.N); });
+  if (!paths.sharp.empty())
+    staged.write(output_path(paths.sharp, name), [&](const std::string& path) {
+      std::vector<char> convex;
+      for (int e : sharp) convex.push_back(is_convex_edge(designer.V(), designer.topology(), g, e));
+      write_sharp(path, mesh.F, designer.topology(), sharp, convex);
+    });
   if (!paths.png.empty()) {  // the prescription's singularities, drawn with the default view of `trivcon render`
     std::vector<std::pair<int, int>> singular(prescription.vertex.begin(), prescription.vertex.end());
+    RenderOptions ro;
+    ro.sharp_edges = sharp;
     staged.write(output_path(paths.png, name),
-                 [&](const std::string& path) { write_png(path, render_field(mesh.V, designer.topology(), g, d.field, singular)); });
+                 [&](const std::string& path) { write_png(path, render_field(mesh.V, designer.topology(), g, d.field, singular, ro)); });
   }
 }
 

@@ -16,6 +16,7 @@ namespace trivcon::cli {
 struct OutputPaths {
   std::string field, connection, lines, report, png, singularities, matching;  // singularities: --sing-out, matching: --matching-out
   std::string mesh;                                                            // --mesh-out: the mesh the field belongs to (.ply or .obj)
+  std::string sharp;                                                           // --sharp-out: QuadWild .sharp of the sharp edges
 };
 
 // Output paths for one prescription of a batch: "{name}" in a path is replaced by the item's name;
@@ -35,9 +36,11 @@ class StagedOutputs {
   std::vector<std::pair<std::string, std::string>> staged_;  // (temporary, final path)
 };
 
-// Stages the field, connection, lines and picture of design `d` of `prescription` (item `name` of a
-// batch, or ""); the report is staged by its caller.
+// Stages the field, connection, lines, sharp edges (`sharp`: edge ids, trivcon/features.h; also drawn in
+// the picture) and picture of design `d` of `prescription` (item `name` of a batch, or ""); the report is
+// staged by its caller.
 void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const std::string& name, const MeshData& mesh,
-                          const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d);
+                          const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d,
+                          const std::vector<int>& sharp = {});
 
 }  // namespace trivcon::cli

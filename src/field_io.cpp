@@ -173,6 +173,17 @@ void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F
         out << "\n";
       }
     });
+  } else if (ends_with(path, ".rosy")) {
+    // QuadWild reads 4-RoSy fields only (vcglib's Load4ROSY): another N would be misread, not rejected.
+    if (field.N != 4)
+      throw Error(path + ": a .rosy file holds a 4-direction field (QuadWild's format), this field has N = " + std::to_string(field.N));
+    write_file_atomically(path, [&](std::ostream& out) {
+      out << nF << "\n" << field.N << "\n" << std::setprecision(17);
+      for (int f = 0; f < nF; ++f) {
+        const Eigen::Vector3d d = direction_k(g, field, f, 0);
+        out << d.x() << " " << d.y() << " " << d.z() << "\n";
+      }
+    });
   } else if (ends_with(path, ".ply")) {
     write_file_atomically(path, [&](std::ostream& out) {
       out << "ply\nformat binary_little_endian 1.0\ncomment trivcon field, N " << field.N << "\nelement vertex " << V.rows()
@@ -228,6 +239,28 @@ MatrixX3d detail::read_field_from(const std::string& bytes, const std::string& p
     for (int f = 0; f < num_faces; ++f) {
       if (!lines.next()) throw Error(path + ": truncated after line " + std::to_string(lines.number) + " (face " + std::to_string(f) + ")");
       const std::vector<double> v = parse_numbers(lines, 3 * N);
+      d.row(f) << v[0], v[1], v[2];
+    }
+    if (lines.next()) throw Error(lines.where() + ": more lines than faces");
+    return d;
+  }
+  if (ends_with(path, ".rosy")) {  // QuadWild: the face count, N, then "x y z" per face
+    TextLines lines(bytes, path);
+    if (!lines.next()) throw Error(path + ": empty file (expected the face count on the first line)");
+    const double count = parse_numbers(lines, 1)[0];
+    if (count != num_faces) {
+      std::ostringstream claimed;
+      claimed << std::setprecision(15) << count;
+      throw Error(lines.where() + ": the field has " + claimed.str() + " faces, the mesh has " + std::to_string(num_faces));
+    }
+    if (!lines.next()) throw Error(path + ": ends after the face count (expected N on the second line)");
+    const double N = parse_numbers(lines, 1)[0];
+    if (!(N >= 1 && N <= kMaxFieldN) || N != std::floor(N))
+      throw Error(lines.where() + ": malformed N (expected a whole number, 4 for QuadWild)");
+    if (N_in_file) *N_in_file = static_cast<int>(N);
+    for (int f = 0; f < num_faces; ++f) {
+      if (!lines.next()) throw Error(path + ": truncated after line " + std::to_string(lines.number) + " (face " + std::to_string(f) + ")");
+      const std::vector<double> v = parse_numbers(lines, 3);
       d.row(f) << v[0], v[1], v[2];
     }
     if (lines.next()) throw Error(lines.where() + ": more lines than faces");

@@ -386,6 +386,34 @@ Mesh make_genus_surface(int g, int resolution) {
   return builder.finish();
 }
 
+Mesh make_capped_cylinder(int rings, int segments, int stacks, double height) {
+  require(stacks >= 1, "make_capped_cylinder", "stacks", stacks, "stacks >= 1");
+  require(std::isfinite(height) && height > 0, "make_capped_cylinder", "height", height, "height > 0");
+  const Mesh disk = make_disk(rings, segments);  // checks rings and segments
+  // rim: the first id of the disk's outer ring, of `count` vertices.
+  const int nd = static_cast<int>(disk.V.rows()), count = rings * segments, rim = nd - count;
+  require_size("make_capped_cylinder", 2.0 * nd + (stacks - 1.0) * count, 2.0 * disk.F.rows() + 2.0 * stacks * count);
+  MeshBuilder builder(2.0 * nd + (stacks - 1.0) * count, 2.0 * disk.F.rows() + 2.0 * stacks * count);
+  for (int cap = 0; cap < 2; ++cap)
+    for (int v = 0; v < nd; ++v) builder.add_vertex(disk.V(v, 0), disk.V(v, 1), cap == 0 ? -height / 2 : height / 2);
+  for (int r = 1; r < stacks; ++r)
+    for (int m = 0; m < count; ++m) {
+      const double angle = 2 * kPi * m / count;
+      builder.add_vertex(std::cos(angle), std::sin(angle), -height / 2 + height * r / stacks);
+    }
+  for (int f = 0; f < disk.F.rows(); ++f) builder.add_triangle(disk.F(f, 0), disk.F(f, 2), disk.F(f, 1));  // bottom: faces −z
+  for (int f = 0; f < disk.F.rows(); ++f) builder.add_triangle(nd + disk.F(f, 0), nd + disk.F(f, 1), nd + disk.F(f, 2));
+  // Row r, vertex m of the side; rows 0 and `stacks` are the rims. (angle, z) × is the outward normal.
+  auto id = [&](int m, int r) {
+    m %= count;
+    if (r == 0) return rim + m;
+    if (r == stacks) return nd + rim + m;
+    return 2 * nd + (r - 1) * count + m;
+  };
+  add_quad_grid(builder, count, stacks, id);
+  return builder.finish();
+}
+
 Mesh make_disk(int rings, int segments) {
   require(rings >= 1, "make_disk", "rings", rings, "rings >= 1");
   require(segments >= 3, "make_disk", "segments", segments, "segments >= 3");

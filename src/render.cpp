@@ -175,6 +175,7 @@ class Renderer {
     if (t_.num_faces > 0) {
       draw_surface();
       draw_boundary();
+      draw_sharp_edges();
       if (streamlines != nullptr)
         for (const Streamline& line : *streamlines) draw_streamline(line);
       else
@@ -316,6 +317,13 @@ class Renderer {
         draw_segment(vertex(V_, loop[k]), vertex(V_, loop[(k + 1) % loop.size()]), 1.3, 1.3, o_.palette.boundary);
   }
 
+  // Drawn like the boundary, in their own colour; ids outside the mesh or of boundary edges are skipped.
+  void draw_sharp_edges() {
+    for (int e : o_.sharp_edges)
+      if (e >= 0 && e < t_.num_edges)
+        draw_segment(vertex(V_, t_.edge_vertices(e, 0)), vertex(V_, t_.edge_vertices(e, 1)), 1.3, 1.3, o_.palette.sharp);
+  }
+
   // N tapered spokes from `base` in face f, each `length` long (a single one half as long again: it is
   // alone, and its wedge shape shows the orientation).
   void draw_glyph(int f, const Vector3d& base, double length) {
@@ -402,7 +410,7 @@ class Renderer {
   // One legend row: its text and what is drawn left of it.
   struct LegendRow {
     enum Key { None, Disc, Line } key;
-    int index;  // for a disc: n (index n/N)
+    int index;  // for a disc: n (index n/N); for a line: 0 boundary, 1 sharp edges
     std::string text;
   };
 
@@ -423,6 +431,7 @@ class Renderer {
                           (vertices == 1 ? " vertex" : " vertices")});
     if (count.empty()) rows.push_back({LegendRow::None, 0, "no singular vertices"});
     if (!t_.boundary_loops.empty()) rows.push_back({LegendRow::Line, 0, "boundary"});
+    if (!o_.sharp_edges.empty()) rows.push_back({LegendRow::Line, 1, "sharp edges"});
     return rows;
   }
 
@@ -459,7 +468,7 @@ class Renderer {
                   rows[r].index > 0 ? o_.palette.positive : o_.palette.negative);
       if (rows[r].key == LegendRow::Line)
         canvas_.for_samples(x0, middle - 1.3 * scale_, x0 + key - 10 * scale_, middle + 1.3 * scale_,
-                            [&](size_t i, double, double) { canvas_.set(i, o_.palette.boundary); });
+                            [&](size_t i, double, double) { canvas_.set(i, rows[r].index == 1 ? o_.palette.sharp : o_.palette.boundary); });
       draw_text(text_x, y, rows[r].text, unit);
     }
   }

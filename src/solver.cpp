@@ -181,6 +181,15 @@ double ConnectionSolver::Impl::regularize_rigid_cycles() {
   for (const DualCycle& c : cycles.loops) regularize(c);
   for (const DualCycle& c : cycles.generators) regularize(c);
   for (const FixedPath& p : paths) regularize(p.path);
+  // With fixed faces, the path rows and the vertex rows can be dependent on the edges of positive weight
+  // alone: a vertex whose only weighted edges are links between adjacent fixed faces has its holonomy fixed
+  // twice, and A W Aᵀ is singular. CAD meshes, with their right-angled triangles (weights of 0 or of
+  // round-off size, ~1e-17) along feature lines, do this often. The rows are independent on all interior
+  // edges (the paths form a forest, trivcon/constraints.h), so every edge lighter than ε then gets ε: the
+  // field turns there only when nothing else can.
+  if (!paths.empty())
+    for (int e = 0; e < nE; ++e)
+      if (!topology.is_boundary_edge(e) && weights(e) < epsilon) weights(e) = epsilon, ++regularized_edges;
   return epsilon;
 }
 

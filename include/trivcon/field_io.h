@@ -7,6 +7,8 @@
 //   rotated by 2πk/N about the face normal (right-hand rule, normal of the face as oriented).
 // - .rawfield (Directional's raw field): first line "N F", then one line per face with 3N numbers,
 //   the N vectors x y z one after the other, counter-clockwise.
+// - .rosy (QuadWild's 4-RoSy field, vcglib Load4ROSY): line 1 the face count, line 2 N (always 4: the
+//   writer refuses another N), then one line "x y z" per face, the first direction as in the text format.
 // - .ply: binary little-endian PLY of the mesh (vertex: double x y z; face: list uchar int
 //   vertex_indices, then double fx fy fz = the first direction).
 // - Connection: "# trivcon connection", "# N <N>", then one line "i j x" per interior edge, i < j,
@@ -28,9 +30,9 @@
 
 namespace trivcon {
 
-// Writes by extension: .rawfield, .ply, anything else the text format.
+// Writes by extension: .rawfield, .rosy, .ply, anything else the text format.
 void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& geometry, const Field& field);
-// Reads a field written by write_field or a Directional .rawfield: world directions (F × 3, the first
+// Reads a field written by write_field, a Directional .rawfield or a QuadWild .rosy: world directions (F × 3, the first
 // direction per face) and N (0 when the file does not say). `num_faces` must match.
 MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file = nullptr);
 

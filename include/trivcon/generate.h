@@ -46,6 +46,13 @@ Mesh make_genus_surface(int g, int resolution);
 // k·segments vertices on radius k/rings (`segments` ≥ 3), so triangles keep their shape;
 // 1 + segments·rings·(rings+1)/2 vertices, segments·rings² faces; χ = 1, one boundary loop.
 Mesh make_disk(int rings, int segments);
+// Closed cylinder around the z axis, radius 1, z in [−height/2, height/2] (height > 0): two flat caps, each
+// make_disk(rings, segments) (the bottom one turned to face −z), and a side of `stacks` ≥ 1 rows of
+// quads split into triangles between the two rims of rings·segments vertices each. Vertex ids: the bottom
+// cap's (as make_disk's, at z = −height/2), the top cap's, then stacks − 1 side rows bottom to top; faces:
+// bottom cap, top cap, side. The two rims are sharp edges of dihedral angle 90° (a CAD-like test shape,
+// trivcon/features.h); χ = 2.
+Mesh make_capped_cylinder(int rings, int segments, int stacks, double height = 2.0);
 // Flat annulus with radii 0 < r_in < r_out: rings + 1 circles of `segments` ≥ 3 vertices
 // (`rings` ≥ 1), (rings+1)·segments vertices, 2·rings·segments faces; χ = 0, two boundary loops.
 Mesh make_annulus(int rings, int segments, double r_in = 0.5, double r_out = 1.0);

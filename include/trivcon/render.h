@@ -36,7 +36,8 @@
 // - Singular vertices: discs, red for positive and blue for negative indices, radius growing with |index|
 //   (radius 9 pixels for index ±1, scaled by √|index|, at least 6), drawn when the vertex is visible. A legend
 //   lists N and the indices present, in the image corner where it hides the least of the surface (lower left
-//   on ties). Boundary loops: green lines.
+//   on ties). Boundary loops: green lines. Sharp (feature) edges given in RenderOptions::sharp_edges
+//   (trivcon/features.h): magenta lines of the same width, with a legend row.
 // - Sizes in pixels scale with the image's smaller side (the values below are for 900 pixels).
 // - Deterministic: identical inputs give identical pixels and bytes (single thread, no clocks, no
 //   uninitialised memory).
@@ -76,6 +77,7 @@ struct Palette {
   Rgb back{240, 170, 90};    // surface seen from behind, before shading
   Rgb field{22, 28, 48};     // hedgehog glyphs and streamlines
   Rgb boundary{30, 150, 60};
+  Rgb sharp{200, 40, 170};    // feature edges (RenderOptions::sharp_edges)
   Rgb positive{215, 35, 35};  // singularity with index > 0
   Rgb negative{30, 80, 215};  // index < 0
   Rgb text{40, 40, 40};
@@ -89,7 +91,8 @@ struct RenderOptions {
   double glyph_spacing = 11;  // pixels between glyphs or streamlines (at 900 pixels; scaled with the image)
   bool smooth_shading = true;
   bool legend = true;
-  int supersampling = 3;  // samples per pixel along each axis (anti-aliasing)
+  std::vector<int> sharp_edges;  // edge ids (trivcon/topology.h) drawn as feature lines; empty: none
+  int supersampling = 3;         // samples per pixel along each axis (anti-aliasing)
   Palette palette;
 };
 

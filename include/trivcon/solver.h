@@ -11,7 +11,10 @@
 // where that would make the constraints unsatisfiable: the edges of a cycle or fixed-face path that has no
 // edge of positive weight, and the edges around a vertex that zero weights cut off from the rest of its
 // component, get 1e-6 × the median positive weight, so the field can still turn there when nothing else
-// can (regularized_edges()). Since the mollification, zero-area faces no longer cause either.
+// can (regularized_edges()). Since the mollification, zero-area faces no longer cause either. With fixed
+// faces, every edge lighter than that (0, or a round-off 1e-17 where both opposite angles are right) gets it:
+// path and vertex rows can otherwise be dependent on the weighted edges alone (feature lines of CAD meshes,
+// trivcon/features.h).
 //
 // Default route (SolverKind::Cholesky): x = W Aᵀ y with (A W Aᵀ) y = b, where A = [D; C] holds the
 // interior-vertex rows D and the cycle rows C (loops, generators). D W Dᵀ is the cotan Laplacian on

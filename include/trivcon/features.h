@@ -1,0 +1,82 @@
+// trivcon/features.h: sharp feature edges, and the fixed directions that make a field follow them.
+//
+// Conventions
+// - A feature (sharp) edge is an interior edge (Topology ids); boundary edges are never features (they
+//   are what --align-boundary aligns to; the two can be combined).
+// - Dihedral angle of interior edge e = (i, j), L = edge_faces(e, 0) holding i → j, R = edge_faces(e, 1):
+//   θ_e = the angle between the unit normals of L and R (Geometry::normal, faces as oriented by
+//   trivcon/topology.h), in [0, π]; 0 where the surface is flat across e. `sharp_edges(…, DEG)` takes the
+//   edges with θ_e > DEG degrees.
+// - Convexity: e is convex (a ridge) when (n_L × n_R) · (p_j − p_i) > 0, i.e. R bends away from L's
+//   normal; concave (a valley) otherwise. With outward normals (closed meshes as generated, trivcon/
+//   generate.h) the edges of a box are convex; an inside-out mesh swaps the two.
+// - Feature alignment: every face beside a feature edge is fixed (trivcon/constraints.h) to that edge's
+//   direction p_j − p_i (i < j) in the face's frame (Geometry::half_edge_angle of the half-edge the face
+//   holds, + π in R), the same sense on both sides, so that parallel transport across the edge carries
+//   one onto the other for every N (for even N the sense does not matter modulo 2π/N). A face beside several feature edges (at a corner)
+//   follows the longest one; the others are compatible when their directions agree with it modulo 2π/N within kFeatureAngleTolerance (for N
+//   = 4 two perpendicular edges are: a cross along one is along the other), and every face where they do not is reported
+//   (FeatureAlignment::conflicts), never resolved silently.
+// - QuadWild's .sharp file (written by write_sharp, read back by read_sharp): line 1 the number of lines
+//   that follow, then one line "convexity,face,edge" per side of each feature edge: convexity 1 convex, 0
+//   concave; `face` the face id; `edge` ∈ {0, 1, 2} the edge joining the face's vertices edge and edge + 1
+//   (mod 3) in the face's order as given (the file's, not the re-oriented Topology::F). Each feature edge
+//   gives two lines, one for each of its faces (as QuadWild's own exporter writes), ordered by edge id then
+//   L before R.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "trivcon/geometry.h"
+#include "trivcon/topology.h"
+
+namespace trivcon {
+
+// Two edge directions closer than this (radians, modulo 2π/N) count as compatible at a corner.
+constexpr double kFeatureAngleTolerance = 1e-9;
+
+// θ_e above (radians); 0 for boundary edges.
+double dihedral_angle(const Topology& topology, const Geometry& geometry, int edge);
+// Whether interior edge `edge` is convex (see above).
+bool is_convex_edge(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, int edge);
+
+// The interior edges whose dihedral angle exceeds `degrees` (in [0, 180]; anything else, NaN included,
+// throws trivcon::Error), in increasing id.
+std::vector<int> sharp_edges(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, double degrees);
+
+// Reads feature edges: one "i j" (vertex ids, either order) per line, '#' comments and blank lines skipped.
+// Errors name file:line: a malformed line, a vertex id out of range, a pair that is not an edge of the mesh,
+// a boundary edge, an edge listed twice. Returns edge ids in increasing order.
+std::vector<int> read_feature_edges(const std::string& path, const Topology& topology);
+
+// A face beside feature edges that do not agree modulo 2π/N: it follows `followed`, not `other`.
+struct FeatureConflict {
+  int face;
+  int followed, other;  // edge ids
+  double difference;    // |angle of other − angle of followed| modulo 2π/N, radians in (tolerance, π/N]
+};
+
+struct FeatureAlignment {
+  std::map<int, double> fixed;             // face → angle in the face's frame (IndexPrescription::fixed)
+  std::vector<FeatureConflict> conflicts;  // one per (face, disagreeing edge), by face
+  int corner_faces = 0;                    // faces beside two or more feature edges (compatible or not)
+};
+// The fixed directions for `edges` (interior edge ids) and symmetry N ≥ 1.
+FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
+                                   int N);
+
+// One line of a .sharp file.
+struct SharpFaceEdge {
+  int convex;  // 1 convex, 0 concave
+  int face;    // face id
+  int edge;    // 0, 1, 2: from the face's vertex `edge` to vertex `edge` + 1 in the given F
+};
+// Writes QuadWild's .sharp for `edges` (interior edge ids) atomically; `F` is the mesh's faces as given (the
+// file's order; the Topology was built from it), `convex` one flag per listed edge.
+void write_sharp(const std::string& path, const MatrixX3i& F, const Topology& topology, const std::vector<int>& edges,
+                 const std::vector<char>& convex);
+// Reads a .sharp file: checks the count, the faces (in [0, F)) and edges (0..2); errors name file:line.
+std::vector<SharpFaceEdge> read_sharp(const std::string& path, int num_faces);
+
+}  // namespace trivcon

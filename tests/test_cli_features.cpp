@@ -1,0 +1,173 @@
+// `trivcon solve --align-features / --features / --sharp-out / --field-out *.rosy`, `check` on a .rosy and
+// `render --align-features`, run as a separate process.
+#include <Eigen/Geometry>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "support.h"
+#include "trivcon/features.h"
+#include "trivcon/field_io.h"
+#include "trivcon/io.h"
+#include "trivcon/render.h"
+
+namespace trivcon {
+namespace {
+
+using test::q;
+using test::run_cli;
+using test::slurp;
+using test::temp_file;
+
+std::string mesh_file(const Mesh& m, const std::string& name) {
+  const std::string path = temp_file(name);
+  write_obj(path, m.V, m.F);
+  return path;
+}
+
+// The solve of the README's pipeline on the flat-faced cube: --auto puts +1/4 at the 8 corners, the .rosy
+// has every face beside a cube edge along it (modulo π/2), the .sharp lists both sides of the 12 · n edges.
+TEST(CliFeatures, CubePipelineForQuadWild) {
+  const int n = 6;
+  const Mesh m = make_cube_sphere(n, false);
+  const std::string mesh = mesh_file(m, "cube.obj"), rosy = temp_file("m.rosy"), sharp = temp_file("m.sharp");
+  const std::string sings = temp_file("m.sing"), report = temp_file("r.json");
+  const auto r = run_cli("solve " + q(mesh) + " -N 4 --auto --align-features 30 --field-out " + q(rosy) + " --sharp-out " + q(sharp) +
+                         " --sing-out " + q(sings) + " --report " + q(report));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("features: " + std::to_string(12 * n) + " sharp edges (" + std::to_string(12 * n) + " convex)"), std::string::npos)
+      << r.out;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_TRUE(j["verified"].get<bool>());
+  EXPECT_EQ(j["features"]["sharp_edges"], 12 * n);
+  EXPECT_EQ(j["features"]["conflicts"].size(), 0u);
+  EXPECT_LE(j["fixed"]["max_error"].get<double>(), 1e-9);
+  // The 8 corners, +1/4 each, and nothing else.
+  std::set<int> corners;
+  for (int v : test::vertices_of_valence(m, 3)) corners.insert(v);
+  std::set<int> used;
+  for (const auto& s : j["singularities"]) {
+    EXPECT_EQ(s["index"].get<std::string>(), "1/4");
+    used.insert(s["vertex"].get<int>());
+  }
+  EXPECT_EQ(used, corners);
+
+  const Topology t = test::topo(m);
+  const Geometry g = compute_geometry(m.V, t);
+  int N = 0;
+  const MatrixX3d d = read_field(rosy, static_cast<int>(m.F.rows()), &N);
+  EXPECT_EQ(N, 4);
+  const std::vector<SharpFaceEdge> lines = read_sharp(sharp, static_cast<int>(m.F.rows()));
+  EXPECT_EQ(lines.size(), 2u * 12 * n);
+  for (const SharpFaceEdge& s : lines) {
+    EXPECT_EQ(s.convex, 1);
+    const Eigen::Vector3d a = m.V.row(m.F(s.face, s.edge)), b = m.V.row(m.F(s.face, (s.edge + 1) % 3));
+    EXPECT_GE(((a.array().abs() == 1.0) && (b.array().abs() == 1.0)).count(), 2) << "not a cube edge";
+    // The face's direction along the edge modulo π/2, from the positions.
+    const Eigen::Vector3d p0 = m.V.row(m.F(s.face, 0)), p1 = m.V.row(m.F(s.face, 1)), p2 = m.V.row(m.F(s.face, 2));
+    const Eigen::Vector3d normal = (p1 - p0).cross(p2 - p0).normalized(), dir = d.row(s.face);
+    EXPECT_NEAR(dir.dot(normal), 0, 1e-12);
+    const double angle = std::atan2(dir.cross(b - a).dot(normal), dir.dot(b - a));
+    EXPECT_LE(std::abs(angle - kPi / 2 * std::round(angle / (kPi / 2))), 1e-9) << "face " << s.face;
+  }
+  // check reads the .rosy and finds the same singularities.
+  const auto c = run_cli("check " + q(mesh) + " " + q(rosy) + " -N 4 -s " + q(sings));
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("8 singular vertices in the field"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("matches the prescription"), std::string::npos) << c.out;
+}
+
+TEST(CliFeatures, FeaturesFileWithSingularitiesByHand) {
+  // Only the cube's four vertical edges (along y) listed; the corners given by hand.
+  const Mesh m = make_cube_sphere(4, false);
+  const Topology t = test::topo(m);
+  std::string list = "# vertical cube edges\n";
+  int listed = 0;
+  for (int e = 0; e < t.num_edges; ++e) {
+    const Eigen::Vector3d a = m.V.row(t.edge_vertices(e, 0)), b = m.V.row(t.edge_vertices(e, 1));
+    if (std::abs(a.x()) == 1 && std::abs(a.z()) == 1 && std::abs(b.x()) == 1 && std::abs(b.z()) == 1 && a.x() == b.x() && a.z() == b.z())
+      list += std::to_string(t.edge_vertices(e, 1)) + " " + std::to_string(t.edge_vertices(e, 0)) + "\n", ++listed;
+  }
+  ASSERT_EQ(listed, 16);
+  const std::string mesh = mesh_file(m, "cube.obj"), edges = temp_file("edges.txt"), sings = temp_file("corners.sing");
+  test::write_text(edges, list);
+  std::string corners;
+  for (int v : test::vertices_of_valence(m, 3)) corners += std::to_string(v) + " 1/4\n";
+  test::write_text(sings, corners);
+  const std::string report = temp_file("r.json"), sharp = temp_file("m.sharp");
+  const auto r = run_cli("solve " + q(mesh) + " -N 4 -s " + q(sings) + " --features " + q(edges) + " --sharp-out " + q(sharp) +
+                         " --report " + q(report));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_TRUE(j["verified"].get<bool>());
+  EXPECT_EQ(j["features"]["sharp_edges"], 16);
+  EXPECT_EQ(j["fixed"]["faces"], 32);
+  EXPECT_EQ(read_sharp(sharp, static_cast<int>(m.F.rows())).size(), 32u);
+}
+
+TEST(CliFeatures, CornerConflictsAreReported) {
+  // The cube with N = 2: a line field cannot follow two perpendicular edges at once.
+  const std::string mesh = mesh_file(make_cube_sphere(4, false), "cube.obj"), report = temp_file("r.json");
+  const auto r = run_cli("solve " + q(mesh) + " -N 2 --auto --align-features 30 --report " + q(report));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("24 face-edge pairs at corners where sharp edges meet"), std::string::npos) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j["features"]["conflicts"].size(), 24u);
+  EXPECT_EQ(j["features"]["corner_faces"], 24);
+}
+
+TEST(CliFeatures, UsageAndInputErrors) {
+  const std::string mesh = mesh_file(make_cube_sphere(2, false), "cube.obj");
+  for (const std::string bad : {"-1", "200", "nan", "abc", "30x"}) {
+    const auto r = run_cli("solve " + q(mesh) + " -N 4 --align-features " + bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("expected an angle in degrees in [0, 180]"), std::string::npos) << r.err;
+  }
+  auto r = run_cli("solve " + q(mesh) + " -N 4 --sharp-out " + q(temp_file("m.sharp")));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("needs --align-features or --features"), std::string::npos) << r.err;
+  r = run_cli("solve " + q(mesh) + " -N 2 --align-features 30 --field-out " + q(temp_file("m.rosy")));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("-N 4"), std::string::npos) << r.err;
+  r = run_cli("solve " + q(mesh) + " -N 4 --features " + q(temp_file("missing.txt")));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("missing.txt"), std::string::npos) << r.err;
+  const std::string edges = temp_file("edges.txt");
+  test::write_text(edges, "0 1\nnot numbers\n");
+  r = run_cli("solve " + q(mesh) + " -N 4 --features " + q(edges));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find(edges + ":"), std::string::npos) << r.err;
+  r = run_cli("solve " + q(mesh) + " -N 4 --features " + q(edges) + " --split-large-turns");
+  EXPECT_EQ(r.status, 1);
+}
+
+TEST(CliFeatures, RenderDrawsTheSharpEdges) {
+  const Mesh m = make_cube_sphere(6, false);
+  const std::string mesh = mesh_file(m, "cube.obj"), rosy = temp_file("m.rosy");
+  ASSERT_EQ(run_cli("solve " + q(mesh) + " -q -N 4 --auto --align-features 30 --field-out " + q(rosy)).status, 0);
+  const std::string with = temp_file("with.png"), without = temp_file("without.png");
+  auto r = run_cli("render " + q(mesh) + " --field " + q(rosy) + " --align-features 30 --size 400x300 -o " + q(with));
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(run_cli("render " + q(mesh) + " --field " + q(rosy) + " --size 400x300 -o " + q(without)).status, 0);
+  EXPECT_NE(slurp(with), slurp(without));
+  // In the library: the sharp colour appears only when edges are given.
+  const Topology t = test::topo(m);
+  const Geometry g = compute_geometry(m.V, t);
+  const Field field = field_from_directions(g, read_field(rosy, static_cast<int>(m.F.rows())), 4);
+  RenderOptions o;
+  o.width = 400, o.height = 300;
+  auto count_sharp = [&](const Image& image) {
+    int n = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) n += image.pixel(x, y) == o.palette.sharp;
+    return n;
+  };
+  EXPECT_EQ(count_sharp(render_field(m.V, t, g, field, {}, o)), 0);
+  o.sharp_edges = sharp_edges(m.V, t, g, 30);
+  EXPECT_GT(count_sharp(render_field(m.V, t, g, field, {}, o)), 200);
+  r = run_cli("render " + q(mesh) + " --field " + q(rosy) + " --align-features 500 -o " + q(with));
+  EXPECT_EQ(r.status, 2);
+}
+
+}  // namespace
+}  // namespace trivcon

@@ -1,0 +1,339 @@
+// Sharp feature edges (trivcon/features.h): detection, the fixed faces that make a field follow them (with
+// --auto's placement and with singularities given by hand), conflicts at corners, and the .sharp / .rosy
+// files QuadWild reads.
+#include <Eigen/Geometry>
+#include <cmath>
+#include <set>
+
+#include "support.h"
+#include "trivcon/auto.h"
+#include "trivcon/features.h"
+#include "trivcon/field_io.h"
+#include "trivcon/io.h"
+
+namespace trivcon {
+namespace {
+
+using test::error_of;
+using test::temp_file;
+using test::write_text;
+
+// A fandisk-like block: the flat-faced cube with its top (y = 1) bulged into a curved roof,
+// y += 0.3 (1 − x²)(y + 1)/2. The sides x = ±1, z = ±1 and the bottom stay flat; the top edges along x are
+// curves that meet the vertical edges at non-right angles (about 59°, since dy/dx = ∓0.6 there), so the
+// faces at those four corners cannot follow both edges with a cross.
+Mesh bulged_block(int n) {
+  Mesh m = make_cube_sphere(n, false);
+  for (int v = 0; v < m.V.rows(); ++v) m.V(v, 1) += 0.3 * (1 - m.V(v, 0) * m.V(v, 0)) * (m.V(v, 1) + 1) / 2;
+  return m;
+}
+
+// The oriented faces' unit normal, from the vertex positions alone.
+Eigen::Vector3d unit_normal(const MatrixX3d& V, const Topology& t, int f) {
+  const Eigen::Vector3d p0 = V.row(t.F(f, 0)), p1 = V.row(t.F(f, 1)), p2 = V.row(t.F(f, 2));
+  return (p1 - p0).cross(p2 - p0).normalized();
+}
+
+// How far (radians, in [0, π/4]) the world direction `d` in face f is from edge e's direction modulo π/2,
+// measured in the face's plane from the positions (not through trivcon's frames).
+double off_edge(const MatrixX3d& V, const Topology& t, int f, int e, const Eigen::Vector3d& d) {
+  const Eigen::Vector3d n = unit_normal(V, t, f);
+  const Eigen::Vector3d edge = V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0));
+  const double a = std::atan2(d.cross(edge).dot(n), d.dot(edge));
+  const double q = kPi / 2;
+  const double r = a - q * std::round(a / q);
+  return std::abs(r);
+}
+
+// Per face, its sharp edges.
+std::map<int, std::vector<int>> faces_beside(const Topology& t, const std::vector<int>& edges) {
+  std::map<int, std::vector<int>> out;
+  for (int e : edges) out[t.edge_faces(e, 0)].push_back(e), out[t.edge_faces(e, 1)].push_back(e);
+  return out;
+}
+
+struct Solved {
+  std::vector<int> edges;
+  FeatureAlignment alignment;
+  std::map<int, int> singularities;
+  Design design;
+};
+
+// The CLI's route: sharp edges at `degrees`, faces fixed to them, then --auto's placement (honouring the
+// same fixed faces) or the given singularities, then the exact solve.
+Solved solve_with_features(FieldDesigner& designer, double degrees, const std::map<int, int>* given = nullptr) {
+  Solved s;
+  s.edges = sharp_edges(designer.V(), designer.topology(), designer.geometry(), degrees);
+  s.alignment = feature_alignment(designer.V(), designer.topology(), designer.geometry(), s.edges, 4);
+  std::vector<int> faces;
+  for (auto [f, a] : s.alignment.fixed) faces.push_back(f);
+  designer.set_fixed_faces(faces);
+  IndexPrescription p;
+  p.N = 4;
+  p.fixed = s.alignment.fixed;
+  if (given) {
+    p.vertex = *given;
+  } else {
+    AutoOptions ao;
+    ao.N = 4;
+    ao.fixed = p.fixed;
+    p.vertex = auto_singularities(designer, ao).vertex;
+  }
+  s.singularities = p.vertex;
+  s.design = designer.design(p);
+  return s;
+}
+
+// Exact, no singularity beyond the prescription, and every face beside a sharp edge along it (modulo π/2)
+// except the reported conflicts, where the face is along the edge it follows.
+void expect_exact_and_aligned(const FieldDesigner& designer, const Solved& s) {
+  const Design& d = s.design;
+  EXPECT_TRUE(design_verified(d));
+  EXPECT_LE(std::max(d.connection.max_vertex_residual, d.connection.max_cycle_residual), 1e-9);
+  EXPECT_LE(d.max_fixed_error, 1e-9);
+  EXPECT_TRUE(d.index_mismatch_vertices.empty()) << d.index_mismatch_vertices.size() << " vertices read back another index";
+  std::map<int, int> read;
+  for (int v = 0; v < designer.topology().num_vertices; ++v)
+    if (d.indices.vertex[v] != 0) read[v] = d.indices.vertex[v];
+  EXPECT_EQ(read, s.singularities);
+  std::set<std::pair<int, int>> conflicting;  // (face, edge it does not follow)
+  for (const FeatureConflict& c : s.alignment.conflicts) conflicting.insert({c.face, c.other});
+  int checked = 0;
+  for (const auto& [f, edges] : faces_beside(designer.topology(), s.edges))
+    for (int e : edges) {
+      if (conflicting.count({f, e})) continue;
+      const Eigen::Vector3d dir = designer.geometry().direction_in_face(f, d.field.angle(f));
+      EXPECT_LE(off_edge(designer.V(), designer.topology(), f, e, dir), 1e-9) << "face " << f << " edge " << e;
+      ++checked;
+    }
+  EXPECT_GT(checked, 0);
+}
+
+TEST(SharpEdges, CubeHasItsTwelveEdgesConvexAtNinetyDegrees) {
+  const Mesh m = make_cube_sphere(6, false);
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  const std::vector<int> edges = sharp_edges(m.V, t, designer.geometry(), 30);
+  ASSERT_EQ(edges.size(), 12u * 6);
+  for (int e : edges) {
+    EXPECT_NEAR(dihedral_angle(t, designer.geometry(), e), kPi / 2, 1e-12);
+    EXPECT_TRUE(is_convex_edge(m.V, t, designer.geometry(), e));
+    // On the cube's edges two coordinates are ±1 at both ends.
+    for (int end = 0; end < 2; ++end) {
+      const Eigen::Vector3d p = m.V.row(t.edge_vertices(e, end));
+      EXPECT_EQ((p.array().abs() == 1.0).count() >= 2, true);
+    }
+  }
+  EXPECT_EQ(sharp_edges(m.V, t, designer.geometry(), 91).size(), 0u);
+  EXPECT_EQ(sharp_edges(m.V, t, designer.geometry(), 0).size(), 12u * 6);
+}
+
+TEST(SharpEdges, ConcaveEdgesOfAHoledPlate) {
+  const Mesh m = make_genus_surface(1, 2);
+  FieldDesigner designer(m.V, m.F);
+  const std::vector<int> edges = sharp_edges(m.V, designer.topology(), designer.geometry(), 30);
+  int convex = 0;
+  for (int e : edges) convex += is_convex_edge(m.V, designer.topology(), designer.geometry(), e);
+  // The hole's four vertical edges are concave (valleys seen from outside); everything else is convex.
+  EXPECT_GT(convex, 0);
+  EXPECT_EQ(static_cast<int>(edges.size()) - convex, 4 * 2 * 2);  // 4 edges, 2 voxels tall, resolution 2
+}
+
+TEST(SharpEdges, BadAnglesAreRejected) {
+  const Mesh m = make_cube_sphere(2, false);
+  FieldDesigner designer(m.V, m.F);
+  for (double bad : {-1.0, 200.0, std::nan("")})
+    EXPECT_NE(error_of([&] { sharp_edges(m.V, designer.topology(), designer.geometry(), bad); }).find("out of range"), std::string::npos);
+}
+
+TEST(SharpEdges, CylinderRimsOnly) {
+  const Mesh m = make_capped_cylinder(4, 8, 6);
+  FieldDesigner designer(m.V, m.F);
+  EXPECT_EQ(designer.topology().euler_characteristic(), 2);
+  const std::vector<int> edges = sharp_edges(m.V, designer.topology(), designer.geometry(), 30);
+  EXPECT_EQ(edges.size(), 2u * 4 * 8);  // the two rims of rings · segments edges
+  for (int e : edges) {
+    EXPECT_NEAR(std::abs(m.V(designer.topology().edge_vertices(e, 0), 2)), 1.0, 1e-15);
+    EXPECT_TRUE(is_convex_edge(m.V, designer.topology(), designer.geometry(), e));  // outward normals
+  }
+  // make_capped_cylinder's sizes: two make_disk(4, 8) caps (1 + 8·4·5/2 = 81 vertices, 8·16 faces) and
+  // 6 rows of 32 quads, 5 inner rows of vertices.
+  EXPECT_EQ(m.V.rows(), 2 * 81 + 5 * 32);
+  EXPECT_EQ(m.F.rows(), 2 * 128 + 2 * 6 * 32);
+  EXPECT_TRUE(designer.topology().flipped_faces.empty());
+  EXPECT_NE(error_of([] { make_capped_cylinder(4, 8, 0); }).find("make_capped_cylinder: invalid stacks = 0"), std::string::npos);
+  EXPECT_NE(error_of([] { make_capped_cylinder(4, 8, 2, -1); }).find("height"), std::string::npos);
+}
+
+TEST(ReadFeatureEdges, ReadsPairsAndNamesTheLineOfEachError) {
+  const Mesh m = make_cube_sphere(2, false);
+  const Topology t = test::topo(m);
+  const std::string path = temp_file("edges.txt");
+  const int a = t.edge_vertices(3, 0), b = t.edge_vertices(3, 1), c = t.edge_vertices(7, 0), d = t.edge_vertices(7, 1);
+  write_text(path,
+             "# features\n" + std::to_string(b) + " " + std::to_string(a) + "\n\n" + std::to_string(c) + " " + std::to_string(d) + "\n");
+  EXPECT_EQ(read_feature_edges(path, t), (std::vector<int>{3, 7}));
+  auto error = [&](const std::string& text) {
+    write_text(path, text);
+    return error_of([&] { read_feature_edges(path, t); });
+  };
+  const std::string pair = std::to_string(a) + " " + std::to_string(b) + "\n";
+  EXPECT_NE(error(pair + pair).find(path + ":2: edge"), std::string::npos);
+  EXPECT_NE(error(pair + pair).find("listed twice (first at line 1)"), std::string::npos);
+  EXPECT_NE(error("0 1000\n").find(path + ":1: vertex id '1000' is not a whole number"), std::string::npos);
+  EXPECT_NE(error("0 x\n").find(path + ":1:"), std::string::npos);
+  EXPECT_NE(error("1 2 3\n").find(path + ":1: expected two vertex ids"), std::string::npos);
+  EXPECT_NE(error("4 4\n").find(path + ":1: (4, 4) is not an edge"), std::string::npos);
+  // A pair that is not an edge: two opposite corners of the cube.
+  int far = 0;
+  for (int v = 1; v < m.V.rows(); ++v)
+    if ((m.V.row(v) + m.V.row(0)).norm() < 1e-12) far = v;
+  EXPECT_NE(error("0 " + std::to_string(far) + "\n").find("is not an edge of the mesh"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_feature_edges(temp_file("missing.txt"), t); }).find("missing.txt"), std::string::npos);
+  // Boundary edges are not features.
+  const Mesh disk = make_disk(2, 6);
+  const Topology td = test::topo(disk);
+  const int last = static_cast<int>(disk.V.rows()) - 1;  // rim vertices are the last ring
+  write_text(path, std::to_string(last - 1) + " " + std::to_string(last) + "\n");
+  EXPECT_NE(error_of([&] { read_feature_edges(path, td); }).find("is a boundary edge"), std::string::npos);
+}
+
+TEST(FeatureAlignment, CubeCornersAreCompatibleForCrossesNotForLines) {
+  const Mesh m = make_cube_sphere(4, false);
+  FieldDesigner designer(m.V, m.F);
+  const std::vector<int> edges = sharp_edges(m.V, designer.topology(), designer.geometry(), 30);
+  const FeatureAlignment crosses = feature_alignment(m.V, designer.topology(), designer.geometry(), edges, 4);
+  EXPECT_EQ(crosses.fixed.size(), faces_beside(designer.topology(), edges).size());
+  EXPECT_EQ(crosses.corner_faces, 24);  // one triangle of each corner quad holds both of its sharp edges
+  EXPECT_TRUE(crosses.conflicts.empty());
+  const FeatureAlignment lines = feature_alignment(m.V, designer.topology(), designer.geometry(), edges, 2);
+  ASSERT_EQ(lines.conflicts.size(), 24u);
+  for (const FeatureConflict& c : lines.conflicts) EXPECT_NEAR(c.difference, kPi / 2, 1e-12);
+}
+
+TEST(FeatureAlignment, CubeWithAutoGetsItsEightCorners) {
+  const Mesh m = make_cube_sphere(8, false);
+  FieldDesigner designer(m.V, m.F);
+  const Solved s = solve_with_features(designer, 30);
+  EXPECT_EQ(s.edges.size(), 12u * 8);
+  EXPECT_TRUE(s.alignment.conflicts.empty());
+  std::map<int, int> corners;
+  for (int v : test::vertices_of_valence(m, 3)) corners[v] = 1;
+  ASSERT_EQ(corners.size(), 8u);
+  EXPECT_EQ(s.singularities, corners);
+  expect_exact_and_aligned(designer, s);
+}
+
+TEST(FeatureAlignment, CubeWithSingularitiesByHand) {
+  // The corners, and also a +1/4 −1/4 pair inside a cube face: exact and aligned all the same.
+  const Mesh m = make_cube_sphere(8, false);
+  FieldDesigner designer(m.V, m.F);
+  std::map<int, int> given;
+  for (int v : test::vertices_of_valence(m, 3)) given[v] = 1;
+  int inside_a = -1, inside_b = -1;
+  for (int v = 0; v < m.V.rows(); ++v) {  // two vertices of the face z = 1, away from its edges
+    const Eigen::Vector3d p = m.V.row(v);
+    if (p.z() == 1 && std::abs(p.x() + 0.25) < 1e-12 && std::abs(p.y()) < 1e-12) inside_a = v;
+    if (p.z() == 1 && std::abs(p.x() - 0.25) < 1e-12 && std::abs(p.y()) < 1e-12) inside_b = v;
+  }
+  ASSERT_GE(inside_a, 0);
+  ASSERT_GE(inside_b, 0);
+  given[inside_a] = 1, given[inside_b] = -1;
+  const Solved s = solve_with_features(designer, 30, &given);
+  expect_exact_and_aligned(designer, s);
+}
+
+TEST(FeatureAlignment, CappedCylinderWithAuto) {
+  const Mesh m = make_capped_cylinder(6, 8, 12);
+  FieldDesigner designer(m.V, m.F);
+  const Solved s = solve_with_features(designer, 30);
+  EXPECT_TRUE(s.alignment.conflicts.empty());
+  int sum = 0;
+  for (auto [v, n] : s.singularities) sum += n;
+  EXPECT_EQ(sum, 4 * 2);  // Poincaré–Hopf: Σ n = N χ
+  // The side is a developable band whose rims the field follows: nothing singular on it.
+  for (auto [v, n] : s.singularities) EXPECT_GT(std::abs(m.V(v, 2)), 1 - 1e-12) << "vertex " << v << " is on the side";
+  expect_exact_and_aligned(designer, s);
+}
+
+TEST(FeatureAlignment, FandiskLikeBlockReportsItsNonRightCorners) {
+  const Mesh m = bulged_block(10);
+  FieldDesigner designer(m.V, m.F);
+  const Solved s = solve_with_features(designer, 30);
+  EXPECT_EQ(s.edges.size(), 12u * 10);  // the roof's own folds are far below 30°
+  // Conflicts are exactly the faces beside two sharp edges whose directions differ modulo π/2, found here
+  // from the positions.
+  std::set<int> expected;
+  for (const auto& [f, edges] : faces_beside(designer.topology(), s.edges)) {
+    if (edges.size() < 2) continue;
+    const Eigen::Vector3d a =
+        m.V.row(designer.topology().edge_vertices(edges[0], 1)) - m.V.row(designer.topology().edge_vertices(edges[0], 0));
+    if (off_edge(m.V, designer.topology(), f, edges[1], a.normalized()) > 1e-9) expected.insert(f);
+  }
+  std::set<int> reported;
+  for (const FeatureConflict& c : s.alignment.conflicts) reported.insert(c.face);
+  EXPECT_EQ(reported, expected);
+  EXPECT_EQ(reported.size(), 4u);  // the roof's four corners, one triangle each
+  int sum = 0;
+  for (auto [v, n] : s.singularities) sum += n;
+  EXPECT_EQ(sum, 8);
+  expect_exact_and_aligned(designer, s);
+}
+
+TEST(QuadWildFiles, RosyRoundTrip) {
+  const Mesh m = make_cube_sphere(4, false);
+  FieldDesigner designer(m.V, m.F);
+  const Solved s = solve_with_features(designer, 30);
+  const std::string path = temp_file("m.rosy");
+  write_field(path, m.V, m.F, designer.geometry(), s.design.field);
+  const std::vector<std::string> lines = test::lines_of(test::slurp(path));
+  ASSERT_EQ(lines.size(), 2 + static_cast<size_t>(m.F.rows()));
+  EXPECT_EQ(lines[0], std::to_string(m.F.rows()));
+  EXPECT_EQ(lines[1], "4");
+  int N = 0;
+  const MatrixX3d d = read_field(path, static_cast<int>(m.F.rows()), &N);
+  EXPECT_EQ(N, 4);
+  for (int f = 0; f < m.F.rows(); ++f)
+    EXPECT_LE((d.row(f).transpose() - designer.geometry().direction_in_face(f, s.design.field.angle(f))).norm(), 1e-15);
+  // Only crosses: QuadWild would misread another N.
+  Field lines2 = s.design.field;
+  lines2.N = 2;
+  EXPECT_NE(error_of([&] { write_field(temp_file("l.rosy"), m.V, m.F, designer.geometry(), lines2); }).find("N = 2"), std::string::npos);
+  write_text(path, "3\n4\n1 0 0\n");
+  EXPECT_NE(error_of([&] { read_field(path, static_cast<int>(m.F.rows())); }).find(path + ":1: the field has 3 faces"), std::string::npos);
+}
+
+TEST(QuadWildFiles, SharpRoundTripInTheFilesFaceOrder) {
+  // Some faces given with the other orientation: the topology flips them back, the file keeps them.
+  Mesh m = make_cube_sphere(3, false);
+  for (int f = 0; f < 5; ++f) std::swap(m.F(f, 1), m.F(f, 2));
+  const Topology t = test::topo(m);
+  ASSERT_EQ(t.flipped_faces.size(), 5u);
+  const Geometry g = compute_geometry(m.V, t);
+  const std::vector<int> edges = sharp_edges(m.V, t, g, 45);
+  std::vector<char> convex;
+  for (int e : edges) convex.push_back(is_convex_edge(m.V, t, g, e));
+  const std::string path = temp_file("m.sharp");
+  write_sharp(path, m.F, t, edges, convex);
+  EXPECT_EQ(test::lines_of(test::slurp(path))[0], std::to_string(2 * edges.size()));
+  const std::vector<SharpFaceEdge> read = read_sharp(path, static_cast<int>(m.F.rows()));
+  ASSERT_EQ(read.size(), 2 * edges.size());
+  std::set<std::pair<int, int>> got, want;  // (min vertex, max vertex) of each line's edge, per face
+  for (const SharpFaceEdge& r : read) {
+    EXPECT_EQ(r.convex, 1);
+    const int i = m.F(r.face, r.edge), j = m.F(r.face, (r.edge + 1) % 3);
+    got.insert({r.face, std::min(i, j) * 100000 + std::max(i, j)});
+  }
+  for (int e : edges)
+    for (int side = 0; side < 2; ++side) want.insert({t.edge_faces(e, side), t.edge_vertices(e, 0) * 100000 + t.edge_vertices(e, 1)});
+  EXPECT_EQ(got, want);
+  write_text(path, "2\n1,0,0\n");
+  EXPECT_NE(error_of([&] { read_sharp(path, 10); }).find("ends after 1 of the 2"), std::string::npos);
+  write_text(path, "1\n1,0,3\n");
+  EXPECT_NE(error_of([&] { read_sharp(path, 10); }).find(path + ":2: edge '3'"), std::string::npos);
+  write_text(path, "1\n2,0,1\n");
+  EXPECT_NE(error_of([&] { read_sharp(path, 10); }).find("convexity"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace trivcon
