@@ -46,7 +46,8 @@ class CMakeBuild(build_ext):
         except ImportError:  # CMake then looks for pybind11-dev's config itself
             pass
         if not given:  # our own folder: the module only, Release, ccache when there is one
-            args += ["-DCMAKE_BUILD_TYPE=Release", "-DTRIVCON_BUILD_TESTS=OFF", "-DTRIVCON_BUILD_BENCH=OFF"]
+            # The module needs neither the editor's server nor its page (node, cpp-httplib).
+            args += ["-DCMAKE_BUILD_TYPE=Release", "-DTRIVCON_BUILD_TESTS=OFF", "-DTRIVCON_BUILD_BENCH=OFF", "-DTRIVCON_EDITOR=OFF"]
             if shutil.which("ccache"):
                 args.append("-DCMAKE_CXX_COMPILER_LAUNCHER=ccache")
         args += shlex.split(os.environ.get("CMAKE_ARGS", ""))

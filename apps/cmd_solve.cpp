@@ -51,7 +51,6 @@ struct SolveOptions {
 // Rounds of --split-large-turns before it gives up (each splits every edge still turning by π/N or more).
 constexpr int kMaxSplitRounds = 8;
 
-// --fix takes "F:x,y,z" / "F:angle=A" specs and files; a spec starts with a face id and a colon.
 // The strength T of --align curvature[:T] (0 when not given), or nothing when the text is not of that form.
 std::optional<double> alignment_strength(const std::string& text) {
   if (text == "curvature") return 0.0;
@@ -67,11 +66,6 @@ std::optional<double> alignment_strength(const std::string& text) {
   }
   if (used != number.size() || !std::isfinite(t) || !(t < 1)) return std::nullopt;
   return t;
-}
-
-bool is_fix_spec(const std::string& s) {
-  const size_t colon = s.find(':');
-  return colon != std::string::npos && colon > 0 && s.find_first_not_of("0123456789") == colon;
 }
 
 std::string fmt(double v) {
@@ -214,12 +208,7 @@ void run_solve(const SolveOptions& o) {
   std::string features_summary;
   std::vector<int> sharp = apply_features(o, designer, prescription, &extra, &features_summary);
   std::map<int, double> explicit_fixed;  // --fix wins over --align-boundary on the same face
-  for (const auto& f : o.fixes) {
-    if (is_fix_spec(f))
-      add_fixed_direction(f, designer.topology(), designer.geometry(), explicit_fixed);
-    else
-      read_fixed_directions(f, designer.topology(), designer.geometry(), explicit_fixed);
-  }
+  add_fix_options(o.fixes, designer.topology(), designer.geometry(), explicit_fixed);
   for (auto [f, angle] : explicit_fixed) prescription.fixed[f] = angle;
   std::vector<int> fixed_faces;
   for (auto [f, angle] : prescription.fixed) fixed_faces.push_back(f);

@@ -1,5 +1,6 @@
 #include "prescription_options.h"
 
+#include "trivcon/constraints.h"
 #include "trivcon/error.h"
 #include "trivcon/field_io.h"
 
@@ -34,6 +35,26 @@ MatrixX3d PrescriptionOptions::read_field_file(const std::string& path, int num_
                 " was given");
   if (file_N > 0) N_out = file_N;
   return directions;
+}
+
+namespace {
+
+// --fix takes "F:x,y,z" / "F:angle=A" specs and files; a spec starts with a face id and a colon.
+bool is_fix_spec(const std::string& s) {
+  const size_t colon = s.find(':');
+  return colon != std::string::npos && colon > 0 && s.find_first_not_of("0123456789") == colon;
+}
+
+}  // namespace
+
+void add_fix_options(const std::vector<std::string>& fixes, const Topology& topology, const Geometry& geometry,
+                     std::map<int, double>& fixed) {
+  for (const auto& f : fixes) {
+    if (is_fix_spec(f))
+      add_fixed_direction(f, topology, geometry, fixed);
+    else
+      read_fixed_directions(f, topology, geometry, fixed);
+  }
 }
 
 }  // namespace trivcon::cli

@@ -1,12 +1,15 @@
-// The options that describe a prescription (-N, -s, --sing, --generator, --boundary), shared by `solve`
+// The options that describe a prescription (-N, -s, --sing, --generator, --boundary), shared by `solve`, `edit`
 // and `check`.
 #pragma once
 #include <CLI/CLI.hpp>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "trivcon/common.h"
+#include "trivcon/geometry.h"
 #include "trivcon/indices.h"
+#include "trivcon/topology.h"
 
 namespace trivcon::cli {
 
@@ -26,5 +29,10 @@ struct PrescriptionOptions {
   // the file states one, which must agree with -N when that was given (trivcon::Error otherwise).
   MatrixX3d read_field_file(const std::string& path, int num_faces, int& N) const;
 };
+
+// The --fix arguments of `solve` and `edit`: "F:x,y,z" / "F:angle=A" specs and files of such lines, added to
+// `fixed` (face → angle in its frame; trivcon/constraints.h; throws trivcon::Error naming the argument).
+void add_fix_options(const std::vector<std::string>& fixes, const Topology& topology, const Geometry& geometry,
+                     std::map<int, double>& fixed);
 
 }  // namespace trivcon::cli

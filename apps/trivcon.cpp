@@ -21,6 +21,9 @@ int main(int argc, char** argv) {
   trivcon::cli::register_solve(app);
   trivcon::cli::register_check(app);
   trivcon::cli::register_render(app);
+#ifdef TRIVCON_EDITOR
+  trivcon::cli::register_edit(app);
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -5,15 +5,22 @@
 #   scripts/deps.sh --fuzz     also clang's libFuzzer and sanitizer runtimes (scripts/fuzz.sh)
 #   scripts/deps.sh --python   also the Python module's: pybind11, numpy, pytest, Dask (distributed), pip, venv,
 #                              setuptools and wheel, all from Debian (scripts/python.sh; no other package index)
+#   scripts/deps.sh --web      also the editor's (`trivcon edit`): cpp-httplib, Chromium for the browser tests, node and
+#                              npm (Debian's, unless a node is already installed), then `npm ci` in web/ (three, esbuild,
+#                              puppeteer-core, at the versions of web/package-lock.json) when web/node_modules is not current
 set -euo pipefail
 packages=(build-essential cmake pkg-config zlib1g-dev libeigen3-dev libsuitesparse-dev libopenblas-dev libmetis-dev
           libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libstb-dev)
+web=0
 for extra in "$@"; do
   case "$extra" in
     --python) packages+=(python3 python3-dev python3-venv python3-pip python3-setuptools python3-wheel python3-numpy pybind11-dev
                          python3-pybind11 python3-pytest python3-distributed) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev libomp-14-dev) ;;  # libFuzzer, its sanitizer runtimes, OpenMP for clang
-    *) echo "deps.sh: unknown option $extra (known: --python, --fuzz)" >&2; exit 2 ;;
+    --web) web=1
+           packages+=(libcpp-httplib-dev chromium)
+           command -v npm >/dev/null 2>&1 || packages+=(nodejs npm) ;;
+    *) echo "deps.sh: unknown option $extra (known: --python, --fuzz, --web)" >&2; exit 2 ;;
   esac
 done
 missing=()
@@ -27,4 +34,11 @@ if [ ${#missing[@]} -gt 0 ]; then
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -qq
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+if [ "$web" = 1 ]; then
+  # npm ci when node_modules is missing or older than the lock file (npm writes node_modules/.package-lock.json).
+  if [ ! -f web/node_modules/.package-lock.json ] || [ web/package-lock.json -nt web/node_modules/.package-lock.json ]; then
+    echo "== npm ci in web/"
+    (cd web && npm ci --no-audit --no-fund --loglevel=error)
+  fi
 fi

@@ -160,58 +160,55 @@ int field_text_N(const std::string& bytes, const std::string& path) {
 
 }  // namespace
 
-void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& g, const Field& field) {
+void write_field_to(std::ostream& out, const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& g,
+                    const Field& field) {
   const int nF = static_cast<int>(F.rows());
   if (ends_with(path, ".rawfield")) {
-    write_file_atomically(path, [&](std::ostream& out) {
-      out << std::setprecision(17) << field.N << " " << nF << "\n";
-      for (int f = 0; f < nF; ++f) {
-        for (int k = 0; k < field.N; ++k) {
-          const Eigen::Vector3d d = direction_k(g, field, f, k);
-          out << (k ? " " : "") << d.x() << " " << d.y() << " " << d.z();
-        }
-        out << "\n";
+    out << std::setprecision(17) << field.N << " " << nF << "\n";
+    for (int f = 0; f < nF; ++f) {
+      for (int k = 0; k < field.N; ++k) {
+        const Eigen::Vector3d d = direction_k(g, field, f, k);
+        out << (k ? " " : "") << d.x() << " " << d.y() << " " << d.z();
       }
-    });
+      out << "\n";
+    }
   } else if (ends_with(path, ".rosy")) {
     // QuadWild reads 4-RoSy fields only (vcglib's Load4ROSY): another N would be misread, not rejected.
     if (field.N != 4)
       throw Error(path + ": a .rosy file holds a 4-direction field (QuadWild's format), this field has N = " + std::to_string(field.N));
-    write_file_atomically(path, [&](std::ostream& out) {
-      out << nF << "\n" << field.N << "\n" << std::setprecision(17);
-      for (int f = 0; f < nF; ++f) {
-        const Eigen::Vector3d d = direction_k(g, field, f, 0);
-        out << d.x() << " " << d.y() << " " << d.z() << "\n";
-      }
-    });
+    out << nF << "\n" << field.N << "\n" << std::setprecision(17);
+    for (int f = 0; f < nF; ++f) {
+      const Eigen::Vector3d d = direction_k(g, field, f, 0);
+      out << d.x() << " " << d.y() << " " << d.z() << "\n";
+    }
   } else if (ends_with(path, ".ply")) {
-    write_file_atomically(path, [&](std::ostream& out) {
-      out << "ply\nformat binary_little_endian 1.0\ncomment trivcon field, N " << field.N << "\nelement vertex " << V.rows()
-          << "\nproperty double x\nproperty double y\nproperty double z\nelement face " << nF
-          << "\nproperty list uchar int vertex_indices\nproperty double fx\nproperty double fy\nproperty double fz\nend_header\n";
-      for (int v = 0; v < V.rows(); ++v)
-        for (int k = 0; k < 3; ++k) put_double(out, V(v, k));
-      for (int f = 0; f < nF; ++f) {
-        out.put(3);
-        for (int k = 0; k < 3; ++k) {
-          const int32_t id = F(f, k);
-          out.write(reinterpret_cast<const char*>(&id), 4);
-        }
-        const Eigen::Vector3d d = direction_k(g, field, f, 0);
-        for (int k = 0; k < 3; ++k) put_double(out, d(k));
+    out << "ply\nformat binary_little_endian 1.0\ncomment trivcon field, N " << field.N << "\nelement vertex " << V.rows()
+        << "\nproperty double x\nproperty double y\nproperty double z\nelement face " << nF
+        << "\nproperty list uchar int vertex_indices\nproperty double fx\nproperty double fy\nproperty double fz\nend_header\n";
+    for (int v = 0; v < V.rows(); ++v)
+      for (int k = 0; k < 3; ++k) put_double(out, V(v, k));
+    for (int f = 0; f < nF; ++f) {
+      out.put(3);
+      for (int k = 0; k < 3; ++k) {
+        const int32_t id = F(f, k);
+        out.write(reinterpret_cast<const char*>(&id), 4);
       }
-    });
+      const Eigen::Vector3d d = direction_k(g, field, f, 0);
+      for (int k = 0; k < 3; ++k) put_double(out, d(k));
+    }
   } else {
-    write_file_atomically(path, [&](std::ostream& out) {
-      out << "# trivcon field: per face, the first of N unit directions (x y z, world coordinates)\n# N " << field.N << "\n# faces " << nF
-          << "\n"
-          << std::setprecision(17);
-      for (int f = 0; f < nF; ++f) {
-        const Eigen::Vector3d d = direction_k(g, field, f, 0);
-        out << d.x() << " " << d.y() << " " << d.z() << "\n";
-      }
-    });
+    out << "# trivcon field: per face, the first of N unit directions (x y z, world coordinates)\n# N " << field.N << "\n# faces " << nF
+        << "\n"
+        << std::setprecision(17);
+    for (int f = 0; f < nF; ++f) {
+      const Eigen::Vector3d d = direction_k(g, field, f, 0);
+      out << d.x() << " " << d.y() << " " << d.z() << "\n";
+    }
   }
+}
+
+void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& g, const Field& field) {
+  write_file_atomically(path, [&](std::ostream& out) { write_field_to(out, path, V, F, g, field); });
 }
 
 MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file) {

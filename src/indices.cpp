@@ -67,11 +67,13 @@ std::string format_index(int n, int N) {
   return std::to_string(n / g) + "/" + std::to_string(N / g);
 }
 
+void write_singularities_to(std::ostream& out, const std::map<int, int>& vertex, int N) {
+  out << "# trivcon singularities\n# N " << N << "\n# " << vertex.size() << " singular vertices\n";
+  for (auto [v, n] : vertex) out << v << " " << format_index(n, N) << "\n";
+}
+
 void write_singularities(const std::string& path, const std::map<int, int>& vertex, int N) {
-  write_file_atomically(path, [&](std::ostream& out) {
-    out << "# trivcon singularities\n# N " << N << "\n# " << vertex.size() << " singular vertices\n";
-    for (auto [v, n] : vertex) out << v << " " << format_index(n, N) << "\n";
-  });
+  write_file_atomically(path, [&](std::ostream& out) { write_singularities_to(out, vertex, N); });
 }
 
 void add_vertex_index(const std::string& spec, IndexPrescription& p) {

@@ -21,6 +21,7 @@
 // Readers accept what the writers write (and .rawfield from Directional) and report the file and line of
 // any problem. All writers are atomic (trivcon/io.h).
 #pragma once
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,9 @@ namespace trivcon {
 
 // Writes by extension: .rawfield, .rosy, .ply, anything else the text format.
 void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& geometry, const Field& field);
+// The same bytes written to a stream (the editor's downloads); `path` only picks the format, by its extension.
+void write_field_to(std::ostream& out, const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& geometry,
+                    const Field& field);
 // Reads a field written by write_field, a Directional .rawfield or a QuadWild .rosy: world directions (F × 3, the first
 // direction per face) and N (0 when the file does not say). `num_faces` must match.
 MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file = nullptr);

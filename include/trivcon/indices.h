@@ -14,6 +14,7 @@
 // Gauss–Bonnet: on every component the vertex indices plus the loop indices sum to χ.
 #pragma once
 #include <map>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,8 @@ std::string format_index(int n, int N);
 // comment ("# trivcon singularities", "# N <N>", "# <count> singular vertices"), then one
 // "VERTEX INDEX" line per vertex in increasing id, INDEX from format_index. read_singularities reads it back.
 void write_singularities(const std::string& path, const std::map<int, int>& vertex, int N);
+// The same text written to a stream (the editor's download).
+void write_singularities_to(std::ostream& out, const std::map<int, int>& vertex, int N);
 
 // Checks the prescription against the mesh: vertex out of range, unreferenced or on the boundary;
 // generator or loop id out of range; on each closed component, vertex indices summing to χ; on a

@@ -1,0 +1,61 @@
+// server/editor_server.h: the HTTP server of `trivcon edit` — the page and a JSON API over one FieldDesigner.
+//
+// No numerics here: requests are turned into the library's prescriptions (through the same parsers as
+// the command line, so that a mistake gets the CLI's message), designed by FieldDesigner, and described
+// by solve_report (report/report.h). The endpoints are documented in README.md ("Editor").
+//
+// Safety (README.md, "Editor"): it listens on the host it is given (the CLI's default is 127.0.0.1);
+// every API call needs the per-run token (header X-Trivcon-Token, cookie, or ?token=); a request whose
+// Host header is not the served address is refused (DNS rebinding); bodies are size-limited; no endpoint
+// reads or writes a file. Requests are served on several threads: designs share the designer (design() is
+// const) and a change of the fixed faces (set_fixed_faces refactors) takes it exclusively.
+#pragma once
+#include <cstddef>
+#include <memory>
+#include <string>
+
+#include "trivcon/design.h"
+#include "trivcon/indices.h"
+#include "trivcon/io.h"
+
+namespace trivcon::server {
+
+struct EditorOptions {
+  std::string host = "127.0.0.1";
+  std::string token;                  // "" → 128 random bits, in hex
+  size_t max_body_bytes = 32u << 20;  // request bodies above this get 413
+  std::string mesh_path;              // as given on the command line (the report names it)
+  double read_seconds = 0;            // reading the mesh (the report's seconds.read)
+  IndexPrescription initial;          // the session the page starts with (-N, -s, --sing, --fix angles)
+  bool align_boundary = false;        // --align-boundary at start
+};
+
+class EditorServer {
+ public:
+  // Prepares the designer (validates the mesh: throws trivcon::Error) and factors for the initial fixed faces.
+  EditorServer(MeshData mesh, EditorOptions options);
+  // With a designer the caller prepared for this mesh (`trivcon edit` needs it to read --fix first).
+  EditorServer(MeshData mesh, std::unique_ptr<FieldDesigner> designer, EditorOptions options);
+  ~EditorServer();
+  EditorServer(const EditorServer&) = delete;
+  EditorServer& operator=(const EditorServer&) = delete;
+
+  // Binds host:port (port 0: a free one); returns the port. Throws trivcon::Error when it cannot (then another
+  // port may be tried).
+  int bind(int port);
+  // Serves until stop() (from any thread). Returns false if the listening socket failed.
+  bool run();
+  void stop();
+  bool running() const;
+
+  const std::string& token() const;
+  int port() const;
+  // The page's address with the token, e.g. http://127.0.0.1:8642/?token=… (after bind()).
+  std::string url() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace trivcon::server
