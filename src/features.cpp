@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "detail/text_lines.h"
 #include "trivcon/error.h"
 #include "trivcon/field.h"
 #include "trivcon/io.h"
@@ -31,24 +32,7 @@ int corner_of(const Topology& t, int f, int e) {
   return -1;
 }
 
-// The non-comment lines of a text file, with their 1-based numbers.
-struct Lines {
-  std::istringstream in;
-  std::string path, line;
-  int number = 0;
-  Lines(const std::string& bytes, const std::string& p) : in(bytes), path(p) {}
-  bool next() {
-    while (std::getline(in, line)) {
-      ++number;
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      const size_t a = line.find_first_not_of(" \t");
-      if (a == std::string::npos || line[a] == '#') continue;
-      return true;
-    }
-    return false;
-  }
-  std::string where() const { return path + ":" + std::to_string(number); }
-};
+using Lines = detail::TextLines;
 
 // A whole number in [lo, hi], or an error naming the line and what it should be.
 long long whole(const std::string& token, const Lines& lines, long long lo, long long hi, const char* what) {

@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "detail/readers.h"
+#include "detail/text_lines.h"
 #include "detail/text_scanner.h"
 #include "trivcon/error.h"
 
@@ -41,24 +42,7 @@ int edge_between(const Topology& t, int i, int j) {
 
 void put_double(std::ostream& out, double v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); }
 
-// Lines of a text file with their 1-based numbers, comments and blank lines skipped.
-struct TextLines {
-  std::istringstream in;
-  std::string path, line;
-  int number = 0;
-  TextLines(const std::string& bytes, const std::string& p) : in(bytes), path(p) {}
-  bool next() {
-    while (std::getline(in, line)) {
-      ++number;
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      const size_t a = line.find_first_not_of(" \t");
-      if (a == std::string::npos || line[a] == '#') continue;
-      return true;
-    }
-    return false;
-  }
-  std::string where() const { return path + ":" + std::to_string(number); }
-};
+using detail::TextLines;
 
 std::vector<double> parse_numbers(const TextLines& lines, size_t expected) {
   std::istringstream fields(lines.line);
