@@ -318,16 +318,7 @@ std::vector<int> edges_by_vertices(const Topology& t) {
   return order;
 }
 
-// A whole number token within [lo, hi], or an error naming the line and what it should be.
-long long whole_number(const std::string& token, const TextLines& lines, long long lo, long long hi, const char* what) {
-  char* end = nullptr;
-  errno = 0;
-  const long long v = std::strtoll(token.c_str(), &end, 10);
-  if (token.empty() || end != token.c_str() + token.size() || errno == ERANGE || v < lo || v > hi)
-    throw Error(lines.where() + ": " + what + " '" + token + "' is not a whole number in [" + std::to_string(lo) + ", " +
-                std::to_string(hi) + "]");
-  return v;
-}
+using detail::whole_number;
 }  // namespace
 
 void write_matching(const std::string& path, const Topology& t, const Eigen::VectorXi& matching, int N) {
