@@ -331,6 +331,7 @@ function highlightCycle(kind, id) {
 let inflight = false;
 let pending = null;
 let idleWaiters = [];
+let refactorSeconds = null; // how long the last re-factoring for fixed faces took (the progress bar's estimate)
 let solvedFixedKey = null; // the fixed faces the server was last set up for (a change refactors)
 
 function fixedKey(s) {
@@ -346,17 +347,30 @@ async function pump() {
   inflight = true;
   const refactor = fixedKey(job.session) !== solvedFixedKey;
   let timer = null;
+  const t0 = performance.now();
   if (refactor) {
-    const t0 = performance.now();
+    // The server does not stream its progress; the bar runs against the expected time: the last
+    // re-factoring's, or at first three times the set-up without fixed faces (BENCHMARKS.md measures
+    // 1.8–3.4× with thousands of them), and stops short of the end until the answer arrives.
     const faces = job.session.fixed.size + (job.session.align ? ' + boundary' : '');
-    const tick = () => status(`re-factoring for ${faces} fixed face(s)… ${((performance.now() - t0) / 1000).toFixed(1)} s`);
+    const expected = refactorSeconds ?? 3 * (lastReport ? lastReport.seconds.setup + lastReport.seconds.analysis : 1);
+    const bar = $('progress');
+    bar.hidden = false;
+    const tick = () => {
+      const elapsed = (performance.now() - t0) / 1000;
+      bar.value = Math.min(0.95, elapsed / Math.max(expected, 0.05));
+      status(`re-factoring for ${faces} fixed face(s)… ${elapsed.toFixed(1)} s of about ${expected.toFixed(1)} s`);
+    };
     tick();
     timer = setInterval(tick, 100);
   } else {
-    status('solving…');
+    // Shown only for a solve that takes a while: a page update per edit would be repainted (on the CPU,
+    // with SwiftShader) while the server solves on the same cores.
+    timer = setTimeout(() => status('solving…'), 250);
   }
   try {
     const r = await api.solve(requestBody(job.session), glyphs.stride, wantedDirections(glyphs));
+    if (refactor) refactorSeconds = (performance.now() - t0) / 1000;
     solvedFixedKey = fixedKey(job.session);
     showField(r, job);
     lastError = '';
@@ -366,7 +380,8 @@ async function pump() {
     lastError = e.message;
     status('not solved: the last valid field is shown');
   } finally {
-    if (timer) clearInterval(timer);
+    if (timer) clearInterval(timer), clearTimeout(timer);
+    $('progress').hidden = true;
   }
   updateReadout();
   inflight = false;
@@ -736,7 +751,8 @@ renderer.domElement.addEventListener('pointermove', (e) => {
     session.sings.set(v, n);
     gesture.at = v;
     rebuildMarkers();
-    invalidate();
+    // No frame of its own: the marker is drawn with the field solved for it (showField), so that the page
+    // does not render while the server solves on the same cores, and marker and field never disagree.
     requestSolve(e.timeStamp); // the newest position replaces any pending one; timed from the pointer event
   } else if (gesture.kind === 'fix') {
     const s = pickSurface(e.clientX, e.clientY);

@@ -234,8 +234,20 @@ async function main() {
       await page.mouse.move(c.x, c.y);
       await page.mouse.down();
       for (let k = 1; k <= 5; ++k) await page.mouse.move(c.x + 6 * k, c.y);
+      // The re-factoring shows its progress: a bar and a status line, both gone when the field arrives.
+      await page.evaluate(() => {
+        window.__progressSeen = [];
+        new MutationObserver(() => {
+          const bar = document.getElementById('progress');
+          if (!bar.hidden) window.__progressSeen.push(document.getElementById('status').textContent);
+        }).observe(document.getElementById('panel'), { subtree: true, childList: true, attributes: true, characterData: true });
+      });
       await page.mouse.up();
       await idle();
+      const seen = await page.evaluate(() => window.__progressSeen);
+      assert.ok(seen.some((t) => /^re-factoring for 1 fixed face\(s\)… \d+\.\d s of about \d+\.\d s$/.test(t)), JSON.stringify(seen));
+      assert.equal(await page.evaluate(() => document.getElementById('progress').hidden), true);
+      assert.match(await page.evaluate(() => document.getElementById('status').textContent), /^solved: energy /);
       const fixed = await page.evaluate(() => window.__trivcon.session.fixed);
       assert.equal(fixed.length, 1);
       const state = await api('/api/state');
