@@ -3,6 +3,10 @@
 #include "summary.h"
 #include "trivcon/matching.h"
 #include "trivcon/blas.h"
+#include "trivcon/process.h"
+
+#include <cstdlib>
+#include <string>
 
 namespace trivcon::cli {
 
@@ -17,6 +21,12 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
   report["weights"] = run.weights;
   report["solver"] = run.solver;
   report["blas_kernels"] = blas_kernels();
+  {  // huge pages for malloc's large blocks (trivcon/process.h)
+    const char* tunables = std::getenv("GLIBC_TUNABLES");
+    const std::string t = tunables ? tunables : "";
+    report["huge_pages"] = {{"kernel", transparent_huge_pages_mode()},
+                            {"malloc", t.find("glibc.malloc.hugetlb=1") != std::string::npos || t.find("glibc.malloc.hugetlb=2") != std::string::npos}};
+  }
   report["ordering"] = designer.solver().ordering();
   nlohmann::ordered_json sing = nlohmann::ordered_json::array();
   for (auto [v, n] : prescription.vertex) sing.push_back({{"vertex", v}, {"index", format_index(n, prescription.N)}});

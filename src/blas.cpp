@@ -29,16 +29,6 @@ std::string native_blas_kernels() {
   return "";
 }
 
-void use_native_blas_kernels(char** argv) {
-  if (std::getenv("OPENBLAS_CORETYPE") != nullptr) return;
-  if (blas_kernels() != "Prescott") return;  // OpenBLAS's generic fallback for a CPU it does not know
-  const std::string native = native_blas_kernels();
-  if (native.empty()) return;
-  if (setenv("OPENBLAS_CORETYPE", native.c_str(), 1) != 0) return;
-  execv("/proc/self/exe", argv);
-  unsetenv("OPENBLAS_CORETYPE");  // exec failed: carry on as we are
-}
-
 namespace {
 std::mutex blas_threads_mutex;
 int single_threaded_users = 0;  // live SingleThreadedBlas objects

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -18,6 +19,7 @@
 
 #include "support.h"
 #include "trivcon/blas.h"
+#include "trivcon/process.h"
 #include "trivcon/generate.h"
 #include "trivcon/geometry.h"
 #include "trivcon/io.h"
@@ -519,6 +521,13 @@ TEST(CliSolve, SphereWithTwoPoles) {
   ASSERT_TRUE(rep["blas_kernels"].is_string());
   if (std::getenv("OPENBLAS_CORETYPE") == nullptr && !native_blas_kernels().empty()) {
     EXPECT_NE(rep["blas_kernels"].get<std::string>(), "Prescott");
+  }
+  // Huge pages (trivcon/process.h): asked for where the kernel gives them only on request, unless the
+  // environment chooses (GLIBC_TUNABLES naming glibc.malloc.hugetlb).
+  EXPECT_EQ(rep["huge_pages"]["kernel"], transparent_huge_pages_mode());
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (std::string(transparent_huge_pages_mode()) == "madvise" && (!tunables || !std::strstr(tunables, "glibc.malloc.hugetlb"))) {
+    EXPECT_EQ(rep["huge_pages"]["malloc"], true);
   }
 
   // Field text: header, one unit vector per face.

@@ -18,12 +18,8 @@ std::string blas_kernels();
 // AVX-512 (F, CD, BW, DQ, VL), "Haswell" with AVX2 and FMA, else "".
 std::string native_blas_kernels();
 
-// For a program's main(): if OpenBLAS fell back to its generic kernels although the CPU supports better
-// ones, and OPENBLAS_CORETYPE is not set, re-executes the program (/proc/self/exe, same arguments) with
-// OPENBLAS_CORETYPE set to native_blas_kernels(). Returns when there is nothing to do, or if the
-// re-execution fails (the program then carries on with the generic kernels). Set OPENBLAS_CORETYPE
-// yourself (e.g. to Prescott) to keep your own choice.
-void use_native_blas_kernels(char** argv);
+// A program's main() gets the better kernels by calling use_tuned_process(argv) (trivcon/process.h), which
+// re-executes it with OPENBLAS_CORETYPE set to native_blas_kernels() when OpenBLAS fell back to its generic ones.
 
 // While an object of this class lives, OpenBLAS runs every call on the calling thread alone (its own
 // thread count is set to 1, and restored when the last such object in the process is destroyed). For

@@ -1,0 +1,47 @@
+#include "trivcon/process.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+
+#include "trivcon/blas.h"
+
+namespace trivcon {
+
+const char* transparent_huge_pages_mode() {
+  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string line;
+  if (!std::getline(in, line)) return "";
+  for (const char* mode : {"always", "madvise", "never"})
+    if (line.find(std::string("[") + mode + "]") != std::string::npos) return mode;
+  return "";
+}
+
+void use_tuned_process(char** argv) {
+  const char* old_tunables = std::getenv("GLIBC_TUNABLES");
+  const std::string tunables = old_tunables ? old_tunables : "";
+  bool set_coretype = false, set_tunables = false;
+  if (std::getenv("OPENBLAS_CORETYPE") == nullptr && blas_kernels() == "Prescott") {  // OpenBLAS's generic fallback
+    const std::string native = native_blas_kernels();
+    set_coretype = !native.empty() && setenv("OPENBLAS_CORETYPE", native.c_str(), 1) == 0;
+  }
+  if (tunables.find("glibc.malloc.hugetlb") == std::string::npos && std::strcmp(transparent_huge_pages_mode(), "madvise") == 0) {
+    const std::string value = tunables.empty() ? "glibc.malloc.hugetlb=1" : tunables + ":glibc.malloc.hugetlb=1";
+    set_tunables = setenv("GLIBC_TUNABLES", value.c_str(), 1) == 0;
+  }
+  if (!set_coretype && !set_tunables) return;
+  execv("/proc/self/exe", argv);
+  // The re-execution failed: carry on as we are, with the environment as it was.
+  if (set_coretype) unsetenv("OPENBLAS_CORETYPE");
+  if (set_tunables) {
+    if (old_tunables)
+      setenv("GLIBC_TUNABLES", tunables.c_str(), 1);
+    else
+      unsetenv("GLIBC_TUNABLES");
+  }
+}
+
+}  // namespace trivcon
