@@ -71,7 +71,6 @@ struct ConnectionSolver::Impl {
   std::vector<double> loop_curvature, generator_holonomy, path_holonomy;
   SetupTimings timings;
   std::unique_ptr<detail::SolverEngine> engine;
-  std::unique_ptr<detail::SolverEngine> relaxed_engine;  // vertex rows only, when the path rows are sparse
   bool sparse_paths = false;
 
   // Rows of the reduced system: interior vertices (minus one per closed component), then the cycle
@@ -241,18 +240,17 @@ void ConnectionSolver::Impl::factor(const std::function<SolverAnalysis()>& analy
     if (analysis && paths.empty()) given = [&analysis] { return std::move(analysis().state_); };
     engine = detail::make_cholesky_engine(ends, num_vertex_rows, SparseMatrix(m, 0), Ct, w, options.factorization, timings, given);
   } else {
-    // The vertex rows alone (for the field without path constraints), and vertex + path rows together.
+    // The vertex and path rows together, ordered anew (CAMD). (Ordering the path rows first, or each
+    // before the first of its vertices, with the vertex order of the system without them, made the
+    // factorization 60–80 times slower on a cube's feature lines: 4,367 paths, many sharing edges.)
     const SparseMatrix Et =
         detail::cycle_columns(m, edge_column, static_cast<int>(paths.size()), [&](int k) -> const DualCycle& { return paths[k].path; });
-    relaxed_engine =
-        detail::make_cholesky_engine(ends, num_vertex_rows, SparseMatrix(m, 0), SparseMatrix(m, 0), w, options.factorization, timings);
     engine = detail::make_cholesky_engine(ends, num_vertex_rows, Et, Ct, w, options.factorization, timings);
   }
   t0 = Clock::now();
   Eigen::VectorXd base(num_vertex_rows);
   for (int v = 0; v < t.num_vertices; ++v)
     if (vertex_row[v] >= 0) base(vertex_row[v]) = geometry.angle_defect(v);
-  if (relaxed_engine) relaxed_engine->set_base_rhs(base);
   base.conservativeResize(num_vertex_rows + (sparse_paths ? static_cast<Eigen::Index>(paths.size()) : 0));
   base.tail(base.size() - num_vertex_rows).setZero();
   engine->set_base_rhs(base);
@@ -420,22 +418,24 @@ ConnectionSolver::Impl::CycleRhs ConnectionSolver::Impl::cycle_rhs(const IndexPr
   return c;
 }
 
-// With the path rows sparse, each path's whole number of turns n_E is rounded from the field without path
-// constraints (and with real-valued loop and generator holonomies): the vertex rows alone. Returns the
-// right-hand side of the vertex and path rows.
+// With the path rows sparse, each path's whole number of turns n_E is the one that makes the connection's
+// turn along the path, beyond parallel transport, smallest: for a path of one edge (two adjacent fixed
+// faces, most of them on feature lines and boundaries) that turn is the edge's x itself, fixed by the two
+// directions alone, so this is the principal matching of the two fixed directions. (Rounding instead the
+// turn of the field without path constraints, which knows nothing of the fixed directions, gave a CAD
+// mesh 65 times the energy of the dense route's choice, and needed a second factorization; this choice is
+// within 0.2 % there, BENCHMARKS.md "Fixed directions".) Returns the right-hand side of the vertex and
+// path rows.
 Eigen::VectorXd ConnectionSolver::Impl::round_sparse_path_turns(const IndexPrescription& prescription, const Eigen::VectorXd& b_D,
                                                                 Eigen::VectorXd& n_E) const {
   const double step = 2 * kPi / prescription.N;
-  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(topology.num_edges);
-  const Eigen::VectorXd x0_active = relaxed_engine->solve(b_D, [](const Eigen::VectorXd& r0) { return r0; });
-  for (size_t a = 0; a < active_edges.size(); ++a) x0(active_edges[a]) = x0_active(static_cast<Eigen::Index>(a));
   const int nP = static_cast<int>(paths.size());
   n_E.resize(nP);
   Eigen::VectorXd b = b_D;
   b.conservativeResize(num_vertex_rows + nP);
   for (int k = 0; k < nP; ++k) {
     const double h = path_target(k, prescription);
-    n_E(k) = std::floor((h - cycle_sum(paths[k].path, x0)) / step + 0.5 + 1e-7);
+    n_E(k) = std::floor(h / step + 0.5 + 1e-7);
     b(num_vertex_rows + k) = h - step * n_E(k);
   }
   return b;

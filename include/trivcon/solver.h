@@ -35,8 +35,9 @@
 // system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
 //
 // Fixed-face paths (trivcon/constraints.h) are cycle rows too. With more than 256 of them the Cholesky
-// route puts them with the vertex rows instead (a second, vertex-only factorization gives the field
-// without them, from which each path's whole number of turns is rounded), keeping the dense block small.
+// route puts them with the vertex rows instead, keeping the dense block small; each path's whole number
+// of turns is then the one that makes its turn beyond parallel transport smallest (for a path of one edge
+// between adjacent fixed faces, the principal matching of their two directions).
 //
 // Free cycle indices (generators and loops not prescribed) are chosen so that the field is smoothest:
 // the energy is a quadratic function of them, E = E₀ + (2π/N)² (u − n)ᵀ P (u − n) with P = S⁻¹; the
