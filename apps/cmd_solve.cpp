@@ -32,6 +32,7 @@ struct SolveOptions {
   std::string mesh;
   PrescriptionOptions prescription;
   std::string weights = "cotan", solver = "cholesky", factorization = "own";
+  double weight_floor = 0;
   std::vector<int> root_faces;
   std::vector<double> root_angles;
   std::vector<std::string> fixes;
@@ -200,6 +201,7 @@ void run_solve(const SolveOptions& o) {
 
   SolverOptions options;
   options.weights = o.weights == "unit" ? WeightKind::Unit : WeightKind::Cotan;
+  options.weight_floor = o.weight_floor;
   options.solver = o.solver == "qr" ? SolverKind::QR : SolverKind::Cholesky;
   options.factorization = o.factorization == "cholmod" ? Factorization::Cholmod : Factorization::Parallel;
   FieldDesigner designer(mesh.V, mesh.F, options);
@@ -354,6 +356,9 @@ void register_solve(CLI::App& app) {
   cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply, optionally .gz")->required();
   o.prescription.add_to(cmd, true);
   cmd->add_option("--weights", o.weights, "cotan (default: clamped cotangent weights) or unit")->check(CLI::IsMember({"cotan", "unit"}));
+  cmd->add_option("--weight-floor", o.weight_floor,
+                  "with cotan weights, every interior edge gets at least this fraction of the median weight (default 0: none)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--solver", o.solver, "cholesky (default) or qr (the paper's SuiteSparseQR route)")
       ->check(CLI::IsMember({"cholesky", "qr"}));
   cmd->add_option("--factorization", o.factorization,

@@ -55,7 +55,8 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
   report["weight_policy"] = {
       {"mollified_faces", designer.geometry().mollified_faces},       {"mollify_epsilon", designer.geometry().mollify_epsilon},
       {"clamped_cotangents", designer.geometry().clamped_cotangents}, {"zero_weight_edges", designer.geometry().zero_weight_edges},
-      {"regularized_edges", designer.solver().regularized_edges()},   {"refinements", c.refinements}};
+      {"regularized_edges", designer.solver().regularized_edges()},   {"weight_floor", designer.solver_options().weight_floor},
+      {"floored_edges", designer.solver().floored_edges()},           {"refinements", c.refinements}};
   report["energy"] = c.energy;
   report["residuals"] = {{"max_vertex", c.max_vertex_residual},
                          {"max_cycle", c.max_cycle_residual},

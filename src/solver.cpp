@@ -88,6 +88,7 @@ struct ConnectionSolver::Impl {
   std::vector<int> fixed_faces;
   std::vector<FixedPath> paths;
   int regularized_edges = 0;
+  int floored_edges = 0;  // edges raised to SolverOptions::weight_floor
 
   Impl(const Topology& t, const Geometry& g, const Cycles& c, SolverOptions o) : topology(t), geometry(g), cycles(c), options(o) {}
   int num_generators() const { return static_cast<int>(cycles.generators.size()); }
@@ -144,6 +145,19 @@ void ConnectionSolver::Impl::set_weights_and_paths(const std::vector<int>& fixed
   weights.setZero(nE);
   for (int e = 0; e < nE; ++e)
     if (!t.is_boundary_edge(e)) weights(e) = options.weights == WeightKind::Unit ? 1.0 : geometry.cotan_weight(e);
+  if (!(options.weight_floor >= 0 && options.weight_floor <= 1))
+    throw Error("the weight floor must be in [0, 1] (a fraction of the median weight), not " + std::to_string(options.weight_floor));
+  if (options.weights == WeightKind::Cotan && options.weight_floor > 0) {
+    std::vector<double> positive;
+    for (int e = 0; e < nE; ++e)
+      if (weights(e) > 0) positive.push_back(weights(e));
+    if (!positive.empty()) {
+      std::nth_element(positive.begin(), positive.begin() + positive.size() / 2, positive.end());
+      const double floor = options.weight_floor * positive[positive.size() / 2];
+      for (int e = 0; e < nE; ++e)
+        if (!t.is_boundary_edge(e) && weights(e) < floor) weights(e) = floor, ++floored_edges;
+    }
+  }
   for (size_t l = 0; l < t.boundary_loops.size(); ++l) loop_curvature.push_back(trivcon::loop_curvature(t, geometry, static_cast<int>(l)));
   for (const DualCycle& g : cycles.generators) generator_holonomy.push_back(levi_civita_holonomy(g, geometry));
   fixed_faces = fixed;
@@ -267,6 +281,7 @@ const std::vector<double>& ConnectionSolver::loop_curvatures() const { return im
 const std::vector<double>& ConnectionSolver::generator_holonomies() const { return impl_->generator_holonomy; }
 const std::vector<int>& ConnectionSolver::fixed_faces() const { return impl_->fixed_faces; }
 int ConnectionSolver::regularized_edges() const { return impl_->regularized_edges; }
+int ConnectionSolver::floored_edges() const { return impl_->floored_edges; }
 const std::vector<FixedPath>& ConnectionSolver::fixed_paths() const { return impl_->paths; }
 
 // Every vertex row must reach a boundary vertex or the dropped vertex of its component through edges of

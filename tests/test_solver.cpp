@@ -290,6 +290,45 @@ TEST(Solver, UnitWeightsAreExact) {
   }
 }
 
+// SolverOptions::weight_floor: every interior edge gets at least floor × the median positive cotan weight,
+// the others keep theirs, the solve stays exact and optimal for those weights; a well-shaped mesh (no
+// weight below the floor) is not changed at all.
+TEST(Solver, WeightFloorRaisesOnlyTheLightEdges) {
+  for (const Case& c : generated_cases()) {
+    SCOPED_TRACE(c.name);
+    FieldDesigner plain(c.mesh.V, c.mesh.F);
+    const double floor = 0.2;
+    FieldDesigner floored(c.mesh.V, c.mesh.F, SolverOptions{WeightKind::Cotan, SolverKind::Cholesky, Factorization::Parallel, floor});
+    const Eigen::VectorXd& w0 = plain.solver().weights();
+    const Eigen::VectorXd& w1 = floored.solver().weights();
+    std::vector<double> positive;
+    for (int e = 0; e < w0.size(); ++e)
+      if (w0(e) > 0) positive.push_back(w0(e));
+    std::sort(positive.begin(), positive.end());
+    const double least = floor * positive[positive.size() / 2];
+    int raised = 0;
+    for (int e = 0; e < w0.size(); ++e) {
+      if (plain.topology().is_boundary_edge(e)) {
+        EXPECT_EQ(w1(e), 0.0);
+        continue;
+      }
+      if (w0(e) < least) {
+        EXPECT_DOUBLE_EQ(w1(e), least) << e;
+        ++raised;
+      } else {
+        EXPECT_EQ(w1(e), w0(e)) << e;
+      }
+    }
+    EXPECT_EQ(floored.solver().floored_edges(), raised);
+    const Design r = floored.design(c.prescription);
+    expect_exact(floored, r, c.prescription, false);
+    EXPECT_LE(test::max_face_optimality(floored, r.connection), 1e-9);
+    if (raised == 0) EXPECT_NEAR(r.connection.energy, plain.design(c.prescription).connection.energy, 1e-12 * std::max(1.0, r.connection.energy));
+  }
+  const Mesh m = make_icosphere(3);
+  EXPECT_THROW(FieldDesigner(m.V, m.F, SolverOptions{WeightKind::Cotan, SolverKind::Cholesky, Factorization::Parallel, 1.5}).solver(), Error);
+}
+
 // The index n (units of 1/N) connection x gives a cycle of Levi-Civita holonomy z: Σ c x = z − 2π n/N.
 double cycle_index(const DualCycle& c, const Eigen::VectorXd& x, double holonomy, int N) {
   double sum = 0;

@@ -83,6 +83,7 @@ class FieldDesigner {
   const PropagationPlan& plan() const { return plan_; }  // the field's spanning trees (trivcon/field.h)
   const ConnectionSolver& solver() const;                // set up on first use
   const PrepareTimings& timings() const { return timings_; }
+  const SolverOptions& solver_options() const { return options_; }
 
  private:
   MatrixX3d V_;

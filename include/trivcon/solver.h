@@ -73,6 +73,11 @@ struct SolverOptions {
   WeightKind weights = WeightKind::Cotan;
   SolverKind solver = SolverKind::Cholesky;
   Factorization factorization = Factorization::Parallel;
+  // With cotan weights: every interior edge gets at least weight_floor × the median positive weight (0:
+  // none, the default). A floor lets the field turn across edges whose clamped cotangents are 0 or
+  // nearly so, instead of piling that turning onto their neighbours (BENCHMARKS.md "Weights that spread
+  // turning" measures what it does to large turns and energies). In [0, 1].
+  double weight_floor = 0;
 };
 
 struct Connection {
@@ -155,6 +160,7 @@ class ConnectionSolver {
   const std::vector<int>& fixed_faces() const;  // sorted, without repeats
   // Zero-weight edges given a small weight (see above).
   int regularized_edges() const;
+  int floored_edges() const;  // interior edges raised to SolverOptions::weight_floor
   const std::vector<FixedPath>& fixed_paths() const;
 
  private:

@@ -164,8 +164,12 @@ struct DesignerState {
 };
 using DesignerPtr = std::shared_ptr<DesignerState>;
 
-SolverOptions solver_options(const std::string& weights, const std::string& solver, const std::string& factorization) {
+SolverOptions solver_options(const std::string& weights, const std::string& solver, const std::string& factorization,
+                             double weight_floor = 0) {
   SolverOptions o;
+  if (!(weight_floor >= 0 && weight_floor <= 1))
+    throw Error("weight_floor must be in [0, 1] (a fraction of the median weight), not " + std::to_string(weight_floor));
+  o.weight_floor = weight_floor;
   if (weights != "cotan" && weights != "unit") throw Error("weights must be 'cotan' or 'unit', not '" + weights + "'");
   if (solver != "cholesky" && solver != "qr") throw Error("solver must be 'cholesky' or 'qr', not '" + solver + "'");
   if (factorization != "own" && factorization != "cholmod")
@@ -177,8 +181,8 @@ SolverOptions solver_options(const std::string& weights, const std::string& solv
 }
 
 DesignerPtr make_designer(const MatrixX3d& V, const MatrixX3i& F, const std::string& weights, const std::string& solver,
-                          const std::string& factorization) {
-  const SolverOptions options = solver_options(weights, solver, factorization);
+                          const std::string& factorization, double weight_floor) {
+  const SolverOptions options = solver_options(weights, solver, factorization, weight_floor);
   auto s = std::make_shared<DesignerState>();
   {
     py::gil_scoped_release release;
@@ -438,7 +442,8 @@ PYBIND11_MODULE(_core, m) {
 
   // --- FieldDesigner.
   py::class_<DesignerState, DesignerPtr>(m, "Designer", "trivcon::FieldDesigner on (V, F), factored at construction.")
-      .def(py::init(&make_designer), py::arg("V"), py::arg("F"), py::arg("weights"), py::arg("solver"), py::arg("factorization"))
+      .def(py::init(&make_designer), py::arg("V"), py::arg("F"), py::arg("weights"), py::arg("solver"), py::arg("factorization"),
+           py::arg("weight_floor") = 0.0)
       .def_property_readonly("V", [](const DesignerState& s) { return double_matrix3(s.V); })
       .def_property_readonly("F_input", [](const DesignerState& s) { return int64_matrix(s.F); })
       .def_property_readonly("F", [](const DesignerState& s) { return int64_matrix(s.topology().F); })

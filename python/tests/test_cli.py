@@ -120,6 +120,22 @@ def test_unit_weights_and_qr(cli, tmp_path):
     agree(cli, tmp_path, path, 1, ["--weights", "unit", "--solver", "qr", "--sing", "0:1", "--sing", "11:1"], r)
 
 
+def test_weight_floor_agrees_with_the_program(cli, tmp_path):
+    # A jittered cube: many of its cotangents are small or clamped, so the floor raises them.
+    V, F = trivcon.read_mesh(CUBE_OBJ)
+    path = str(tmp_path / "cube.obj")
+    trivcon.write_mesh(path, V, F)
+    plain = trivcon.FieldDesigner(V, F).solve(N=4, singularities="auto")
+    floored = trivcon.FieldDesigner(V, F, weight_floor=0.5)
+    r = floored.solve(N=4, singularities=plain.singularities)
+    assert r.verified
+    assert r.energy != plain.energy
+    args = ["--weight-floor", "0.5"]
+    for v, n in sorted(plain.singularities.items()):
+        args += ["--sing", f"{v}:{n}"]
+    agree(cli, tmp_path, path, 4, args, r)
+
+
 def test_render_matches_the_program(cli, tmp_path):
     V, F = trivcon.read_mesh(CUBE_OBJ)
     field = tmp_path / "f.txt"

@@ -150,6 +150,9 @@ def test_prescription_errors_are_the_librarys(sphere, annulus):
         da.solve(N=1, singularities={v: 1})
     raises("auto_cancel needs singularities='auto'", d.solve, N=4, auto_cancel=2)
     raises("weights must be 'cotan' or 'unit', not 'area'", trivcon.FieldDesigner, V, F, weights="area")
+    raises("weight_floor must be in [0, 1] (a fraction of the median weight), not 1.500000", trivcon.FieldDesigner, V, F,
+           weight_floor=1.5)
+    raises("weight_floor must be a number in [0, 1], not 'a'", trivcon.FieldDesigner, V, F, weight_floor="a")
 
 
 def test_file_errors_match_the_cli(tmp_path, cli):

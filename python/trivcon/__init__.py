@@ -416,13 +416,16 @@ def blas_kernels():
 class FieldDesigner:
     """A mesh prepared for fields: validated, its geometry and cycles computed, the system factored once.
 
-    FieldDesigner(V, F, weights="cotan", solver="cholesky", factorization="own")
+    FieldDesigner(V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0)
 
     V (n, 3) real, F (m, 3) integer, ids as in the file. Validation errors (non-finite coordinate,
     vertex id out of range, repeated vertex, non-manifold edge or vertex, non-orientable component)
     raise trivcon.Error with the library's message. weights: "cotan" (clamped cotangent weights,
     default) or "unit"; solver: "cholesky" (default) or "qr" (the paper's SuiteSparseQR route);
-    factorization: "own" (trivcon's, on several threads) or "cholmod".
+    factorization: "own" (trivcon's, on several threads) or "cholmod". weight_floor: with cotan
+    weights, every interior edge gets at least this fraction of the median weight (0 to 1; default 0,
+    none): fewer large turns on meshes with many obtuse angles, at some cost in smoothness (README
+    "Weights and energy").
 
     solve() then costs milliseconds per new set of singularities. Fixed faces change the matrix: a
     solve with a different set of fixed faces than the previous one refactors once; changing only
@@ -430,14 +433,19 @@ class FieldDesigner:
     designer run one at a time); the GIL is released while it works.
     """
 
-    def __init__(self, V, F, weights="cotan", solver="cholesky", factorization="own"):
+    def __init__(self, V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0):
         V, F = _mesh(V, F)
         for name, value, allowed in (("weights", weights, ("cotan", "unit")), ("solver", solver, ("cholesky", "qr")),
                                      ("factorization", factorization, ("own", "cholmod"))):
             if value not in allowed:
                 raise Error(f"{name} must be " + " or ".join(repr(a) for a in allowed) + f", not {value!r}")
-        self._d = _core.Designer(V, F, weights, solver, factorization)
+        try:
+            weight_floor = float(weight_floor)
+        except (TypeError, ValueError):
+            raise Error(f"weight_floor must be a number in [0, 1], not {weight_floor!r}") from None
+        self._d = _core.Designer(V, F, weights, solver, factorization, weight_floor)
         self.weights = weights
+        self.weight_floor = weight_floor
         self.solver = solver
 
     def __repr__(self):
