@@ -2,6 +2,7 @@
 // `render --align-features`, run as a separate process.
 #include <Eigen/Geometry>
 #include <cmath>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -75,6 +76,76 @@ TEST(CliFeatures, CubePipelineForQuadWild) {
   EXPECT_EQ(c.status, 0) << c.out << c.err;
   EXPECT_NE(c.out.find("8 singular vertices in the field"), std::string::npos) << c.out;
   EXPECT_NE(c.out.find("matches the prescription"), std::string::npos) << c.out;
+}
+
+// --split-large-turns with feature alignment: the .rosy and the .sharp belong to the refined mesh
+// (--mesh-out), the sharp edges found again on it, its fixed faces along them, and a principal matching
+// (`check` on the .rosy, as QuadWild reads it) finds exactly the prescription there. A ± pair on
+// neighbouring vertices of a cube face makes the field turn by π/4 or more between them.
+TEST(CliFeatures, SplitLargeTurnsCarriesTheQuadWildFilesToTheRefinedMesh) {
+  const int n = 6;
+  const Mesh m = make_cube_sphere(n, false);
+  const std::string mesh = mesh_file(m, "split_cube.obj"), refined = temp_file("split_cube.ref.obj");
+  const std::string rosy = temp_file("split.rosy"), sharp = temp_file("split.sharp"), sings = temp_file("split.sing"),
+                    report = temp_file("split.json");
+  // The eight corners +1/4, and a +1/4, −1/4 pair at the middle of the top face and a neighbour of it.
+  int middle = -1;
+  double best = 1e300, top = m.V.col(2).maxCoeff();
+  for (int v = 0; v < m.V.rows(); ++v)
+    if (std::abs(m.V(v, 2) - top) < 1e-12 && m.V.row(v).head<2>().norm() < best) best = m.V.row(v).head<2>().norm(), middle = v;
+  int neighbour = -1;
+  for (int f = 0; f < m.F.rows() && neighbour < 0; ++f)
+    for (int k = 0; k < 3; ++k)
+      if (m.F(f, k) == middle && std::abs(m.V(m.F(f, (k + 1) % 3), 2) - top) < 1e-12) neighbour = m.F(f, (k + 1) % 3);
+  ASSERT_GE(neighbour, 0);
+  {
+    std::ofstream out(sings);
+    for (int v : test::vertices_of_valence(m, 3)) out << v << " 1/4\n";
+    out << middle << " 1/4\n" << neighbour << " -1/4\n";
+  }
+  const auto r = run_cli("solve " + q(mesh) + " -N 4 -s " + q(sings) + " --align-features 30 --split-large-turns --mesh-out " + q(refined) +
+                         " --field-out " + q(rosy) + " --sharp-out " + q(sharp) + " --report " + q(report) + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_TRUE(j["verified"].get<bool>());
+  ASSERT_GE(j["split_large_turns"]["rounds"].size(), 1u) << "no large turn to split: the test lost its point";
+  EXPECT_TRUE(j["split_large_turns"]["converged"].get<bool>());
+  EXPECT_EQ(j["indices"]["large_turn_edges"], 0);
+
+  const MeshData ref = read_mesh(refined);
+  const int nF = static_cast<int>(ref.F.rows());
+  EXPECT_GT(nF, m.F.rows());
+  // Input ids kept: the refined mesh starts with the input's vertices.
+  EXPECT_EQ(ref.V.topRows(m.V.rows()), m.V);
+  int N = 0;
+  const MatrixX3d d = read_field(rosy, nF, &N);
+  EXPECT_EQ(N, 4);
+  // The sharp edges of the refined mesh (the cube's edges, split or not), both sides, each face's
+  // direction along its edge modulo π/2.
+  const Topology t = build_topology(ref.F, static_cast<int>(ref.V.rows()));
+  const Geometry g = compute_geometry(ref.V, t);
+  const std::vector<int> edges = sharp_edges(ref.V, t, g, 30);
+  EXPECT_EQ(j["features"]["sharp_edges"], static_cast<int>(edges.size()));
+  const std::vector<SharpFaceEdge> lines = read_sharp(sharp, nF);
+  EXPECT_EQ(lines.size(), 2 * edges.size());
+  for (const SharpFaceEdge& s : lines) {
+    const Eigen::Vector3d a = ref.V.row(ref.F(s.face, s.edge)), b = ref.V.row(ref.F(s.face, (s.edge + 1) % 3));
+    EXPECT_GE(((a.array().abs() == 1.0) && (b.array().abs() == 1.0)).count(), 2) << "not on a cube edge";
+    const Eigen::Vector3d p0 = ref.V.row(ref.F(s.face, 0)), p1 = ref.V.row(ref.F(s.face, 1)), p2 = ref.V.row(ref.F(s.face, 2));
+    const Eigen::Vector3d normal = (p1 - p0).cross(p2 - p0).normalized(), dir = d.row(s.face);
+    const double angle = std::atan2(dir.cross(b - a).dot(normal), dir.dot(b - a));
+    EXPECT_LE(std::abs(angle - kPi / 2 * std::round(angle / (kPi / 2))), 1e-9) << "face " << s.face;
+  }
+  // What a consumer with its own (principal) matching reads on the refined mesh: exactly the prescription.
+  const auto c = run_cli("check " + q(refined) + " " + q(rosy) + " -N 4 -s " + q(sings));
+  EXPECT_EQ(c.status, 0) << c.out << c.err;
+  EXPECT_NE(c.out.find("10 singular vertices in the field"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("matches the prescription"), std::string::npos) << c.out;
+  // On the unrefined mesh the same prescription has a large turn, which the principal matching misreads.
+  const std::string plain_rosy = temp_file("split_plain.rosy");
+  ASSERT_EQ(run_cli("solve " + q(mesh) + " -N 4 -s " + q(sings) + " --align-features 30 --field-out " + q(plain_rosy) + " --quiet").status, 0);
+  const auto c0 = run_cli("check " + q(mesh) + " " + q(plain_rosy) + " -N 4 -s " + q(sings));
+  EXPECT_EQ(c0.out.find("matches the prescription"), std::string::npos) << c0.out;
 }
 
 TEST(CliFeatures, FeaturesFileWithSingularitiesByHand) {
