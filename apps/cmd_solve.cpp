@@ -19,6 +19,7 @@
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
+#include "trivcon/refine.h"
 #include "trivcon/features.h"
 #include "trivcon/generate.h"
 #include "trivcon/matching.h"
@@ -274,51 +275,38 @@ void run_solve(const SolveOptions& o) {
       throw Error("--split-large-turns splits edges, which a --features file names by their vertices: use --align-features instead");
     std::map<int, Eigen::Vector3d> fixed_world;  // --fix directions in world space, per input face
     for (auto [f, angle] : explicit_fixed) fixed_world[f] = designer.geometry().direction_in_face(f, angle);
-    const FieldDesigner* current = &designer;
-    MeshData current_mesh = mesh;
-    std::vector<int> parent(mesh.F.rows());  // input face of every current face
-    std::iota(parent.begin(), parent.end(), 0);
-    IndexPrescription p = prescription;
-    nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
-    bool converged = false;
-    for (int round = 0;; ++round) {
-      const Design d = current->design(p, roots);
-      const std::vector<int> large = large_turn_edges(current->topology(), d.connection.x, p.N);
-      if (large.empty()) {
-        converged = true;
-        break;
-      }
-      if (round == kMaxSplitRounds) break;
-      // The faces beside each such edge are split at their centroids: every corner gains an edge, so the
-      // turning around the edge's ends spreads over more edges.
-      std::vector<int> beside;
-      for (int e : large) beside.push_back(current->topology().edge_faces(e, 0)), beside.push_back(current->topology().edge_faces(e, 1));
-      std::vector<int> step_parent;
-      const Mesh next = split_faces_at_centroids(current_mesh, beside, &step_parent);
-      std::vector<int> composed(step_parent.size());
-      for (size_t f = 0; f < step_parent.size(); ++f) composed[f] = parent[step_parent[f]];
-      parent.swap(composed);
-      std::vector<int> polygon(parent.size());
-      for (size_t f = 0; f < parent.size(); ++f)
-        polygon[f] = mesh.polygon_of_triangle.empty() ? parent[f] : mesh.polygon_of_triangle[parent[f]];
-      current_mesh.V = next.V, current_mesh.F = next.F, current_mesh.polygon_of_triangle = polygon;
-      refined_designer = std::make_unique<FieldDesigner>(current_mesh.V, current_mesh.F, options);
-      current = refined_designer.get();
-      p.fixed.clear();
-      if (o.align_boundary) p.fixed = boundary_alignment(current->V(), current->topology(), current->geometry());
-      sharp = apply_features(o, *current, p, nullptr, nullptr);  // the split faces beside a sharp edge are fixed to it again
+    // Each refined mesh's fixed faces: --align-boundary and the sharp edges found again on it, and the
+    // --fix directions passed to the children of their faces (they win, as on the input mesh).
+    auto constraints = [&](const FieldDesigner& refined, const std::vector<int>& parent) {
+      IndexPrescription q;
+      q.N = prescription.N;
+      if (o.align_boundary) q.fixed = boundary_alignment(refined.V(), refined.topology(), refined.geometry());
+      sharp = apply_features(o, refined, q, nullptr, nullptr);  // the split faces beside a sharp edge are fixed to it again
       for (int f = 0; f < static_cast<int>(parent.size()); ++f) {
         const auto it = fixed_world.find(parent[f]);
-        if (it != fixed_world.end()) p.fixed[f] = current->geometry().angle_in_face(f, it->second);
+        if (it != fixed_world.end()) q.fixed[f] = refined.geometry().angle_in_face(f, it->second);
       }
-      std::vector<int> faces;
-      for (auto [f, angle] : p.fixed) faces.push_back(f);
-      refined_designer->set_fixed_faces(faces);
-      rounds.push_back({{"split_edges", large.size()}, {"vertices", current_mesh.V.rows()}, {"faces", current_mesh.F.rows()}});
+      return q.fixed;
+    };
+    RefinedDesign refined = split_large_turns(designer, mesh.F, prescription, options, constraints, kMaxSplitRounds, roots);
+    nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
+    for (size_t k = 0; k < refined.rounds.size(); ++k) {
+      const RefineRound& r = refined.rounds[k];
+      rounds.push_back({{"split_edges", r.split_edges}, {"vertices", r.vertices}, {"faces", r.faces}});
       if (!o.quiet)
-        std::cout << "split-large-turns: round " << round + 1 << " split " << large.size()
-                  << " edges turning by pi/N or more: " << current_mesh.V.rows() << " vertices, " << current_mesh.F.rows() << " faces\n";
+        std::cout << "split-large-turns: round " << k + 1 << " split " << r.split_edges << " edges turning by pi/N or more: " << r.vertices
+                  << " vertices, " << r.faces << " faces\n";
     }
+    const bool converged = refined.converged;
+    MeshData current_mesh = mesh;
+    if (refined.designer) {
+      std::vector<int> polygon(refined.parent_face.size());
+      for (size_t f = 0; f < polygon.size(); ++f)
+        polygon[f] = mesh.polygon_of_triangle.empty() ? refined.parent_face[f] : mesh.polygon_of_triangle[refined.parent_face[f]];
+      current_mesh.V = refined.V, current_mesh.F = refined.F, current_mesh.polygon_of_triangle = polygon;
+      refined_designer = std::move(refined.designer);
+    }
+    IndexPrescription p = refined.prescription;
     extra["split_large_turns"] = {{"rounds", rounds}, {"converged", converged}, {"max_rounds", kMaxSplitRounds}};
     if (!converged)
       std::cerr << "trivcon: warning: --split-large-turns stopped after " << kMaxSplitRounds

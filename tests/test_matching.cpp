@@ -13,6 +13,7 @@
 #include "trivcon/field_io.h"
 #include "trivcon/io.h"
 #include "trivcon/matching.h"
+#include "trivcon/refine.h"
 
 namespace trivcon {
 namespace {
@@ -305,6 +306,51 @@ TEST(Matching, SplitLargeTurnsKeepsFixedDirections) {
   EXPECT_LE(std::abs(std::remainder(a, kPi / 2)), 1e-9);
   std::map<int, int> want = {{0, -4}};
   EXPECT_EQ(independent_indices(out.V, out.F, dirs, 4, nullptr), want);
+}
+
+// The library function behind --split-large-turns (trivcon/refine.h): converged, ids kept, each face's
+// parent the input face it lies in, a fixed face's direction passed to its children, and an independent
+// principal matching reads exactly the prescription on the refined mesh.
+TEST(Matching, SplitLargeTurnsLibraryFunction) {
+  const LargeTurnCase c;
+  FieldDesigner designer(c.mesh.V, c.mesh.F);
+  IndexPrescription p = c.p;
+  const Eigen::Vector3d world = designer.geometry().direction_in_face(7, 0.3);
+  p.fixed[7] = 0.3;
+  designer.set_fixed_faces({7});
+  const RefinedDesign r = split_large_turns(designer, c.mesh.F, p);
+  EXPECT_TRUE(r.converged);
+  ASSERT_GE(r.rounds.size(), 1u);
+  ASSERT_TRUE(r.designer);
+  EXPECT_EQ(r.rounds.back().faces, r.F.rows());
+  EXPECT_EQ(r.rounds.back().vertices, r.V.rows());
+  EXPECT_EQ(r.V.topRows(c.mesh.V.rows()), c.mesh.V);
+  EXPECT_TRUE(design_verified(r.design));
+  EXPECT_TRUE(large_turn_edges(r.designer->topology(), r.design.connection.x, 4).empty());
+  ASSERT_EQ(static_cast<Eigen::Index>(r.parent_face.size()), r.F.rows());
+  int children_of_7 = 0;
+  for (int f = 0; f < r.F.rows(); ++f) {
+    // The face's centroid lies in its parent's plane.
+    const int q = r.parent_face[f];
+    const Eigen::Vector3d a = c.mesh.V.row(c.mesh.F(q, 0)), b = c.mesh.V.row(c.mesh.F(q, 1)), d = c.mesh.V.row(c.mesh.F(q, 2));
+    const Eigen::Vector3d g = (r.V.row(r.F(f, 0)) + r.V.row(r.F(f, 1)) + r.V.row(r.F(f, 2))).transpose() / 3;
+    EXPECT_NEAR((g - a).dot((b - a).cross(d - a).normalized()), 0, 1e-12) << "face " << f;
+    if (q != 7) continue;
+    ++children_of_7;
+    ASSERT_TRUE(r.prescription.fixed.count(f)) << f;
+    const Eigen::Vector3d held = r.designer->geometry().direction_in_face(f, r.design.field.angle(f));
+    const double turn = std::atan2(held.cross(world).dot(r.designer->geometry().normal.row(f)), held.dot(world));
+    EXPECT_LE(std::abs(std::remainder(turn, kPi / 2)), 1e-9) << "face " << f;
+  }
+  EXPECT_GE(children_of_7, 1);
+  EXPECT_EQ(static_cast<int>(r.prescription.fixed.size()), children_of_7);
+  const MatrixX3d dirs = field_directions(r.designer->geometry(), r.design.field);
+  EXPECT_EQ(independent_indices(r.V, r.F, dirs, 4, nullptr), c.p.vertex);
+  // Generator or loop indices are refused (the refined mesh has cycles of its own).
+  IndexPrescription bad = c.p;
+  bad.generator[0] = 1;
+  EXPECT_EQ(error_of([&] { split_large_turns(designer, c.mesh.F, bad); }),
+            "splitting large turns makes new generators and boundary loops: leave their indices to be chosen");
 }
 
 }  // namespace

@@ -29,6 +29,7 @@
 
 #include "trivcon/auto.h"
 #include "trivcon/blas.h"
+#include "trivcon/refine.h"
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
@@ -152,6 +153,16 @@ struct DesignerState {
   const Topology& topology() const { return designer->topology(); }
   const Geometry& geometry() const { return designer->geometry(); }
 
+  // Every edge, sorted by (i, j) (the order of connection files).
+  void sort_edges() {
+    const Topology& t = topology();
+    sorted_edges.resize(t.num_edges);
+    for (int e = 0; e < t.num_edges; ++e) sorted_edges[e] = e;
+    std::sort(sorted_edges.begin(), sorted_edges.end(), [&](int a, int b) {
+      return std::make_pair(t.edge_vertices(a, 0), t.edge_vertices(a, 1)) < std::make_pair(t.edge_vertices(b, 0), t.edge_vertices(b, 1));
+    });
+  }
+
   // Refactors only when the set of fixed faces changes (their angles are right-hand sides).
   void use_fixed_faces(const std::map<int, double>& fixed) {
     std::vector<int> faces;
@@ -190,12 +201,7 @@ DesignerPtr make_designer(const MatrixX3d& V, const MatrixX3i& F, const std::str
     s->F = F;
     s->designer = std::make_unique<FieldDesigner>(V, F, options);
     s->designer->set_fixed_faces({});  // factor now: the constructor of the Python object validates and factors
-    const Topology& t = s->topology();
-    s->sorted_edges.resize(t.num_edges);
-    for (int e = 0; e < t.num_edges; ++e) s->sorted_edges[e] = e;
-    std::sort(s->sorted_edges.begin(), s->sorted_edges.end(), [&](int a, int b) {
-      return std::make_pair(t.edge_vertices(a, 0), t.edge_vertices(a, 1)) < std::make_pair(t.edge_vertices(b, 0), t.edge_vertices(b, 1));
-    });
+    s->sort_edges();
   }
   return s;
 }
@@ -545,6 +551,65 @@ PYBIND11_MODULE(_core, m) {
           },
           py::arg("N"), py::arg("vertex"), py::arg("generator"), py::arg("loop"), py::arg("fixed"), py::arg("roots"),
           "A Design of the prescription (n = index·N per id; fixed: face -> angle).")
+      .def(
+          "split_large_turns",
+          [](const DesignerPtr& s, int N, const std::map<int, int>& vertex, const std::map<int, double>& fixed, bool align_boundary,
+             int max_rounds, const std::string& weights, const std::string& solver, const std::string& factorization, double weight_floor) {
+            const SolverOptions options = solver_options(weights, solver, factorization, weight_floor);
+            auto r = std::make_unique<DesignResult>();
+            r->prescription.N = N;
+            r->prescription.vertex = vertex;
+            r->prescription.fixed = fixed;
+            if (align_boundary)
+              for (auto [f, angle] : boundary_alignment(s->V, s->topology(), s->geometry())) r->prescription.fixed.emplace(f, angle);
+            std::vector<RefineRound> rounds;
+            std::vector<int> parent;
+            bool converged = false;
+            DesignerPtr refined = s;
+            {
+              py::gil_scoped_release release;
+              std::lock_guard<std::mutex> lock(s->mutex);
+              for (const auto& [f, angle] : fixed) check_face(s->topology(), f, "fixed face");
+              s->use_fixed_faces(r->prescription.fixed);
+              // Each refined mesh: the boundary aligned again, the given fixed faces' directions (world
+              // vectors) on their children (they win, as on the input mesh).
+              std::map<int, Eigen::Vector3d> world;
+              for (auto [f, angle] : fixed) world[f] = s->geometry().direction_in_face(f, angle);
+              auto constraints = [&](const FieldDesigner& d, const std::vector<int>& parent_face) {
+                std::map<int, double> out;
+                if (align_boundary) out = boundary_alignment(d.V(), d.topology(), d.geometry());
+                for (int f = 0; f < static_cast<int>(parent_face.size()); ++f) {
+                  const auto it = world.find(parent_face[f]);
+                  if (it != world.end()) out[f] = d.geometry().angle_in_face(f, it->second);
+                }
+                return out;
+              };
+              RefinedDesign d = split_large_turns(*s->designer, s->F, r->prescription, options, constraints, max_rounds);
+              rounds = d.rounds, parent = d.parent_face, converged = d.converged;
+              if (d.designer) {
+                refined = std::make_shared<DesignerState>();
+                refined->V = d.V, refined->F = d.F;
+                refined->designer = std::move(d.designer);
+                for (const auto& [f, angle] : d.prescription.fixed) refined->fixed_faces.push_back(f);
+                refined->sort_edges();
+              }
+              r->prescription = d.prescription;
+              r->design = std::move(d.design);
+              r->verified = design_verified(r->design);
+            }
+            r->state = refined;
+            py::list round_list;
+            for (const RefineRound& k : rounds) {
+              py::dict d;
+              d["split_edges"] = k.split_edges, d["vertices"] = k.vertices, d["faces"] = k.faces;
+              round_list.append(d);
+            }
+            return py::make_tuple(refined, py::cast(std::move(r)), int64_vector(parent), round_list, converged);
+          },
+          py::arg("N"), py::arg("vertex"), py::arg("fixed"), py::arg("align_boundary"), py::arg("max_rounds"), py::arg("weights"),
+          py::arg("solver"), py::arg("factorization"), py::arg("weight_floor"),
+          "Design, refined until no edge turns by pi/N or more (trivcon/refine.h): (designer of the final mesh, DesignResult, "
+          "parent face of each face, rounds, converged).")
       .def(
           "auto_singularities",
           [](const DesignerPtr& s, int N, int iterations, double cancel, bool cancel_absolute, const std::map<int, double>& fixed,

@@ -318,3 +318,35 @@ def test_matching_reads_exactly_the_prescription(tmp_path):
         if len(parts) == 5:
             rows[(int(parts[2]), int(parts[3]))] = int(parts[4])
     assert rows == {(int(i), int(j)): int(k) for (i, j), k in zip(r.edges, m)}
+
+
+def test_split_large_turns_lets_a_principal_matching_read_the_prescription():
+    # The same coarse sphere: refined where the connection turns by pi/N or more, the field on the refined
+    # mesh read by the independent principal matching has exactly the prescription at its vertex ids.
+    V, F = trivcon.make_icosphere(1)
+    d = trivcon.FieldDesigner(V, F)
+    want = {0: Fraction(2)}
+    r = d.solve(N=4, singularities={0: 2}, fixed={5: 0.25}, split_large_turns=True)
+    assert r.split_converged and len(r.split_rounds) >= 1 and r.verified
+    rd = r.designer
+    assert rd is not d and rd.num_faces == r.split_rounds[-1]["faces"] > len(F)
+    assert np.array_equal(rd.V[: len(V)], V)  # input vertices keep their ids
+    assert r.parent_face.shape == (rd.num_faces,) and np.array_equal(r.parent_face[: len(F)], np.arange(len(F)))
+    assert r.large_turn_edges == 0
+    ref = reference.Mesh(rd.V, rd.F)
+    assert ref.field_indices(r.directions, 4) == want
+    # Face 5's children hold its direction (a world vector), modulo a quarter turn.
+    held = d.face_frames()[0][5] * np.cos(0.25) + d.face_frames()[1][5] * np.sin(0.25)
+    children = np.flatnonzero(r.parent_face == 5)
+    assert len(children) >= 1 and set(r.fixed) == set(int(c) for c in children)
+    for c in children:
+        cos = abs(float(np.dot(r.directions[c], held)))
+        assert min(abs(cos - 1), cos) < 1e-9
+    # Nothing to refine: the same designer, no rounds.
+    calm = d.solve(N=4, singularities={0: Fraction(1, 4), 1: Fraction(1, 4), 2: Fraction(1, 4), 3: Fraction(1, 4),
+                                       4: Fraction(1, 4), 5: Fraction(1, 4), 6: Fraction(1, 4), 7: Fraction(1, 4)},
+                   split_large_turns=True)
+    if calm.large_turn_edges == 0:
+        assert calm.split_rounds == [] and calm.designer is d
+    with pytest.raises(trivcon.Error, match="^split_large_turns makes new generators and boundary loops"):
+        d.solve(N=4, singularities={0: 2}, generators={0: 1}, split_large_turns=True)

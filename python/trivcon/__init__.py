@@ -447,6 +447,15 @@ class FieldDesigner:
         self.weights = weights
         self.weight_floor = weight_floor
         self.solver = solver
+        self.factorization = factorization
+
+    @classmethod
+    def _of_core(cls, core, like):
+        """A FieldDesigner around a core designer made by the library (a refined mesh), with the options of `like`."""
+        self = cls.__new__(cls)
+        self._d = core
+        self.weights, self.weight_floor, self.solver, self.factorization = like.weights, like.weight_floor, like.solver, like.factorization
+        return self
 
     def __repr__(self):
         return (f"<trivcon.FieldDesigner: {self.num_vertices} vertices, {self.num_faces} faces, chi {self.euler_characteristic}, "
@@ -562,7 +571,7 @@ class FieldDesigner:
         return out
 
     def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False, roots=None,
-              auto_cancel=0.0, align_curvature=None):
+              auto_cancel=0.0, align_curvature=None, split_large_turns=False, max_rounds=8):
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
@@ -579,6 +588,17 @@ class FieldDesigner:
         align_boundary: fix every face with a boundary edge to that edge's direction (fixed= wins).
         roots: {face: angle}: where the field's propagation starts per component (default: each
           component's smallest face, angle 0; a component with fixed faces starts at its smallest one).
+
+        split_large_turns: refine the mesh where the connection turns by pi/N or more and solve again
+          with the same vertex singularities, at most max_rounds times, until no edge does (trivcon
+          solve --split-large-turns): then any tool's own (principal) matching reads exactly the
+          prescription. The Result then belongs to the refined mesh: Result.designer is a FieldDesigner
+          of it (input vertices keep their ids, new ones appended; a split face keeps its id for its
+          first child), Result.parent_face the input face of each face, Result.split_rounds one dict per
+          round (split_edges, vertices, faces), Result.split_converged whether no large turn is left. The
+          boundary is aligned again on every refined mesh; fixed faces pass their direction to their
+          children. Not with generators or boundary indices (the refined mesh has cycles of its own), nor
+          with roots.
 
         Errors in the prescription raise trivcon.Error with the library's message. The result is
         verified (residuals, transport, indices read back): see Result.verified.
@@ -602,6 +622,23 @@ class FieldDesigner:
             if isinstance(angle, bool) or not isinstance(angle, numbers.Real):
                 raise Error(f"roots[{face}]: the angle must be a number, got {angle!r}")
             root_list.append((face, float(angle)))
+        if split_large_turns:
+            if generators or boundary:
+                raise Error("split_large_turns makes new generators and boundary loops: leave their indices to be chosen")
+            if root_list:
+                raise Error("split_large_turns: roots are not supported (the refined mesh starts each component itself)")
+            if isinstance(max_rounds, bool) or not isinstance(max_rounds, numbers.Integral) or max_rounds < 0:
+                raise Error(f"max_rounds must be a whole number >= 0, not {max_rounds!r}")
+            explicit = self._fixed(fixed, False)
+            core, r, parent, rounds, converged = self._d.split_large_turns(
+                N, vertex, explicit, bool(align_boundary), int(max_rounds), self.weights, self.solver, self.factorization,
+                self.weight_floor)
+            designer = self if core is self._d else FieldDesigner._of_core(core, self)
+            result = Result(designer, r, auto)
+            result.parent_face = parent
+            result.split_rounds = rounds
+            result.split_converged = converged
+            return result
         r = self._d.design(N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), fixed_angles,
                            root_list)
         return Result(self, r, auto)
