@@ -26,6 +26,20 @@ std::string mesh_file(const Mesh& m, const std::string& name) {
   return path;
 }
 
+// Every face-edge of a .sharp lies on an edge of the cube [−1, 1]³, and the face's direction in `d` (one row
+// per face of `m`) runs along it modulo π/2, from the positions alone.
+void expect_along_cube_edges(const Mesh& m, const MatrixX3d& d, const std::vector<SharpFaceEdge>& lines) {
+  for (const SharpFaceEdge& s : lines) {
+    const Eigen::Vector3d a = m.V.row(m.F(s.face, s.edge)), b = m.V.row(m.F(s.face, (s.edge + 1) % 3));
+    EXPECT_GE(((a.array().abs() == 1.0) && (b.array().abs() == 1.0)).count(), 2) << "not on a cube edge";
+    const Eigen::Vector3d p0 = m.V.row(m.F(s.face, 0)), p1 = m.V.row(m.F(s.face, 1)), p2 = m.V.row(m.F(s.face, 2));
+    const Eigen::Vector3d normal = (p1 - p0).cross(p2 - p0).normalized(), dir = d.row(s.face);
+    EXPECT_NEAR(dir.dot(normal), 0, 1e-12);
+    const double angle = std::atan2(dir.cross(b - a).dot(normal), dir.dot(b - a));
+    EXPECT_LE(std::abs(angle - kPi / 2 * std::round(angle / (kPi / 2))), 1e-9) << "face " << s.face;
+  }
+}
+
 // The solve of the README's pipeline on the flat-faced cube: --auto puts +1/4 at the 8 corners, the .rosy
 // has every face beside a cube edge along it (modulo π/2), the .sharp lists both sides of the 12 · n edges.
 TEST(CliFeatures, CubePipelineForQuadWild) {
@@ -60,17 +74,8 @@ TEST(CliFeatures, CubePipelineForQuadWild) {
   EXPECT_EQ(N, 4);
   const std::vector<SharpFaceEdge> lines = read_sharp(sharp, static_cast<int>(m.F.rows()));
   EXPECT_EQ(lines.size(), 2u * 12 * n);
-  for (const SharpFaceEdge& s : lines) {
-    EXPECT_EQ(s.convex, 1);
-    const Eigen::Vector3d a = m.V.row(m.F(s.face, s.edge)), b = m.V.row(m.F(s.face, (s.edge + 1) % 3));
-    EXPECT_GE(((a.array().abs() == 1.0) && (b.array().abs() == 1.0)).count(), 2) << "not a cube edge";
-    // The face's direction along the edge modulo π/2, from the positions.
-    const Eigen::Vector3d p0 = m.V.row(m.F(s.face, 0)), p1 = m.V.row(m.F(s.face, 1)), p2 = m.V.row(m.F(s.face, 2));
-    const Eigen::Vector3d normal = (p1 - p0).cross(p2 - p0).normalized(), dir = d.row(s.face);
-    EXPECT_NEAR(dir.dot(normal), 0, 1e-12);
-    const double angle = std::atan2(dir.cross(b - a).dot(normal), dir.dot(b - a));
-    EXPECT_LE(std::abs(angle - kPi / 2 * std::round(angle / (kPi / 2))), 1e-9) << "face " << s.face;
-  }
+  for (const SharpFaceEdge& s : lines) EXPECT_EQ(s.convex, 1);
+  expect_along_cube_edges(m, d, lines);
   // check reads the .rosy and finds the same singularities.
   const auto c = run_cli("check " + q(mesh) + " " + q(rosy) + " -N 4 -s " + q(sings));
   EXPECT_EQ(c.status, 0) << c.out << c.err;
@@ -128,14 +133,7 @@ TEST(CliFeatures, SplitLargeTurnsCarriesTheQuadWildFilesToTheRefinedMesh) {
   EXPECT_EQ(j["features"]["sharp_edges"], static_cast<int>(edges.size()));
   const std::vector<SharpFaceEdge> lines = read_sharp(sharp, nF);
   EXPECT_EQ(lines.size(), 2 * edges.size());
-  for (const SharpFaceEdge& s : lines) {
-    const Eigen::Vector3d a = ref.V.row(ref.F(s.face, s.edge)), b = ref.V.row(ref.F(s.face, (s.edge + 1) % 3));
-    EXPECT_GE(((a.array().abs() == 1.0) && (b.array().abs() == 1.0)).count(), 2) << "not on a cube edge";
-    const Eigen::Vector3d p0 = ref.V.row(ref.F(s.face, 0)), p1 = ref.V.row(ref.F(s.face, 1)), p2 = ref.V.row(ref.F(s.face, 2));
-    const Eigen::Vector3d normal = (p1 - p0).cross(p2 - p0).normalized(), dir = d.row(s.face);
-    const double angle = std::atan2(dir.cross(b - a).dot(normal), dir.dot(b - a));
-    EXPECT_LE(std::abs(angle - kPi / 2 * std::round(angle / (kPi / 2))), 1e-9) << "face " << s.face;
-  }
+  expect_along_cube_edges(ref, d, lines);
   // What a consumer with its own (principal) matching reads on the refined mesh: exactly the prescription.
   const auto c = run_cli("check " + q(refined) + " " + q(rosy) + " -N 4 -s " + q(sings));
   EXPECT_EQ(c.status, 0) << c.out << c.err;
