@@ -292,10 +292,15 @@ void run_solve(const SolveOptions& o) {
     nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
     for (size_t k = 0; k < refined.rounds.size(); ++k) {
       const RefineRound& r = refined.rounds[k];
-      rounds.push_back({{"split_edges", r.split_edges}, {"vertices", r.vertices}, {"faces", r.faces}});
-      if (!o.quiet)
-        std::cout << "split-large-turns: round " << k + 1 << " split " << r.split_edges << " edges turning by pi/N or more: " << r.vertices
-                  << " vertices, " << r.faces << " faces\n";
+      rounds.push_back({{"split_edges", r.split_edges}, {"vertices", r.vertices}, {"faces", r.faces}, {"reweighted", r.reweighted}});
+      if (!o.quiet) {
+        if (r.reweighted)
+          std::cout << "split-large-turns: round " << k + 1 << " lowered the weights of " << r.split_edges
+                    << " edges still turning by pi/N or more\n";
+        else
+          std::cout << "split-large-turns: round " << k + 1 << " split " << r.split_edges << " edges turning by pi/N or more: " << r.vertices
+                    << " vertices, " << r.faces << " faces\n";
+      }
     }
     const bool converged = refined.converged;
     MeshData current_mesh = mesh;
@@ -309,8 +314,8 @@ void run_solve(const SolveOptions& o) {
     IndexPrescription p = refined.prescription;
     extra["split_large_turns"] = {{"rounds", rounds}, {"converged", converged}, {"max_rounds", kMaxSplitRounds}};
     if (!converged)
-      std::cerr << "trivcon: warning: --split-large-turns stopped after " << kMaxSplitRounds
-                << " rounds with edges still turning by pi/N or more (see large_turns in the report)\n";
+      std::cerr << "trivcon: warning: --split-large-turns stopped after " << kMaxSplitRounds << " rounds of splitting and "
+                << 3 * kMaxSplitRounds << " of lowering weights with edges still turning by pi/N or more (see large_turns in the report)\n";
     if (refined_designer) {
       refined_mesh = std::move(current_mesh);
       prescription = p;

@@ -57,6 +57,12 @@ FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptio
   timings_.prepare = construct_seconds_;
 }
 
+void FieldDesigner::set_solver_options(const SolverOptions& options) {
+  options_ = options;
+  solver_.reset();
+  solver();
+}
+
 void FieldDesigner::set_fixed_faces(const std::vector<int>& faces) {
   fixed_faces_ = faces;
   solver_.reset();

@@ -27,6 +27,8 @@ RefinedDesign split_large_turns(const FieldDesigner& designer, const MatrixX3i& 
   std::iota(out.parent_face.begin(), out.parent_face.end(), 0);
   out.prescription = prescription;
   const FieldDesigner* current = &designer;
+  int splits = 0, reweights = 0;
+  bool reweighting = false;  // once splitting stalls, only the weights change
   for (int round = 0;; ++round) {
     out.design = current->design(out.prescription, round == 0 ? roots : std::vector<std::pair<int, double>>{});
     const std::vector<int> large = large_turn_edges(current->topology(), out.design.connection.x, out.prescription.N);
@@ -34,7 +36,26 @@ RefinedDesign split_large_turns(const FieldDesigner& designer, const MatrixX3i& 
       out.converged = true;
       break;
     }
-    if (round == max_rounds) break;
+    reweighting = reweighting || splits >= max_rounds;
+    if (reweighting) {
+      if (reweights == 3 * max_rounds) break;
+      ++reweights;
+      // Lower the weights of the edges still turning too much (see refine.h), on a designer of our own.
+      if (!out.designer) {
+        out.designer = std::make_unique<FieldDesigner>(out.V, out.F, options);
+        std::vector<int> faces;
+        for (auto [f, angle] : out.prescription.fixed) faces.push_back(f);
+        out.designer->set_fixed_faces(faces);
+        current = out.designer.get();
+      }
+      SolverOptions lighter = out.designer->solver_options();
+      if (lighter.edge_weight_scale.empty()) lighter.edge_weight_scale.assign(out.designer->topology().num_edges, 1.0);
+      for (int e : large) lighter.edge_weight_scale[e] *= 0.5;
+      out.designer->set_solver_options(lighter);
+      out.rounds.push_back({static_cast<int>(large.size()), static_cast<int>(out.V.rows()), static_cast<int>(out.F.rows()), true});
+      continue;
+    }
+    ++splits;
     std::vector<int> beside;
     for (int e : large) beside.push_back(current->topology().edge_faces(e, 0)), beside.push_back(current->topology().edge_faces(e, 1));
     std::vector<int> step_parent;

@@ -158,6 +158,16 @@ void ConnectionSolver::Impl::set_weights_and_paths(const std::vector<int>& fixed
         if (!t.is_boundary_edge(e) && weights(e) < floor) weights(e) = floor, ++floored_edges;
     }
   }
+  if (!options.edge_weight_scale.empty()) {
+    if (static_cast<int>(options.edge_weight_scale.size()) != nE)
+      throw Error("edge_weight_scale has " + std::to_string(options.edge_weight_scale.size()) + " entries for " + std::to_string(nE) +
+                  " edges");
+    for (int e = 0; e < nE; ++e) {
+      if (!(options.edge_weight_scale[e] > 0 && std::isfinite(options.edge_weight_scale[e])))
+        throw Error("edge_weight_scale of edge " + std::to_string(e) + " must be positive and finite");
+      weights(e) *= options.edge_weight_scale[e];
+    }
+  }
   for (size_t l = 0; l < t.boundary_loops.size(); ++l) loop_curvature.push_back(trivcon::loop_curvature(t, geometry, static_cast<int>(l)));
   for (const DualCycle& g : cycles.generators) generator_holonomy.push_back(levi_civita_holonomy(g, geometry));
   fixed_faces = fixed;

@@ -256,6 +256,26 @@ TEST(FeatureAlignment, CappedCylinderWithAuto) {
   expect_exact_and_aligned(designer, s);
 }
 
+// With more than 256 fixed-face paths (the sparse route, trivcon/solver.h) a path of one edge between two
+// adjacent fixed faces takes the smallest turn: |x_e| ≤ π/N. On a capped cylinder's rims the fixed
+// directions of neighbouring faces differ by a little (the rim turns), so any other whole number would
+// make that edge turn by nearly π/2.
+TEST(FeatureAlignment, SparsePathsTakeTheSmallestTurn) {
+  const Mesh m = make_capped_cylinder(6, 96, 12);
+  FieldDesigner designer(m.V, m.F);
+  const Solved s = solve_with_features(designer, 30);
+  const std::vector<FixedPath>& paths = designer.solver().fixed_paths();
+  ASSERT_GT(paths.size(), 256u) << "the dense route would be taken";
+  int one_edge = 0;
+  for (const FixedPath& p : paths) {
+    if (p.path.edges.size() != 1) continue;
+    ++one_edge;
+    EXPECT_LE(std::abs(s.design.connection.x(p.path.edges[0])), kPi / 4 + 1e-9) << "edge " << p.path.edges[0];
+  }
+  EXPECT_GT(one_edge, 100);
+  expect_exact_and_aligned(designer, s);
+}
+
 TEST(FeatureAlignment, FandiskLikeBlockReportsItsNonRightCorners) {
   const Mesh m = bulged_block(10);
   FieldDesigner designer(m.V, m.F);

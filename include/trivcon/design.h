@@ -73,6 +73,8 @@ class FieldDesigner {
   FieldDesigner& operator=(const FieldDesigner&) = delete;
   // Sets the faces whose direction prescriptions fix, and sets up (factors) the solver for them.
   void set_fixed_faces(const std::vector<int>& faces);
+  // Changes the solver's options (e.g. the weights) and sets the solver up again.
+  void set_solver_options(const SolverOptions& options);
 
   Design design(const IndexPrescription& prescription, const std::vector<std::pair<int, double>>& roots = {}) const;
 

@@ -15,6 +15,15 @@
 // (a prescription that sets any is refused). The fixed directions of each refined mesh come from
 // `constraints` (e.g. boundary or feature alignment found again on it); without it, each fixed face of the
 // prescription passes its direction (as a world vector) to all its children.
+//
+// Splitting does not always finish: a centroid split gives the split face's old edges an obtuse angle
+// opposite them, whose clamped cotangent forbids turning there, and the turning moves on. When the
+// `max_rounds` rounds of splitting leave large turns, the weights of the edges still turning by π/N or
+// more are halved on the final mesh (SolverOptions::edge_weight_scale) and it is solved again, up to
+// 3 × `max_rounds` times: a lighter edge turns less, its neighbours take the rest. (Splitting is needed
+// first: a vertex whose index needs more turning than its valence allows below π/N per edge, e.g. 3/2 at
+// a vertex of valence 5, gets there only by gaining edges.)
+// The field is still exact with the prescribed singularities; it is the smoothest one for those weights.
 #pragma once
 #include <functional>
 #include <map>
@@ -26,8 +35,9 @@
 namespace trivcon {
 
 struct RefineRound {
-  int split_edges = 0;  // edges turning by π/N or more, whose two faces were split
+  int split_edges = 0;  // edges turning by π/N or more, whose two faces were split (or reweighted)
   int vertices = 0, faces = 0;  // of the mesh after the round
+  bool reweighted = false;      // the round lowered those edges' weights instead of splitting
 };
 
 // The fixed directions (face → angle in its frame, IndexPrescription::fixed) for a refined mesh, given its

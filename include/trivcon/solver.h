@@ -78,6 +78,10 @@ struct SolverOptions {
   // nearly so, instead of piling that turning onto their neighbours (BENCHMARKS.md "Weights that spread
   // turning" measures what it does to large turns and energies). In [0, 1].
   double weight_floor = 0;
+  // Per edge (empty: none): each interior edge's weight is multiplied by edge_weight_scale[e] > 0 after the
+  // rest of the policy (split_large_turns, trivcon/refine.h, lowers the weights of edges that keep turning
+  // by π/N or more). Its size must be the edge count.
+  std::vector<double> edge_weight_scale;
 };
 
 struct Connection {
