@@ -2,6 +2,8 @@
 // prescribed singularities, optimal, and as fast to edit as without constraints.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <Eigen/Geometry>
 #include <cmath>
 
@@ -263,6 +265,30 @@ TEST(Constraints, ManyFixedFacesSparseRoute) {
     EXPECT_EQ(a.connection.loop_index, (std::vector<int>{0, 0}));
     EXPECT_EQ(a.indices.loop, (std::vector<int>{0, 0}));
   }
+}
+
+// The sparse route's path turns (more than 256 paths, trivcon/solver.h): a one-edge path between two
+// adjacent fixed faces takes the smallest turn, |x_e| ≤ π/N, whatever the sign of the difference between
+// their directions (here random, within ±π/N after parallel transport).
+TEST(Constraints, SparsePathsTakeTheSmallestTurnEitherWay) {
+  const Mesh m = make_disk(24, 12);
+  FieldDesigner d(m.V, m.F);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> angle(-kPi, kPi);
+  IndexPrescription p;
+  p.N = 4;
+  for (int f = 0; f < m.F.rows(); ++f) p.fixed[f] = angle(random);
+  ASSERT_GT(p.fixed.size(), 300u);
+  d.set_fixed_faces(keys(p.fixed));
+  const Design r = d.design(p);
+  EXPECT_TRUE(design_verified(r));
+  int one_edge = 0;
+  for (const FixedPath& path : d.solver().fixed_paths()) {
+    if (path.path.edges.size() != 1) continue;
+    ++one_edge;
+    EXPECT_LE(std::abs(r.connection.x(path.path.edges[0])), kPi / 4 + 1e-9) << "edge " << path.path.edges[0];
+  }
+  EXPECT_GT(one_edge, 50);
 }
 
 // Fixed faces walled in by zero-weight edges (here: every edge unusable) are still joined to the others:

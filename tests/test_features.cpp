@@ -261,7 +261,12 @@ TEST(FeatureAlignment, CappedCylinderWithAuto) {
 // directions of neighbouring faces differ by a little (the rim turns), so any other whole number would
 // make that edge turn by nearly π/2.
 TEST(FeatureAlignment, SparsePathsTakeTheSmallestTurn) {
-  const Mesh m = make_capped_cylinder(6, 96, 12);
+  // The cylinder and its mirror image (the rims then turn the other way in the faces' frames, so the
+  // targets of the paths change sign: both roundings, up and down, are exercised).
+  Mesh mirrored = make_capped_cylinder(6, 96, 12);
+  mirrored.V.col(0) *= -1;
+  mirrored.F.col(1).swap(mirrored.F.col(2));
+  for (const Mesh& m : {make_capped_cylinder(6, 96, 12), mirrored}) {
   FieldDesigner designer(m.V, m.F);
   const Solved s = solve_with_features(designer, 30);
   const std::vector<FixedPath>& paths = designer.solver().fixed_paths();
@@ -274,6 +279,7 @@ TEST(FeatureAlignment, SparsePathsTakeTheSmallestTurn) {
   }
   EXPECT_GT(one_edge, 100);
   expect_exact_and_aligned(designer, s);
+  }
 }
 
 TEST(FeatureAlignment, FandiskLikeBlockReportsItsNonRightCorners) {
