@@ -323,7 +323,9 @@ TEST(Solver, WeightFloorRaisesOnlyTheLightEdges) {
     const Design r = floored.design(c.prescription);
     expect_exact(floored, r, c.prescription, false);
     EXPECT_LE(test::max_face_optimality(floored, r.connection), 1e-9);
-    if (raised == 0) EXPECT_NEAR(r.connection.energy, plain.design(c.prescription).connection.energy, 1e-12 * std::max(1.0, r.connection.energy));
+    if (raised == 0) {
+      EXPECT_NEAR(r.connection.energy, plain.design(c.prescription).connection.energy, 1e-12 * std::max(1.0, r.connection.energy));
+    }
   }
   const Mesh m = make_icosphere(3);
   EXPECT_THROW(FieldDesigner(m.V, m.F, SolverOptions{WeightKind::Cotan, SolverKind::Cholesky, Factorization::Parallel, 1.5}).solver(), Error);
