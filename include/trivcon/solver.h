@@ -81,7 +81,7 @@ struct SolverOptions {
   // Per edge (empty: none): each interior edge's weight is multiplied by edge_weight_scale[e] > 0 after the
   // rest of the policy (split_large_turns, trivcon/refine.h, lowers the weights of edges that keep turning
   // by π/N or more). Its size must be the edge count.
-  std::vector<double> edge_weight_scale;
+  std::vector<double> edge_weight_scale = {};
 };
 
 struct Connection {
