@@ -230,24 +230,18 @@ struct EditorServer::Impl {
       p.N = N.get<int>();
     }
     try {
-      const json& sing = pairs_field(body, "singularities");
-      for (size_t i = 0; i < sing.size(); ++i) {
-        const json& e = pair_at(sing, i, "singularities");
-        const std::string where = "singularities[" + std::to_string(i) + "]";
-        add_vertex_index(id_text(e[0], where, "vertex") + ":" + index_text(e[1], where), p);
-      }
-      const json& gens = pairs_field(body, "generators");
-      for (size_t i = 0; i < gens.size(); ++i) {
-        const json& e = pair_at(gens, i, "generators");
-        const std::string where = "generators[" + std::to_string(i) + "]";
-        add_generator_index(id_text(e[0], where, "generator") + ":" + index_text(e[1], where), p);
-      }
-      const json& loops = pairs_field(body, "boundary");
-      for (size_t i = 0; i < loops.size(); ++i) {
-        const json& e = pair_at(loops, i, "boundary");
-        const std::string where = "boundary[" + std::to_string(i) + "]";
-        add_loop_index(id_text(e[0], where, "boundary loop") + ":" + index_text(e[1], where), p);
-      }
+      // [[id, index], …] lists, each entry passed on as the CLI's "ID:INDEX" (so errors are the CLI's).
+      auto index_pairs = [&](const char* key, const char* what, void (*add)(const std::string&, IndexPrescription&)) {
+        const json& list = pairs_field(body, key);
+        for (size_t i = 0; i < list.size(); ++i) {
+          const json& e = pair_at(list, i, key);
+          const std::string where = std::string(key) + "[" + std::to_string(i) + "]";
+          add(id_text(e[0], where, what) + ":" + index_text(e[1], where), p);
+        }
+      };
+      index_pairs("singularities", "vertex", add_vertex_index);
+      index_pairs("generators", "generator", add_generator_index);
+      index_pairs("boundary", "boundary loop", add_loop_index);
       const json& fixed = pairs_field(body, "fixed");
       for (size_t i = 0; i < fixed.size(); ++i) {
         const json& e = pair_at(fixed, i, "fixed");
