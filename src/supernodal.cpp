@@ -262,7 +262,7 @@ class Numeric {
 
 }  // namespace
 
-TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& own_work, double min_split, int parts) {
+TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& own_work, double min_split, int parts, bool refine) {
   if (parts < 1) parts = 1;
   const int count = static_cast<int>(parent.size());
   std::vector<double> work = own_work;  // of each subtree (a parent comes after its children)
@@ -288,6 +288,32 @@ TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& 
     split.top.push_back(s);
     open_work -= work[s];
     for (int c : children[s]) open.push_back(c), std::push_heap(open.begin(), open.end(), lighter), open_work += work[c];
+  }
+  if (refine && parts > 1) {
+    // Further down while that shortens top + heaviest part: each step moves the heaviest subtree's root to
+    // the top; the best prefix of these steps is kept (64 steps in a row without a better one end the search).
+    auto heaviest_part = [&](std::vector<int> roots) {
+      std::sort(roots.begin(), roots.end(), [&](int a, int b) { return work[a] > work[b]; });
+      std::vector<double> load(parts, 0.0);
+      for (int r : roots) *std::min_element(load.begin(), load.end()) += work[r];
+      return *std::max_element(load.begin(), load.end());
+    };
+    double top_work = 0;
+    for (int s : split.top) top_work += own_work[s];
+    double best = top_work + heaviest_part(open);
+    std::vector<int> steps, best_open = open;
+    size_t best_steps = 0;
+    while (!open.empty() && work[open.front()] > min_split && steps.size() < best_steps + 64) {
+      std::pop_heap(open.begin(), open.end(), lighter);
+      const int s = open.back();
+      open.pop_back();
+      steps.push_back(s);
+      top_work += own_work[s];
+      for (int c : children[s]) open.push_back(c), std::push_heap(open.begin(), open.end(), lighter);
+      if (const double cost = top_work + heaviest_part(open); cost < best) best = cost, best_steps = steps.size(), best_open = open;
+    }
+    split.top.insert(split.top.end(), steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(best_steps));
+    open = best_open;
   }
   std::sort(open.begin(), open.end(), [&](int a, int b) { return work[a] > work[b]; });
   std::vector<double> load(parts, 0.0);

@@ -1,5 +1,6 @@
 // The numeric supernodal factorization (src/supernodal.h, internal) against CHOLMOD's own, on the same
-// symbolic factorization; and the split of the elimination tree it and the backward substitution use.
+// symbolic factorization; the split of the elimination tree it and the backward substitution use; and the
+// parallel substitution (src/detail/substitution.h) against CHOLMOD's solve.
 #include <cholmod.h>
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -12,9 +13,12 @@
 #include <map>
 #include <random>
 #include <set>
+#include <type_traits>
 
 #include "detail/cholmod.h"
+#include "detail/substitution.h"
 #include "detail/supernodal.h"
+#include "trivcon/error.h"
 #include "trivcon/generate.h"
 
 using namespace trivcon;
@@ -233,6 +237,98 @@ TEST(Supernodal, SameBitsEveryTime) {
   cholmod_free_factor(&symbolic, &cm.c);
 }
 
+// A x for the Hermitian (or symmetric) matrix given by its upper triangle, T = double or complex.
+template <class T>
+std::vector<T> multiply(const Upper& M, const std::vector<T>& x) {
+  std::vector<T> y(M.n, T(0));
+  const T* v = reinterpret_cast<const T*>(M.values.data());
+  for (int c = 0; c < M.n; ++c)
+    for (int k = M.outer[c]; k < M.outer[c + 1]; ++k) {
+      const int i = M.inner[k];
+      y[i] += v[k] * x[c];
+      if (i != c) {
+        if constexpr (std::is_same<T, double>::value)
+          y[c] += v[k] * x[i];
+        else
+          y[c] += std::conj(v[k]) * x[i];
+      }
+    }
+  return y;
+}
+
+// The parallel substitution against CHOLMOD's solve with the same factor, and by its own residual, on 1 to 4
+// threads (a split per thread), real and complex, with a small and a large top of the tree.
+template <class T>
+void check_substitution(const Upper& M, const std::string& name) {
+  constexpr bool complex = !std::is_same<T, double>::value;
+  Cholmod cm;
+  cm.c.supernodal = CHOLMOD_SUPERNODAL;
+  cholmod_sparse A = complex ? detail::upper_view_complex(M.outer, M.inner, M.values, M.n) : view(M);
+  cholmod_factor* L = cholmod_analyze(&A, &cm.c);
+  ASSERT_NE(L, nullptr);
+  ASSERT_EQ(complex ? supernodal::factorize_complex(*L, M.outer, M.inner, M.values, cm.c)
+                    : supernodal::factorize(*L, M.outer, M.inner, M.values, cm.c),
+            M.n);
+  std::vector<T> b(M.n);
+  for (int i = 0; i < M.n; ++i) {
+    if constexpr (complex)
+      b[i] = T(std::sin(0.37 * i + 1), std::cos(0.11 * i));
+    else
+      b[i] = std::sin(0.37 * i + 1);
+  }
+  Eigen::VectorXd flat = Eigen::Map<const Eigen::VectorXd>(reinterpret_cast<const double*>(b.data()), (complex ? 2 : 1) * M.n);
+  cholmod_dense B = complex ? detail::dense_view_complex(flat) : detail::dense_view(flat);
+  cholmod_dense* X = cholmod_solve(CHOLMOD_A, L, &B, &cm.c);
+  ASSERT_NE(X, nullptr);
+  const T* theirs = static_cast<const T*>(X->x);
+  double scale = 0;
+  for (int i = 0; i < M.n; ++i) scale = std::max(scale, std::abs(theirs[i]));
+  const int threads = omp_get_max_threads();
+  std::vector<T> first;
+  for (int n : {1, 2, 3, 4}) {
+    SCOPED_TRACE(name + ", " + std::to_string(n) + " threads");
+    omp_set_num_threads(n);
+    const supernodal::Substitution<T> solver(*L);
+    EXPECT_EQ(solver.size(), M.n);
+    for (int run = 0; run < 2; ++run) {
+      std::vector<T> x = b;
+      solver.solve(x.data());
+      double difference = 0;
+      for (int i = 0; i < M.n; ++i) difference = std::max(difference, std::abs(x[i] - theirs[i]) / scale);
+      EXPECT_LT(difference, 1e-12);
+      const std::vector<T> Ax = multiply(M, x);
+      double residual = 0, bmax = 0;
+      for (int i = 0; i < M.n; ++i) residual = std::max(residual, std::abs(Ax[i] - b[i])), bmax = std::max(bmax, std::abs(b[i]));
+      EXPECT_LT(residual, 1e-9 * bmax);
+      if (n == 2 && run == 0) first = x;
+      if (n == 2 && run == 1) {
+        EXPECT_TRUE(first == x) << "two runs on the same threads differ";
+      }
+    }
+  }
+  omp_set_num_threads(threads);
+  cholmod_free_dense(&X, &cm.c);
+  cholmod_free_factor(&L, &cm.c);
+}
+
+TEST(Substitution, SameSolutionAsCholmodRealAndComplex) {
+  check_substitution<double>(shifted_laplacian(make_cube_sphere(50, true), 1e-3, 11), "real cube sphere 50");
+  check_substitution<double>(with_dense_block(make_cube_sphere(30, true), 700), "real, large top");
+  check_substitution<std::complex<double>>(hermitian_laplacian(make_torus(120, 48), 1e-3, 5), "complex torus 120x48");
+  check_substitution<std::complex<double>>(hermitian_laplacian(make_holed_grid(60, 4), 1e-3, 9), "complex holed grid");
+}
+
+TEST(Substitution, RefusesAFactorOfTheOtherType) {
+  Upper M = shifted_laplacian(make_icosphere(2), 1e-3, 3);
+  Cholmod cm;
+  cm.c.supernodal = CHOLMOD_SUPERNODAL;
+  cholmod_sparse A = view(M);
+  cholmod_factor* L = cholmod_analyze(&A, &cm.c);
+  ASSERT_EQ(supernodal::factorize(*L, M.outer, M.inner, M.values, cm.c), M.n);
+  EXPECT_THROW(supernodal::Substitution<std::complex<double>>{*L}, Error);
+  cholmod_free_factor(&L, &cm.c);
+}
+
 TEST(Supernodal, ReportsTheColumnThatIsNotPositiveDefinite) {
   // A diagonally dominant matrix stays so as columns are eliminated: only the row made negative fails,
   // at its own factor column, wherever the ordering put it.
@@ -394,6 +490,44 @@ TEST(Supernodal, TreeSplitIntoAnyNumberOfParts) {
     }
     EXPECT_GE(all_used, 30) << "most random forests leave a subtree for every part";
   }
+}
+
+// With `refine` (the parallel substitution's split): the same contract of independent, balanced parts, and a
+// critical path (the top's work, done on one thread, plus the heaviest part's) never longer than without.
+TEST(Supernodal, RefinedTreeSplitShortensTheCriticalPath) {
+  using supernodal::split_tree;
+  auto critical_path = [](const std::vector<double>& work, const supernodal::TreeSplit& s, const BelowTop& below) {
+    double top = 0;
+    for (int t : s.top) top += work[t];
+    return top + *std::max_element(below.load.begin(), below.load.end());
+  };
+  std::mt19937 rng(23);
+  int shorter = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    std::vector<int> parent;
+    std::vector<double> work;
+    random_forest(rng, parent, work);
+    for (int parts : {2, 3}) {
+      const supernodal::TreeSplit plain = split_tree(parent, work, 100, parts), refined = split_tree(parent, work, 100, parts, true);
+      const BelowTop below_plain = expect_valid_split(parent, work, 100, plain, parts);
+      const BelowTop below_refined = expect_valid_split(parent, work, 100, refined, parts);
+      const double a = critical_path(work, plain, below_plain), b = critical_path(work, refined, below_refined);
+      EXPECT_LE(b, a + 1e-9);
+      shorter += b < a - 1e-9;
+    }
+  }
+  EXPECT_GE(shorter, 1) << "refining should help on some random forests";
+  // A root over three subtrees of 40, 35 and 25: none holds half, so the plain split stops at the root and
+  // two of them share a thread (critical path 1 + 60); going down the 40 (2 over two 19s) gives 3 + 54.
+  const std::vector<int> parent{2, 2, 5, 5, 5, -1};
+  const std::vector<double> work{19, 19, 2, 35, 25, 1};
+  const supernodal::TreeSplit plain = split_tree(parent, work, 1, 2), refined = split_tree(parent, work, 1, 2, true);
+  const BelowTop a = expect_valid_split(parent, work, 1, plain), b = expect_valid_split(parent, work, 1, refined);
+  EXPECT_EQ(plain.top, (std::vector<int>{5}));
+  EXPECT_DOUBLE_EQ(critical_path(work, plain, a), 61);
+  EXPECT_EQ(refined.top, (std::vector<int>{2, 5}));
+  EXPECT_DOUBLE_EQ(critical_path(work, refined, b), 57);
 }
 
 // The elimination trees of mesh Laplacians, with the work measure and threshold supernodal::factorize
