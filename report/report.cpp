@@ -27,6 +27,10 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
     report["huge_pages"] = {{"kernel", transparent_huge_pages_mode()},
                             {"malloc", t.find("glibc.malloc.hugetlb=1") != std::string::npos || t.find("glibc.malloc.hugetlb=2") != std::string::npos}};
   }
+  {  // how long OpenBLAS's idle threads spin (trivcon/process.h): null where OPENBLAS_THREAD_TIMEOUT is unset
+    const char* timeout = std::getenv("OPENBLAS_THREAD_TIMEOUT");
+    report["blas_thread_timeout"] = timeout ? nlohmann::ordered_json(timeout) : nlohmann::ordered_json(nullptr);
+  }
   report["ordering"] = designer.solver().ordering();
   nlohmann::ordered_json sing = nlohmann::ordered_json::array();
   for (auto [v, n] : prescription.vertex) sing.push_back({{"vertex", v}, {"index", format_index(n, prescription.N)}});

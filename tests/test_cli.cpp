@@ -529,6 +529,12 @@ TEST(CliSolve, SphereWithTwoPoles) {
   if (std::string(transparent_huge_pages_mode()) == "madvise" && (!tunables || !std::strstr(tunables, "glibc.malloc.hugetlb"))) {
     EXPECT_EQ(rep["huge_pages"]["malloc"], true);
   }
+  // OpenBLAS's idle threads sleep at once (trivcon/process.h), unless OPENBLAS_THREAD_TIMEOUT chooses.
+  if (const char* timeout = std::getenv("OPENBLAS_THREAD_TIMEOUT")) {
+    EXPECT_EQ(rep["blas_thread_timeout"], timeout);
+  } else if (!blas_kernels().empty()) {
+    EXPECT_EQ(rep["blas_thread_timeout"], "4");
+  }
 
   // Field text: header, one unit vector per face.
   const std::vector<std::string> field = lines_of(slurp(s.field_txt));
