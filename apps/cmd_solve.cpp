@@ -244,6 +244,7 @@ void run_solve(const SolveOptions& o) {
         {"used", r.vertex.size()},
         {"cancel_distance", o.auto_cancel},
         {"vanishing_faces", r.vanishing_faces},
+        {"ordering", r.ordering},
         {"seconds",
          {{"assemble", s.assemble}, {"factor", s.factor}, {"iterate", s.iterate}, {"align", s.align}, {"indices", s.indices},
           {"cancel", s.cancel}}}};

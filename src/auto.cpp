@@ -2,8 +2,10 @@
 #include "trivcon/auto.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <queue>
@@ -11,6 +13,9 @@
 #include <string>
 
 #include "detail/cholmod.h"
+#include "detail/ordering.h"
+#include "detail/parallel.h"
+#include "detail/substitution.h"
 #include "detail/supernodal.h"
 #include "detail/timing.h"
 #include "trivcon/curvature.h"
@@ -64,8 +69,8 @@ struct FactorDeleter {
 };
 
 // The smoothest field's complex values per face (see trivcon/auto.h).
-std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o,
-                                      const std::vector<Complex>* guidance, AutoTimings& time) {
+std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o,
+                                      const std::vector<Complex>* guidance, AutoTimings& time, std::string& ordering_used) {
   auto t0 = Clock::now();
   const int N = o.N;
   std::vector<Complex> u(t.num_faces, Complex(0, 0));
@@ -123,26 +128,63 @@ std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, cons
   time.assemble = seconds_since(t0);
 
   t0 = Clock::now();
-  detail::CholmodContext context;
-  cholmod_common& c = *context;
-  c.nmethods = 1;
-  // AMD, not METIS: on the dual graph of a 400k-face sphere METIS needs 3.3 times fewer flops (2.1e9 against
-  // 7.0e9, CHOLMOD's count) and two thirds of the factor's entries, but METIS_NodeND alone takes 1.7-2.1 s
-  // there, against 0.27 s for the whole AMD analysis; with the numeric factorization below (0.75 s after
-  // METIS, 1.5 s after AMD) and the 8 iterations, AMD's total was 2.8 s and METIS's 3.2 s (measured on a
-  // loaded machine whose set-up took 1.25 s).
-  c.method[0].ordering = CHOLMOD_AMD;
-  c.postorder = 1;
-  c.supernodal = CHOLMOD_SUPERNODAL;  // the numeric factorization below fills a supernodal factor
+  // Two candidate orders, analysed side by side on two threads, and the one with fewer flops (CHOLMOD's
+  // count) kept: AMD, and a nested dissection by the faces' centroids (src/detail/ordering.h). Neither wins
+  // everywhere: on the 400k-face sphere (a regular grid of faces, AMD's worst case) AMD needs 7.0e9 flops,
+  // the dissection 3.9e9; on scans the dissection needs 3-4 times AMD's (the dragon: 9.9e9 against 2.7e9;
+  // armadillo 3.3e8 against 7.6e7). (METIS would need 2.1e9 on the sphere and wins on scans too, but
+  // METIS_NodeND alone takes 1.2-1.5 s there, against 0.15-0.25 s for either analysis here.) Small meshes,
+  // or one thread, take AMD alone. Supernodes are amalgamated less than CHOLMOD's default (zrelax 0.8, 0.1,
+  // 0.05): the explicit zeros that buys are read again by each of the solves below and first-touched by
+  // the factorization (the sphere's factor: 1.90e7 entries for 1.39e7 nonzeros, 2.22e7 with the default);
+  // the factorization itself did not get measurably slower.
+  detail::CholmodContext amd_context, dissection_context;
+  for (cholmod_common* c : {amd_context.get(), dissection_context.get()}) {
+    c->nmethods = 1;
+    c->postorder = 1;
+    c->supernodal = CHOLMOD_SUPERNODAL;  // the numeric factorization below fills a supernodal factor
+    c->zrelax[0] = 0.4, c->zrelax[1] = 0.05, c->zrelax[2] = 0.02;
+  }
+  amd_context.get()->method[0].ordering = CHOLMOD_AMD;
+  dissection_context.get()->method[0].ordering = CHOLMOD_GIVEN;
   cholmod_sparse A = detail::upper_view_complex(outer, inner, values, n);
-  std::unique_ptr<cholmod_factor, FactorDeleter> L(cholmod_analyze(&A, &c), FactorDeleter{&c});
-  detail::require(L != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix", c);
+  const bool compare = n >= detail::kParallelMinElements && detail::max_threads() > 1;
+  std::unique_ptr<cholmod_factor, FactorDeleter> by_amd(nullptr, FactorDeleter{amd_context.get()}),
+      by_dissection(nullptr, FactorDeleter{dissection_context.get()});
+  std::exception_ptr error;
+#pragma omp parallel num_threads(2) if (compare)
+  {
+    try {
+      if (omp_get_thread_num() == 0) {
+        by_amd.reset(cholmod_analyze(&A, amd_context.get()));
+      } else if (compare) {
+        std::vector<std::array<double, 3>> centroid(n);
+        for (int j = 0; j < n; ++j)
+          for (int a = 0; a < 3; ++a)
+            centroid[j][a] = (V(t.F(face_of[j], 0), a) + V(t.F(face_of[j], 1), a) + V(t.F(face_of[j], 2), a)) / 3;
+        std::vector<int> order = ordering::coordinate_dissection(ordering::leading_block_pattern(outer, inner, n), centroid);
+        by_dissection.reset(cholmod_analyze_p(&A, order.data(), nullptr, 0, dissection_context.get()));
+      }
+    } catch (...) {  // an exception must not leave an OpenMP region
+#pragma omp critical
+      error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  detail::require(by_amd != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix", *amd_context);
+  const bool dissect = by_dissection && dissection_context.get()->fl < amd_context.get()->fl;
+  cholmod_common& c = dissect ? *dissection_context : *amd_context;
+  std::unique_ptr<cholmod_factor, FactorDeleter>& L = dissect ? by_dissection : by_amd;
+  (dissect ? by_amd : by_dissection).reset();
+  ordering_used = dissect ? "coordinate dissection" : "AMD";
   // The numeric factor by trivcon's own supernodal code (src/detail/supernodal.h, the same that factors the
   // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another,
   // and took 3-4 times as long on the 400k-face sphere (2.8-3.1 s against 0.73-1.06 s after METIS).
   if (const int minor = supernodal::factorize_complex(*L, outer, inner, values, c); minor < n)
     throw Error("automatic singularities: the smoothest-field matrix is not positive definite (column " + std::to_string(minor) +
                 " of " + std::to_string(n) + "): a non-finite or degenerate weight");
+  // The solves below on both cores (src/detail/substitution.h): CHOLMOD's own took 0.1 s each at 400k faces.
+  const supernodal::Substitution<Complex> substitution(*L);
   time.factor = seconds_since(t0);
 
   t0 = Clock::now();
@@ -165,20 +207,39 @@ std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, cons
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   for (int i = 0; i < 2 * n; ++i) x[i] = uniform(random);
   normalise(x);
-  Eigen::VectorXd b(2 * n);
-  for (int it = 0; it < std::max(1, o.iterations); ++it) {
-    for (int j = 0; j < n; ++j) {
-      const int f = face_of[j];
-      const double m = dirichlet_component[t.face_component[f]] ? 0.0 : k.mass[f];
-      b[2 * j] = m * x[2 * j] + dirichlet[2 * j], b[2 * j + 1] = m * x[2 * j + 1] + dirichlet[2 * j + 1];
+  {
+    // The iterations in the factor's order (no permutation per solve; mass, component and Dirichlet values
+    // permuted once): x ← s (A + εM)⁻¹ (M x + b_D), s = 1 / ‖·‖_M per component, applied with the next mass
+    // product (and at the end) instead of a pass of its own.
+    const std::vector<int>& perm = substitution.permutation();
+    std::vector<Complex> xf(n), bf(n), df(n);
+    std::vector<double> mf(n), scale(components, 1.0), norm(components);
+    std::vector<int> cf(n);
+    for (int q = 0; q < n; ++q) {
+      const int j = perm[q], comp = t.face_component[face_of[j]];
+      xf[q] = Complex(x[2 * j], x[2 * j + 1]), df[q] = Complex(dirichlet[2 * j], dirichlet[2 * j + 1]);
+      cf[q] = comp, mf[q] = dirichlet_component[comp] ? 0.0 : k.mass[face_of[j]];
     }
-    cholmod_dense B = detail::dense_view_complex(b);
-    cholmod_dense* X = cholmod_solve(CHOLMOD_A, L.get(), &B, &c);
-    detail::require(X != nullptr, "automatic singularities: CHOLMOD could not solve with the smoothest-field matrix", c);
-    std::copy_n(static_cast<const double*>(X->x), 2 * n, x.data());
-    cholmod_free_dense(&X, &c);
-    normalise(x);
+    for (int it = 0; it < std::max(1, o.iterations); ++it) {
+      for (int q = 0; q < n; ++q) bf[q] = (mf[q] * scale[cf[q]]) * xf[q] + df[q];
+      substitution.solve_in_factor_order(bf.data());
+      xf.swap(bf);
+      std::fill(norm.begin(), norm.end(), 0.0);
+      for (int q = 0; q < n; ++q) norm[cf[q]] += mf[q] * std::norm(xf[q]);
+      for (int comp = 0; comp < components; ++comp) {
+        if (dirichlet_component[comp]) continue;
+        if (!(norm[comp] > 0) || !std::isfinite(norm[comp]))
+          throw Error("automatic singularities: the inverse iteration lost the field on component " + std::to_string(comp) + " (norm " +
+                      std::to_string(norm[comp]) + ")");
+        scale[comp] = 1 / std::sqrt(norm[comp]);
+      }
+    }
+    for (int q = 0; q < n; ++q) {
+      const Complex v = xf[q] * scale[cf[q]];
+      x[2 * perm[q]] = v.real(), x[2 * perm[q] + 1] = v.imag();
+    }
   }
+  Eigen::VectorXd b(2 * n);
   time.iterate = seconds_since(t0);
   if (guidance) {
     t0 = Clock::now();
@@ -219,13 +280,9 @@ std::vector<Complex> smoothest_values(const Topology& t, const Geometry& g, cons
       const Complex mq = guided[comp] ? q[f] * (msum[comp] / zsum[comp]) : Complex(0, 0);
       b[2 * j] = mq.real() + dirichlet[2 * j], b[2 * j + 1] = mq.imag() + dirichlet[2 * j + 1];
     }
-    cholmod_dense B = detail::dense_view_complex(b);
-    cholmod_dense* X = cholmod_solve(CHOLMOD_A, L.get(), &B, &c);
-    detail::require(X != nullptr, "automatic singularities: CHOLMOD could not solve with the alignment matrix", c);
-    const double* aligned = static_cast<const double*>(X->x);
+    substitution.solve(reinterpret_cast<Complex*>(b.data()));
     for (int j = 0; j < n; ++j)  // components without curvature (flat, umbilic) keep the smoothest field
-      if (guided[t.face_component[face_of[j]]]) x[2 * j] = aligned[2 * j], x[2 * j + 1] = aligned[2 * j + 1];
-    cholmod_free_dense(&X, &c);
+      if (guided[t.face_component[face_of[j]]]) x[2 * j] = b[2 * j], x[2 * j + 1] = b[2 * j + 1];
     time.align = seconds_since(t0);
   }
   for (int j = 0; j < n; ++j) {
@@ -344,7 +401,7 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
   const Weights k = face_weights(V, t, g);
   std::vector<Complex> guidance;
   if (o.align_curvature) guidance = curvature_tensors(V, t, g);
-  std::vector<Complex> u = smoothest_values(t, g, k, o, o.align_curvature ? &guidance : nullptr, r.seconds);
+  std::vector<Complex> u = smoothest_values(V, t, g, k, o, o.align_curvature ? &guidance : nullptr, r.seconds, r.ordering);
 
   auto t0 = Clock::now();
   // Energy (the Rayleigh quotient), then faces where the field vanishes (trivcon/auto.h).

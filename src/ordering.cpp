@@ -1,6 +1,7 @@
 #include "detail/ordering.h"
 
 #include <algorithm>
+#include <functional>
 #include <numeric>
 
 namespace trivcon::ordering {
@@ -37,6 +38,59 @@ std::vector<int> elimination_tree(const Pattern& pattern, const std::vector<int>
     }
   }
   return parent;
+}
+
+std::vector<int> coordinate_dissection(const Pattern& pattern, const std::vector<std::array<double, 3>>& point, int leaf) {
+  const int n = pattern.n;
+  std::vector<int> order(n), side(n, 0);
+  std::iota(order.begin(), order.end(), 0);
+  int stamp = 0;
+  // The range [b, e) of `order` becomes [its left half's order | its right half's | its separator].
+  std::function<void(int, int)> dissect = [&](int b, int e) {
+    if (e <= b) return;
+    std::array<double, 3> lo = point[order[b]], hi = lo;
+    for (int q = b; q < e; ++q)
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], point[order[q]][a]), hi[a] = std::max(hi[a], point[order[q]][a]);
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+    // Ties broken by row, so that the order does not depend on the standard library's algorithms.
+    auto before = [&](int x, int y) { return point[x][axis] < point[y][axis] || (point[x][axis] == point[y][axis] && x < y); };
+    if (e - b <= std::max(leaf, 2)) {  // a leaf: along its axis (a chain of rows then gets no fill)
+      std::sort(order.begin() + b, order.begin() + e, before);
+      return;
+    }
+    const int mid = b + (e - b) / 2;
+    std::nth_element(order.begin() + b, order.begin() + mid, order.begin() + e, before);
+    const int left = ++stamp, right = ++stamp, separator = ++stamp;
+    for (int q = b; q < e; ++q) side[order[q]] = q < mid ? left : right;
+    auto touches = [&](int r, int other) {
+      for (int k = pattern.start[r]; k < pattern.start[r + 1]; ++k)
+        if (side[pattern.neighbour[k]] == other) return true;
+      return false;
+    };
+    int on_left = 0, on_right = 0;
+    for (int q = b; q < e; ++q) (q < mid ? on_left : on_right) += touches(order[q], q < mid ? right : left);
+    const bool from_left = on_left <= on_right;
+    const int sb = from_left ? b : mid, se = from_left ? mid : e;
+    for (int q = sb; q < se; ++q)
+      if (touches(order[q], from_left ? right : left)) side[order[q]] = separator;
+    // The separator's rows to the end of their half (keeping the others' order), then, from the left half,
+    // past the right half.
+    const int cut = static_cast<int>(
+        std::stable_partition(order.begin() + sb, order.begin() + se, [&](int r) { return side[r] != separator; }) - order.begin());
+    int left_end = mid, right_begin = mid, right_end = e;
+    if (from_left) {
+      std::rotate(order.begin() + cut, order.begin() + mid, order.begin() + e);
+      left_end = cut, right_begin = cut, right_end = cut + (e - mid);
+    } else {
+      right_end = cut;
+    }
+    dissect(b, left_end);
+    dissect(right_begin, right_end);
+  };
+  dissect(0, n);
+  return order;
 }
 
 }  // namespace trivcon::ordering

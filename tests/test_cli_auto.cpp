@@ -39,6 +39,7 @@ TEST(CliAuto, CubeGetsEightCornersAndSolvesExactly) {
   EXPECT_EQ(j["auto"]["found"], 8);
   EXPECT_EQ(j["auto"]["cancelled_pairs"], 0);
   EXPECT_EQ(j["auto"]["used"], 8);
+  EXPECT_EQ(j["auto"]["ordering"], "AMD");  // a small mesh: minimum degree alone
   EXPECT_TRUE(j["verified"].get<bool>());
   EXPECT_TRUE(j["indices"]["field_mismatches"].empty());
   const std::map<int, std::string> used = report_singularities(j);

@@ -5,8 +5,7 @@
 //   direction there is at angle arg(u_f)/N, so u_f = e^{iNβ_f} represents the N directions at once.
 // - Energy E(u) = Σ_e w_e |u_R − e^{iNρ_e} u_L|² over interior edges e (L, R and ρ_e of
 //   trivcon/geometry.h: ρ_e carries a direction from L to R, so e^{iNρ_e} carries u). Its Hermitian
-//   matrix A is factored by CHOLMOD as a complex matrix (half the factor and the work of the real
-//   2×2-block form).
+//   matrix A is factored as a complex matrix (half the factor and the work of the real 2×2-block form).
 // - Dual-edge weight w_e = |e|² / (m_L + m_R): the ratio of the primal edge length to the length of the
 //   dual edge between the two faces, with the dual edge measured through the faces' areas
 //   (≈ (m_L + m_R) / |e| up to a constant, which does not change the field). Unlike the cotan-like
@@ -21,10 +20,14 @@
 //   1e-12 × the mean face area stays as a last guard.
 // - The smoothest unit field minimises E(u) / ‖u‖²_M: the eigenvector of the smallest eigenvalue of
 //   A u = λ M u. It is computed per component by inverse-power iterations (x ← (A + εM)⁻¹ M x,
-//   normalised per component to ‖x‖_M = 1, from a fixed pseudo-random start) on ONE supernodal CHOLMOD
-//   factorization (AMD ordering; the numeric factor by trivcon's own supernodal code on
-//   all threads) of A + εM, ε = 1e-8 × Σ_f A_ff / Σ_f m_f (a tiny shift: A alone is
-//   singular when the N-th power of the holonomy is trivial, e.g. on a flat torus).
+//   normalised per component to ‖x‖_M = 1, from a fixed pseudo-random start) on ONE supernodal
+//   factorization of A + εM, ε = 1e-8 × Σ_f A_ff / Σ_f m_f (a tiny shift: A alone is singular when the
+//   N-th power of the holonomy is trivial, e.g. on a flat torus). Its order: CHOLMOD's AMD, or above 50k
+//   faces whichever of AMD and a nested dissection by the faces' centroids needs fewer flops (both analysed
+//   at once on two threads; the dissection wins on regular, remeshed surfaces, AMD on scans); the numeric
+//   factor and the solves by trivcon's own supernodal code on all threads. The result does not depend on
+//   the order beyond round-off (`ordering` says which was used). At 400k faces on 2 cores: about 0.9 s in
+//   all, one third of it the 8 solves (BENCHMARKS.md, "The cost of --auto").
 // - Why face-based: the field lives per face like trivcon's own fields and their indices are read by
 //   the same field_indices (trivcon/field.h), so the singularities are exactly those of the field that
 //   was found; a vertex-based field would have to be moved to faces first (an interpolation that can
@@ -73,6 +76,7 @@
 // `cancel_absolute` (then in the mesh's units).
 #pragma once
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -108,6 +112,7 @@ struct AutoResult {
   std::vector<std::pair<int, int>> pairs;  // cancelled pairs (vertex of index +n, vertex of −n), in order
   double energy = 0;                       // E(u) / ‖u‖²_M over the whole mesh (the Rayleigh quotient without fixed faces)
   int vanishing_faces = 0;                 // faces where |u_f| vanished (see above)
+  std::string ordering;                    // the smoothest field's factor order: "AMD" or "coordinate dissection"
   AutoTimings seconds;
 };
 

@@ -744,6 +744,7 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("vertex", [](const AutoOut& a) { return a.result.vertex; })
       .def_property_readonly("pairs", [](const AutoOut& a) { return a.result.pairs; })
       .def_property_readonly("coincident_removed", [](const AutoOut& a) { return a.result.coincident_removed; })
+      .def_property_readonly("ordering", [](const AutoOut& a) { return a.result.ordering; })
       .def_property_readonly("energy", [](const AutoOut& a) { return a.result.energy; })
       .def_property_readonly("vanishing_faces", [](const AutoOut& a) { return a.result.vanishing_faces; })
       .def_property_readonly("angles", [](const AutoOut& a) { return double_vector(a.result.field.angle); })

@@ -224,6 +224,7 @@ def test_auto_cube():
     assert r.auto is not None and r.auto.singularities == a.singularities
     assert set(r.auto.seconds) == {"assemble", "factor", "iterate", "align", "indices", "cancel"}
     assert r.auto.coincident_removed == 0
+    assert a.ordering == "AMD"  # 768 faces: below the size where a second order is tried
 
 
 def test_auto_align_curvature():

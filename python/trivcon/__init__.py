@@ -891,6 +891,7 @@ class AutoResult:
       directions     float64 (m, 3), angles float64 (m,): the smoothest field itself (not the exact solve)
       energy         its Rayleigh quotient E(u) / |u|^2_M; vanishing_faces: faces where it vanished
       seconds        per stage (assemble, factor, iterate, align, indices, cancel)
+      ordering       the smoothest field's factor order: "AMD" or "coordinate dissection" (auto.h)
     """
 
     def __init__(self, a):
@@ -919,6 +920,11 @@ class AutoResult:
     def coincident_removed(self):
         """Singularities of `found` that summing the indices over coincident vertices removed."""
         return self._a.coincident_removed
+
+    @property
+    def ordering(self):
+        """The smoothest field's factor order: "AMD", or "coordinate dissection" where that needs fewer flops."""
+        return self._a.ordering
 
     @property
     def pairs(self):
