@@ -343,20 +343,22 @@ int child_run(const RunOptions& o) {
   // `reps` times (after one warm-up).
   Samples auto_total, auto_assemble, auto_factor, auto_iterate, auto_indices;
   size_t auto_found = 0;
+  std::string auto_ordering;
   for (int r = 0; r < 1 + reps; ++r) {
     AutoOptions ao;
     ao.N = o.N;
     auto t0 = Clock::now();
     const AutoResult a = auto_singularities(*p.designer, ao);
     const double t = seconds_since(t0);
-    auto_found = a.vertex.size();
+    auto_found = a.vertex.size(), auto_ordering = a.ordering;
     if (r == 0) continue;
     auto_total.add(t), auto_assemble.add(a.seconds.assemble), auto_factor.add(a.seconds.factor), auto_iterate.add(a.seconds.iterate);
     auto_indices.add(a.seconds.indices);
   }
   log("  " + o.name + ": auto " + std::to_string(auto_total.median()) + " s, " + std::to_string(auto_found) + " singularities");
   result["auto"] = json{{"total", auto_total.to_json()},     {"assemble", auto_assemble.to_json()}, {"factor", auto_factor.to_json()},
-                        {"iterate", auto_iterate.to_json()}, {"indices", auto_indices.to_json()},   {"singularities", auto_found}};
+                        {"iterate", auto_iterate.to_json()}, {"indices", auto_indices.to_json()},   {"singularities", auto_found},
+                        {"ordering", auto_ordering}};
   rss["peak"] = peak_rss();
   result["rss"] = rss;
   result["N"] = o.N;
@@ -587,15 +589,16 @@ std::string label(const json& r) {
 void print_auto_table(const json& runs) {
   std::ostream& out = std::cout;
   out << "\n### Automatic placement (`solve --auto`: the smoothest field, trivcon/auto.h), medians\n\n";
-  out << "| mesh | faces | prepare (wall) | auto (assemble / factor / iterate / indices) | auto ÷ prepare | singularities |\n";
-  out << "|---|---:|---:|---:|---:|---:|\n";
+  out << "| mesh | faces | prepare (wall) | auto (assemble / factor / iterate / indices) | auto ÷ prepare | singularities | order |\n";
+  out << "|---|---:|---:|---:|---:|---:|---|\n";
   for (const json& r : runs) {
     if (r.value("status", "") != "ok" || !r["auto"].is_object()) continue;
     const json& a = r["auto"];
     const double prepare = med(r["stages"], "prepare"), total = med(a, "total");
     out << "| " << label(r) << " | " << r["mesh"]["faces"].get<long>() << " | " << sec(prepare) << " | " << sec(total) << " ("
         << fmt(med(a, "assemble")) << " / " << fmt(med(a, "factor")) << " / " << fmt(med(a, "iterate")) << " / " << fmt(med(a, "indices"))
-        << ") | " << fmt(total / prepare, 2) << " | " << a["singularities"].get<long>() << " |\n";
+        << ") | " << fmt(total / prepare, 2) << " | " << a["singularities"].get<long>() << " | " << a.value("ordering", std::string())
+        << " |\n";
   }
   out << "\n";
 }

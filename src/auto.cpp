@@ -147,7 +147,9 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   }
   amd_context.get()->method[0].ordering = CHOLMOD_AMD;
   dissection_context.get()->method[0].ordering = CHOLMOD_GIVEN;
+  // The analyses read the pattern alone (with the complex values they copied them too: 0.04 s at 400k).
   cholmod_sparse A = detail::upper_view_complex(outer, inner, values, n);
+  A.xtype = CHOLMOD_PATTERN, A.x = nullptr;
   const bool compare = n >= detail::kParallelMinElements && detail::max_threads() > 1;
   std::unique_ptr<cholmod_factor, FactorDeleter> by_amd(nullptr, FactorDeleter{amd_context.get()}),
       by_dissection(nullptr, FactorDeleter{dissection_context.get()});

@@ -42,7 +42,7 @@ std::vector<int> elimination_tree(const Pattern& pattern, const std::vector<int>
 
 std::vector<int> coordinate_dissection(const Pattern& pattern, const std::vector<std::array<double, 3>>& point, int leaf) {
   const int n = pattern.n;
-  std::vector<int> order(n), side(n, 0);
+  std::vector<int> order(n), side(n, 0), scratch;
   std::iota(order.begin(), order.end(), 0);
   int stamp = 0;
   // The range [b, e) of `order` becomes [its left half's order | its right half's | its separator].
@@ -77,8 +77,15 @@ std::vector<int> coordinate_dissection(const Pattern& pattern, const std::vector
       if (touches(order[q], from_left ? right : left)) side[order[q]] = separator;
     // The separator's rows to the end of their half (keeping the others' order), then, from the left half,
     // past the right half.
-    const int cut = static_cast<int>(
-        std::stable_partition(order.begin() + sb, order.begin() + se, [&](int r) { return side[r] != separator; }) - order.begin());
+    int cut = sb;
+    scratch.clear();
+    for (int q = sb; q < se; ++q) {
+      if (side[order[q]] == separator)
+        scratch.push_back(order[q]);
+      else
+        order[cut++] = order[q];
+    }
+    std::copy(scratch.begin(), scratch.end(), order.begin() + cut);
     int left_end = mid, right_begin = mid, right_end = e;
     if (from_left) {
       std::rotate(order.begin() + cut, order.begin() + mid, order.begin() + e);
