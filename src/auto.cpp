@@ -68,6 +68,69 @@ struct FactorDeleter {
   void operator()(cholmod_factor* L) const { cholmod_free_factor(&L, c); }
 };
 
+// The symbolic factorization of the smoothest-field matrix (its upper triangle's pattern: outer, inner;
+// rows are the unknown faces face_of), with the CHOLMOD workspace it belongs to and the name of its order.
+//
+// Two candidate orders, analysed side by side on two threads, and the one with fewer flops (CHOLMOD's
+// count) kept: AMD, and a nested dissection by the faces' centroids (src/detail/ordering.h). Neither wins
+// everywhere: on the 400k-face sphere (a regular grid of faces, AMD's worst case) AMD needs 7.0e9 flops,
+// the dissection 3.9e9; on scans the dissection needs 3-4 times AMD's (the dragon: 9.9e9 against 2.7e9;
+// armadillo 3.3e8 against 7.6e7). (METIS would need 2.1e9 on the sphere and wins on scans too, but
+// METIS_NodeND alone takes 1.2-1.5 s there, against 0.15-0.25 s for either analysis here.) Small meshes,
+// or one thread, take AMD alone. Supernodes are amalgamated less than CHOLMOD's default (zrelax 0.8, 0.1,
+// 0.05): the explicit zeros that buys are read again by each solve and first-touched by the factorization
+// (the sphere's factor: 1.90e7 entries for 1.39e7 nonzeros, 2.22e7 with the default); the factorization
+// itself did not get measurably slower.
+struct SymbolicFactor {
+  std::unique_ptr<detail::CholmodContext> context;
+  std::unique_ptr<cholmod_factor, FactorDeleter> factor{nullptr, FactorDeleter{nullptr}};
+  std::string ordering;
+};
+
+SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, const std::vector<int>& face_of, const std::vector<int>& outer,
+                                        const std::vector<int>& inner) {
+  const int n = static_cast<int>(face_of.size());
+  SymbolicFactor candidate[2];  // by AMD, by the dissection
+  for (SymbolicFactor& s : candidate) {
+    s.context = std::make_unique<detail::CholmodContext>();
+    cholmod_common* c = s.context->get();
+    c->nmethods = 1;
+    c->postorder = 1;
+    c->supernodal = CHOLMOD_SUPERNODAL;  // the numeric factorization fills a supernodal factor
+    c->zrelax[0] = 0.4, c->zrelax[1] = 0.05, c->zrelax[2] = 0.02;
+    s.factor = std::unique_ptr<cholmod_factor, FactorDeleter>(nullptr, FactorDeleter{c});
+  }
+  candidate[0].context->get()->method[0].ordering = CHOLMOD_AMD, candidate[0].ordering = "AMD";
+  candidate[1].context->get()->method[0].ordering = CHOLMOD_GIVEN, candidate[1].ordering = "coordinate dissection";
+  // The pattern alone (with the complex values the analyses copied them too: 0.04 s at 400k).
+  cholmod_sparse A = detail::upper_pattern_view(outer, inner, n);
+  const bool compare = n >= detail::kParallelMinElements && detail::max_threads() > 1;
+  std::exception_ptr error;
+#pragma omp parallel num_threads(2) if (compare)
+  {
+    try {
+      if (omp_get_thread_num() == 0) {
+        candidate[0].factor.reset(cholmod_analyze(&A, candidate[0].context->get()));
+      } else if (compare) {
+        std::vector<std::array<double, 3>> centroid(n);
+        for (int j = 0; j < n; ++j)
+          for (int a = 0; a < 3; ++a)
+            centroid[j][a] = (V(t.F(face_of[j], 0), a) + V(t.F(face_of[j], 1), a) + V(t.F(face_of[j], 2), a)) / 3;
+        std::vector<int> order = ordering::coordinate_dissection(ordering::leading_block_pattern(outer, inner, n), centroid);
+        candidate[1].factor.reset(cholmod_analyze_p(&A, order.data(), nullptr, 0, candidate[1].context->get()));
+      }
+    } catch (...) {  // an exception must not leave an OpenMP region
+#pragma omp critical
+      error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  detail::require(candidate[0].factor != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix",
+                  candidate[0].context->common());
+  const bool dissect = candidate[1].factor && candidate[1].context->common().fl < candidate[0].context->common().fl;
+  return std::move(candidate[dissect ? 1 : 0]);
+}
+
 // The smoothest field's complex values per face (see trivcon/auto.h).
 std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o,
                                       const std::vector<Complex>* guidance, AutoTimings& time, std::string& ordering_used) {
@@ -128,57 +191,10 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   time.assemble = seconds_since(t0);
 
   t0 = Clock::now();
-  // Two candidate orders, analysed side by side on two threads, and the one with fewer flops (CHOLMOD's
-  // count) kept: AMD, and a nested dissection by the faces' centroids (src/detail/ordering.h). Neither wins
-  // everywhere: on the 400k-face sphere (a regular grid of faces, AMD's worst case) AMD needs 7.0e9 flops,
-  // the dissection 3.9e9; on scans the dissection needs 3-4 times AMD's (the dragon: 9.9e9 against 2.7e9;
-  // armadillo 3.3e8 against 7.6e7). (METIS would need 2.1e9 on the sphere and wins on scans too, but
-  // METIS_NodeND alone takes 1.2-1.5 s there, against 0.15-0.25 s for either analysis here.) Small meshes,
-  // or one thread, take AMD alone. Supernodes are amalgamated less than CHOLMOD's default (zrelax 0.8, 0.1,
-  // 0.05): the explicit zeros that buys are read again by each of the solves below and first-touched by
-  // the factorization (the sphere's factor: 1.90e7 entries for 1.39e7 nonzeros, 2.22e7 with the default);
-  // the factorization itself did not get measurably slower.
-  detail::CholmodContext amd_context, dissection_context;
-  for (cholmod_common* c : {amd_context.get(), dissection_context.get()}) {
-    c->nmethods = 1;
-    c->postorder = 1;
-    c->supernodal = CHOLMOD_SUPERNODAL;  // the numeric factorization below fills a supernodal factor
-    c->zrelax[0] = 0.4, c->zrelax[1] = 0.05, c->zrelax[2] = 0.02;
-  }
-  amd_context.get()->method[0].ordering = CHOLMOD_AMD;
-  dissection_context.get()->method[0].ordering = CHOLMOD_GIVEN;
-  // The analyses read the pattern alone (with the complex values they copied them too: 0.04 s at 400k).
-  cholmod_sparse A = detail::upper_view_complex(outer, inner, values, n);
-  A.xtype = CHOLMOD_PATTERN, A.x = nullptr;
-  const bool compare = n >= detail::kParallelMinElements && detail::max_threads() > 1;
-  std::unique_ptr<cholmod_factor, FactorDeleter> by_amd(nullptr, FactorDeleter{amd_context.get()}),
-      by_dissection(nullptr, FactorDeleter{dissection_context.get()});
-  std::exception_ptr error;
-#pragma omp parallel num_threads(2) if (compare)
-  {
-    try {
-      if (omp_get_thread_num() == 0) {
-        by_amd.reset(cholmod_analyze(&A, amd_context.get()));
-      } else if (compare) {
-        std::vector<std::array<double, 3>> centroid(n);
-        for (int j = 0; j < n; ++j)
-          for (int a = 0; a < 3; ++a)
-            centroid[j][a] = (V(t.F(face_of[j], 0), a) + V(t.F(face_of[j], 1), a) + V(t.F(face_of[j], 2), a)) / 3;
-        std::vector<int> order = ordering::coordinate_dissection(ordering::leading_block_pattern(outer, inner, n), centroid);
-        by_dissection.reset(cholmod_analyze_p(&A, order.data(), nullptr, 0, dissection_context.get()));
-      }
-    } catch (...) {  // an exception must not leave an OpenMP region
-#pragma omp critical
-      error = std::current_exception();
-    }
-  }
-  if (error) std::rethrow_exception(error);
-  detail::require(by_amd != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix", *amd_context);
-  const bool dissect = by_dissection && dissection_context.get()->fl < amd_context.get()->fl;
-  cholmod_common& c = dissect ? *dissection_context : *amd_context;
-  std::unique_ptr<cholmod_factor, FactorDeleter>& L = dissect ? by_dissection : by_amd;
-  (dissect ? by_amd : by_dissection).reset();
-  ordering_used = dissect ? "coordinate dissection" : "AMD";
+  const SymbolicFactor symbolic = analyse_smoothest_matrix(V, t, face_of, outer, inner);
+  cholmod_common& c = **symbolic.context;
+  cholmod_factor* const L = symbolic.factor.get();
+  ordering_used = symbolic.ordering;
   // The numeric factor by trivcon's own supernodal code (src/detail/supernodal.h, the same that factors the
   // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another,
   // and took 3-4 times as long on the 400k-face sphere (2.8-3.1 s against 0.73-1.06 s after METIS).

@@ -59,6 +59,9 @@ class CholmodLongContext {
 // column, sorted): outer has at least n + 1 entries.
 cholmod_sparse upper_view(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values, int n);
 
+// The pattern alone (CHOLMOD_PATTERN: no values), for a symbolic analysis that need not copy them.
+cholmod_sparse upper_pattern_view(const std::vector<int>& outer, const std::vector<int>& inner, int n);
+
 // The same for a complex Hermitian matrix (CHOLMOD_COMPLEX): `values` holds (real, imaginary) per entry,
 // 2 × outer[n] numbers; CHOLMOD takes the lower triangle as the conjugate of the upper.
 cholmod_sparse upper_view_complex(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values, int n);
