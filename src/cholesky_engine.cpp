@@ -3,10 +3,12 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <memory>
 #include <string>
 
 #include "detail/ordering.h"
 #include "detail/parallel.h"
+#include "detail/substitution.h"
 #include "detail/supernodal.h"
 #include "detail/timing.h"
 #include "trivcon/error.h"
@@ -97,10 +99,8 @@ class CholeskyEngine : public SolverEngine {
   mutable std::vector<int> super_stamp_;
   mutable Eigen::VectorXd forward_work_;
   mutable int stamp_ = 0;
-  // Backward substitution on OpenMP's threads (see plan_backward): the supernodes of the top of the tree,
-  // then one set of disjoint subtrees per thread, all in decreasing order.
-  std::vector<int> backward_top_;
-  std::vector<std::vector<int>> backward_part_;
+  // Backward substitution on OpenMP's threads (src/detail/substitution.h), planned once the factor has its values.
+  std::unique_ptr<supernodal::Substitution<double>> substitution_;
 
   // The rows of A (see normal_matrix): vertex rows given per system edge by the rows of its two ends (a
   // boundary or dropped vertex has none), then the extra rows Et (fixed-face paths that are ordered with
@@ -210,45 +210,12 @@ class CholeskyEngine : public SolverEngine {
     super_parent_ = supernodal::supernode_parents(L, super_of_col_);
     super_stamp_.assign(L.count, -1);
     for (int& r : edge_rows_.row) r = position_[r];
-    plan_backward();
+    substitution_ = std::make_unique<supernodal::Substitution<double>>(*factor);
   }
 
-  // Splits the supernodal elimination tree for a backward substitution on OpenMP's threads, balanced by
-  // the factor's entries (see supernodal::split_tree), each list in decreasing order.
-  void plan_backward() {
-    const Supernodes L(factor);
-    std::vector<double> entries(L.count);
-    for (int s = 0; s < L.count; ++s) entries[s] = static_cast<double>(L.height(s)) * L.cols(s);
-    supernodal::TreeSplit split = supernodal::split_tree(super_parent_, entries, 1e4, max_threads());
-    backward_top_.assign(split.top.rbegin(), split.top.rend());
-    backward_part_.resize(split.part.size());
-    for (size_t k = 0; k < split.part.size(); ++k) backward_part_[k].assign(split.part[k].rbegin(), split.part[k].rend());
-  }
-
-  // z ← L⁻ᵀ z (in factor order): the top supernodes, then the two parts of the tree concurrently.
-  // Each supernode s solves its columns given its rows below, which belong to its ancestors: done
-  // before it (the top) or earlier in its own part (decreasing order).
-  void backward(Eigen::VectorXd& z) const {
-    const Supernodes L(factor);
-    auto solve_supernodes = [&](const std::vector<int>& list) {
-      Eigen::VectorXd below;
-      for (int s : list) {
-        const int ncol = L.cols(s), nrow = L.height(s);
-        const auto Ls = L.values(s);
-        auto block = z.segment(L.first(s), ncol);
-        if (nrow > ncol) {
-          below.resize(nrow - ncol);
-          for (int i = 0; i < nrow - ncol; ++i) below(i) = z(L.row(s, ncol + i));
-          block.noalias() -= Ls.bottomRows(nrow - ncol).transpose() * below;
-        }
-        Ls.topRows(ncol).triangularView<Eigen::Lower>().transpose().solveInPlace(block);
-      }
-    };
-    solve_supernodes(backward_top_);
-    const int parts = static_cast<int>(backward_part_.size());
-#pragma omp parallel for schedule(static, 1) num_threads(parts) if (parts > 1 && !backward_part_[1].empty())
-    for (int k = 0; k < parts; ++k) solve_supernodes(backward_part_[k]);
-  }
+  // z ← L⁻ᵀ z (in factor order), on OpenMP's threads: the top of the tree, then one set of disjoint subtrees
+  // per thread (src/detail/substitution.h).
+  void backward(Eigen::VectorXd& z) const { substitution_->backward_in_factor_order(z.data()); }
 
   // z += L⁻¹ d for d with the few nonzeros `entries` (factor positions, values): only the supernodes on
   // the paths from those entries to the root of the elimination tree are touched, in increasing order.

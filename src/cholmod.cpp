@@ -30,19 +30,17 @@ CholmodLongContext::CholmodLongContext() {
 }
 CholmodLongContext::~CholmodLongContext() { cholmod_l_finish(&c_); }
 
-cholmod_sparse upper_view(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values, int n) {
-  cholmod_sparse s{};
-  s.nrow = s.ncol = static_cast<size_t>(n), s.nzmax = static_cast<size_t>(outer[n]);
-  s.p = const_cast<int*>(outer.data()), s.i = const_cast<int*>(inner.data()), s.x = const_cast<double*>(values.data());
-  s.stype = 1, s.itype = CHOLMOD_INT, s.xtype = CHOLMOD_REAL, s.dtype = CHOLMOD_DOUBLE, s.sorted = 1, s.packed = 1;
-  return s;
-}
-
 cholmod_sparse upper_pattern_view(const std::vector<int>& outer, const std::vector<int>& inner, int n) {
   cholmod_sparse s{};
   s.nrow = s.ncol = static_cast<size_t>(n), s.nzmax = static_cast<size_t>(outer[n]);
   s.p = const_cast<int*>(outer.data()), s.i = const_cast<int*>(inner.data());
   s.stype = 1, s.itype = CHOLMOD_INT, s.xtype = CHOLMOD_PATTERN, s.dtype = CHOLMOD_DOUBLE, s.sorted = 1, s.packed = 1;
+  return s;
+}
+
+cholmod_sparse upper_view(const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values, int n) {
+  cholmod_sparse s = upper_pattern_view(outer, inner, n);
+  s.x = const_cast<double*>(values.data()), s.xtype = CHOLMOD_REAL;
   return s;
 }
 

@@ -32,7 +32,8 @@ void use_tuned_process(char** argv) {
   const char* old_tunables = std::getenv("GLIBC_TUNABLES");
   const std::string tunables = old_tunables ? old_tunables : "";
   bool set_coretype = false, set_tunables = false, set_timeout = false;
-  if (std::getenv("OPENBLAS_CORETYPE") == nullptr && blas_kernels() == "Prescott") {  // OpenBLAS's generic fallback
+  const std::string kernels = blas_kernels();  // "" when the BLAS is not OpenBLAS
+  if (std::getenv("OPENBLAS_CORETYPE") == nullptr && kernels == "Prescott") {  // OpenBLAS's generic fallback
     const std::string native = native_blas_kernels();
     set_coretype = !native.empty() && setenv("OPENBLAS_CORETYPE", native.c_str(), 1) == 0;
   }
@@ -41,7 +42,7 @@ void use_tuned_process(char** argv) {
     set_tunables = setenv("GLIBC_TUNABLES", value.c_str(), 1) == 0;
   }
   // OpenBLAS's idle threads wait 2^4 cycles, not 2^28 (about 0.1 s), for more work (trivcon/process.h).
-  if (std::getenv("OPENBLAS_THREAD_TIMEOUT") == nullptr && !blas_kernels().empty())
+  if (std::getenv("OPENBLAS_THREAD_TIMEOUT") == nullptr && !kernels.empty())
     set_timeout = setenv("OPENBLAS_THREAD_TIMEOUT", kBlasThreadTimeout, 1) == 0;
   if (!set_coretype && !set_tunables && !set_timeout) return;
   execv("/proc/self/exe", argv);

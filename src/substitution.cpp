@@ -108,6 +108,34 @@ void Substitution<T>::solve_in_factor_order(T* z) const {
         z[r] -= out[i];
     }
   };
+  const int parts = static_cast<int>(part_.size());
+  const bool several = parts > 1 && !part_[1].empty();
+  std::vector<std::exception_ptr> error(parts);
+#pragma omp parallel for schedule(static, 1) num_threads(parts) if (several)
+  for (int k = 0; k < parts; ++k) {
+    try {
+      std::vector<T> sent;
+      send_[k].assign(top_columns_, T(0));
+      for (int s : part_[k]) forward(s, sent, send_[k].data());
+    } catch (...) {  // an exception must not leave an OpenMP region
+      error[k] = std::current_exception();
+    }
+  }
+  for (const auto& e : error)
+    if (e) std::rethrow_exception(e);
+  for (int k = 0; k < parts; ++k)  // in a fixed order
+    for (int s : top_)
+      for (int c = S.first(s); c < S.first(s) + S.cols(s); ++c) z[c] -= send_[k][top_slot_[c]];
+  std::vector<T> scratch;
+  for (int s : top_) forward(s, scratch, nullptr);
+  backward_in_factor_order(z);
+}
+
+template <class T>
+void Substitution<T>::backward_in_factor_order(T* z) const {
+  if (n_ == 0) return;
+  const Supernodes S(&L_);
+  const T* values = static_cast<const T*>(L_.x);
   // Backward: Lᴴ z = y. Supernode s gathers its rows below (its ancestors', done) after a copy of its own
   // entries (v: its rows, in its row order), then solves its columns last to first, each column read from
   // its last row up: the supernodes come in decreasing order, so the whole pass reads the factor as one
@@ -130,31 +158,15 @@ void Substitution<T>::solve_in_factor_order(T* z) const {
 
   const int parts = static_cast<int>(part_.size());
   const bool several = parts > 1 && !part_[1].empty();
-  std::vector<std::exception_ptr> error(parts);
-#pragma omp parallel for schedule(static, 1) num_threads(parts) if (several)
-  for (int k = 0; k < parts; ++k) {
-    try {
-      std::vector<T> sent;
-      send_[k].assign(top_columns_, T(0));
-      for (int s : part_[k]) forward(s, sent, send_[k].data());
-    } catch (...) {  // an exception must not leave an OpenMP region
-      error[k] = std::current_exception();
-    }
-  }
-  for (const auto& e : error)
-    if (e) std::rethrow_exception(e);
-  for (int k = 0; k < parts; ++k)  // in a fixed order
-    for (int s : top_)
-      for (int c = S.first(s); c < S.first(s) + S.cols(s); ++c) z[c] -= send_[k][top_slot_[c]];
   std::vector<T> scratch;
-  for (int s : top_) forward(s, scratch, nullptr);
   for (auto s = top_.rbegin(); s != top_.rend(); ++s) backward(*s, scratch);
+  std::vector<std::exception_ptr> error(parts);
 #pragma omp parallel for schedule(static, 1) num_threads(parts) if (several)
   for (int k = 0; k < parts; ++k) {
     try {
       std::vector<T> gathered;
       for (auto s = part_[k].rbegin(); s != part_[k].rend(); ++s) backward(*s, gathered);
-    } catch (...) {
+    } catch (...) {  // an exception must not leave an OpenMP region
       error[k] = std::current_exception();
     }
   }

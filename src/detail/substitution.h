@@ -17,7 +17,7 @@
 // is more than most supernodes' work). The split is balanced by entries and goes down the tree while that
 // shortens top + heaviest part (split_tree's `refine`). At 400k faces on 2 cores a complex solve takes
 // 30 ms (1.9e7 factor entries: about 20 GB/s), against 0.1 s for cholmod_solve.
-// Not for concurrent calls on one object (its work vectors are shared); one object per thread.
+// solve and solve_in_factor_order are not for concurrent calls on one object (their work vectors are shared).
 #pragma once
 #include <cholmod.h>
 
@@ -40,6 +40,9 @@ class Substitution {
   void solve(T* x) const;
   // The same in the factor's order: z ← (L Lᴴ)⁻¹ z, z[k] the entry of matrix row permutation()[k].
   void solve_in_factor_order(T* z) const;
+  // Its second half alone: z ← L⁻ᴴ z in the factor's order (the trivial-connection solver's backward
+  // substitution, after its own sparse forward update). Uses no member work vector.
+  void backward_in_factor_order(T* z) const;
   const std::vector<int>& permutation() const { return perm_; }
   int size() const { return n_; }
 
