@@ -128,9 +128,13 @@ std::vector<int> apply_features(const SolveOptions& o, const FieldDesigner& desi
 // Solves one prescription on the prepared designer, writes its outputs, prints its summary; returns
 // whether verification passed.
 // `extra` holds report entries of the whole run (the "auto" or "sing_from_field" object), added to the report.
+// `guide` (--auto's smoothest field, on this designer's faces): components without a root or fixed face take
+// their rotation from it (roots_toward, trivcon/auto.h) instead of starting at angle 0.
 bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& designer, const IndexPrescription& prescription,
-               const std::vector<std::pair<int, double>>& roots, const std::string& name, double read_seconds,
-               const nlohmann::ordered_json& extra, const std::vector<int>& sharp) {
+               const std::vector<std::pair<int, double>>& given_roots, const std::string& name, double read_seconds,
+               const nlohmann::ordered_json& extra, const std::vector<int>& sharp, const Field* guide = nullptr) {
+  std::vector<std::pair<int, double>> roots = given_roots;
+  if (guide) roots = roots_toward(designer, designer.design(prescription, roots).field, *guide, roots, prescription.fixed);
   const Design d = designer.design(prescription, roots);
   const Connection& c = d.connection;
 
@@ -166,6 +170,9 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
     if (!d.index_mismatch_vertices.empty())
       std::cout << " (" << d.index_mismatch_vertices.size() - unexplained.size()
                 << " at vertices where the connection turns by pi/N or more across an edge, which a per-face field cannot show)";
+    std::cout << "\nfield exact: "
+              << (d.field_exact ? "yes (read on its own with the closest matching, the per-face field shows exactly the prescribed singularities)"
+                                : "NO (read on its own, the per-face field shows other singularities than prescribed: see the warning)");
     std::cout << "\ntime: solve " << fmt(d.solve_seconds) << " s, field " << fmt(d.field_seconds) << " s\n";
   }
   // Where the connection turns by π/N or more, a tool that pairs directions itself sees other indices.
@@ -180,7 +187,8 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, FieldDesigner& desig
     std::cerr << "trivcon: warning" << (name.empty() ? "" : " for " + name) << ": " << large.size()
               << " edges turn by pi/N or more; a tool that matches directions itself (Directional, QuadWild, MIQ) will read " << consumer
               << " singular vertices from this field, " << extra
-              << " of them differing from the prescription (report: large_turns); give it --matching-out, or refine the mesh there\n";
+              << " of them differing from the prescription (report: large_turns, field_exact); give it --matching-out, or refine the mesh "
+                 "there (--split-large-turns)\n";
   }
   if (!ok)
     std::cerr << "trivcon: verification failed" << (name.empty() ? "" : " for " + name) << ": residual " << residual
@@ -228,6 +236,7 @@ void run_solve(const SolveOptions& o) {
               << fmt(pt.setup) << " s)\n"
               << features_summary;
   // Singularities found for the user: from the smoothest field (--auto), or from another field's indices.
+  std::optional<Field> auto_field;  // --auto's smoothest field: the final field takes its rotation from it
   if (o.auto_place) {
     AutoOptions ao;
     ao.N = prescription.N;
@@ -236,10 +245,12 @@ void run_solve(const SolveOptions& o) {
     if (!o.align.empty()) ao.align_curvature = true, ao.curvature_t = *alignment_strength(o.align);  // checked by CLI11
     const AutoResult r = auto_singularities(designer, ao);
     prescription.vertex = r.vertex;
+    auto_field = r.field;
     const AutoTimings& s = r.seconds;
     extra["auto"] = {
         {"found", r.found.size()},
         {"coincident_removed", r.coincident_removed},
+        {"boundary_moved", r.boundary_moved},
         {"cancelled_pairs", r.pairs.size()},
         {"used", r.vertex.size()},
         {"cancel_distance", o.auto_cancel},
@@ -318,6 +329,15 @@ void run_solve(const SolveOptions& o) {
       std::cerr << "trivcon: warning: --split-large-turns stopped after " << kMaxSplitRounds << " rounds of splitting and "
                 << 3 * kMaxSplitRounds << " of lowering weights with edges still turning by pi/N or more (see large_turns in the report)\n";
     if (refined_designer) {
+      if (auto_field) {  // the guide on the refined faces: each child lies in its parent's plane
+        Field guide{auto_field->N, Eigen::VectorXd(refined.parent_face.size())};
+        for (size_t f = 0; f < refined.parent_face.size(); ++f) {
+          const int parent = refined.parent_face[f];
+          guide.angle(f) = refined_designer->geometry().angle_in_face(
+              static_cast<int>(f), designer.geometry().direction_in_face(parent, auto_field->angle(parent)));
+        }
+        auto_field = guide;
+      }
       refined_mesh = std::move(current_mesh);
       prescription = p;
     }
@@ -327,7 +347,7 @@ void run_solve(const SolveOptions& o) {
 
   bool ok = true;
   if (batch.empty()) {
-    ok = solve_one(o, out_mesh, out_designer, prescription, roots, "", read_seconds, extra, sharp);
+    ok = solve_one(o, out_mesh, out_designer, prescription, roots, "", read_seconds, extra, sharp, auto_field ? &*auto_field : nullptr);
   } else {
     for (BatchItem& item : batch) {  // check every item before writing anything
       item.prescription.fixed = prescription.fixed;

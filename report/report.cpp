@@ -100,6 +100,8 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
                        {"verify", d.verify_seconds},
                        {"write", run.write_seconds}};
   report["verified"] = run.verified;
+  // Whether a reader of the per-face field (closest matching) sees exactly the prescription (Design::field_exact).
+  report["field_exact"] = d.field_exact;
   return report;
 }
 

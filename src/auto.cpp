@@ -18,6 +18,7 @@
 #include "detail/substitution.h"
 #include "detail/supernodal.h"
 #include "detail/timing.h"
+#include "trivcon/constraints.h"
 #include "trivcon/curvature.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
@@ -458,6 +459,12 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
   const FieldIndices indices = field_indices(t, g, cycles, r.field);
   for (int v = 0; v < t.num_vertices; ++v)
     if (indices.vertex[v] != 0) r.found[v] = indices.vertex[v];
+  // Turning of whole 2π/N steps at boundary vertices beside fixed faces goes to an interior neighbour, where
+  // the exact solve can place it (trivcon/constraints.h).
+  for (auto [v, n] : boundary_turns_moved_inside(t, g, o.fixed, r.field)) {
+    r.boundary_moved += std::abs(n);
+    if ((r.found[v] += n) == 0) r.found.erase(v);
+  }
   r.seconds.indices = seconds_since(t0);
   const std::map<int, int> merged = merge_coincident_singularities(V, t, r.found);
   r.coincident_removed = static_cast<int>(r.found.size() - merged.size());
@@ -482,6 +489,33 @@ AutoResult auto_singularities(const MatrixX3d& V, const MatrixX3i& F, const Auto
   const Geometry g = compute_geometry(V, t);
   const Cycles cycles = compute_cycles(t);
   return auto_singularities(V, t, g, cycles, options);
+}
+
+std::vector<std::pair<int, double>> roots_toward(const FieldDesigner& designer, const Field& field, const Field& guide,
+                                                 const std::vector<std::pair<int, double>>& roots, const std::map<int, double>& fixed) {
+  const Topology& t = designer.topology();
+  const Geometry& g = designer.geometry();
+  if (field.angle.size() != t.num_faces || guide.angle.size() != t.num_faces)
+    throw Error("roots_toward: the field and the guide need one angle per face (" + std::to_string(t.num_faces) + ")");
+  if (field.N != guide.N) throw Error("roots_toward: the field has N = " + std::to_string(field.N) + ", the guide N = " + std::to_string(guide.N));
+  std::vector<char> decided(t.components.size(), 0);
+  for (auto [f, angle] : roots)
+    if (f >= 0 && f < t.num_faces) decided[t.face_component[f]] = 1;
+  for (const auto& entry : fixed)
+    if (entry.first >= 0 && entry.first < t.num_faces) decided[t.face_component[entry.first]] = 1;
+  std::vector<std::complex<double>> sum(t.components.size(), 0.0);
+  for (int f = 0; f < t.num_faces; ++f) {
+    const int c = t.face_component[f];
+    if (decided[c]) continue;
+    sum[c] += g.face_area(f) * std::polar(1.0, field.N * (guide.angle(f) - field.angle(f)));
+  }
+  std::vector<std::pair<int, double>> out = roots;
+  for (size_t c = 0; c < t.components.size(); ++c) {
+    if (decided[c] || std::abs(sum[c]) <= 1e-300) continue;
+    const int f = t.components[c].first_face;
+    out.emplace_back(f, wrap_angle(field.angle(f) + std::arg(sum[c]) / field.N));
+  }
+  return out;
 }
 
 }  // namespace trivcon

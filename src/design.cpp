@@ -87,6 +87,9 @@ const ConnectionSolver& FieldDesigner::solver() const {
 }
 
 Design FieldDesigner::design(const IndexPrescription& prescription, const std::vector<std::pair<int, double>>& roots) const {
+  // Fixed boundary directions that need other singularities than those given: refused before the solve
+  // (the connection would be exact, the per-face field would read singularities nobody placed).
+  check_aligned_index_sums(topology_, geometry_, prescription);
   Design d;
   auto t0 = Clock::now();
   d.connection = solver().solve(prescription);
@@ -114,6 +117,8 @@ Design FieldDesigner::design(const IndexPrescription& prescription, const std::v
     auto it = prescription.vertex.find(v);
     if (d.indices.vertex[v] != (it == prescription.vertex.end() ? 0 : it->second)) d.index_mismatch_vertices.push_back(v);
   }
+  d.field_exact = d.index_mismatch_vertices.empty() && d.indices.generator == d.connection.generator_index &&
+                  d.indices.loop == d.connection.loop_index;
   // A turn of exactly ±π/N is ambiguous for the field (both give the same N-direction), hence the margin.
   const double half_period = kPi / prescription.N - 1e-9;
   auto large = [&](int e) { return std::abs(d.connection.x(e)) >= half_period; };

@@ -189,5 +189,43 @@ TEST(CliAuto, UsageErrors) {
   EXPECT_NE(r.err.find("missing.txt"), std::string::npos) << r.err;
 }
 
+
+// A boundary alignment that needs interior singularities and gets none is an error naming the sum; with
+// --auto the same mesh solves, and says that its per-face field is exact.
+TEST(CliAuto, AlignedDiskWithoutSingularitiesIsAnErrorAndAutoFixesIt) {
+  const std::string mesh = mesh_file(make_disk(30, 120), "disk.obj"), report = temp_file("report.json");
+  const auto bad = run_cli("solve " + mesh + " -N 4 --align-boundary");
+  EXPECT_EQ(bad.status, 1) << bad.err;
+  EXPECT_NE(bad.err.find("need interior singularities summing to 1 (Gauss-Bonnet with the boundary's turning, Euler characteristic 1), "
+                         "but the prescription's sum to 0"),
+            std::string::npos)
+      << bad.err;
+  EXPECT_NE(bad.err.find("--auto"), std::string::npos) << bad.err;
+  const auto good = run_cli("solve " + mesh + " -N 4 --align-boundary --auto --report " + report);
+  ASSERT_EQ(good.status, 0) << good.err;
+  EXPECT_NE(good.out.find("field exact: yes"), std::string::npos) << good.out;
+  const nlohmann::json j = read_json(report);
+  EXPECT_TRUE(j["field_exact"].get<bool>());
+  EXPECT_TRUE(j["verified"].get<bool>());
+}
+
+// Verified but not exact for a reader: two +1 crosses on a coarse icosphere turn by more than π/4 across the
+// edges around them, so the per-face field reads other indices there. The program says so plainly.
+TEST(CliAuto, AVerifiedFieldThatReadsOtherSingularitiesSaysItIsNotExact) {
+  const std::string mesh = mesh_file(make_icosphere(1), "ico.obj"), report = temp_file("report.json");
+  const auto r = run_cli("solve " + mesh + " -N 4 --sing 0:1 --sing 3:1 --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("field exact: NO"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("--split-large-turns"), std::string::npos) << r.err;
+  const nlohmann::json j = read_json(report);
+  EXPECT_TRUE(j["verified"].get<bool>());
+  EXPECT_FALSE(j["field_exact"].get<bool>());
+  EXPECT_FALSE(j["indices"]["field_mismatches"].empty());
+  // Refined until no edge turns that much, it is exact.
+  const auto s = run_cli("solve " + mesh + " -N 4 --sing 0:1 --sing 3:1 --split-large-turns --report " + report);
+  ASSERT_EQ(s.status, 0) << s.err;
+  EXPECT_TRUE(read_json(report)["field_exact"].get<bool>()) << s.out;
+}
+
 }  // namespace
 }  // namespace trivcon

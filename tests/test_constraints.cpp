@@ -277,7 +277,14 @@ TEST(Constraints, SparsePathsTakeTheSmallestTurnEitherWay) {
   std::uniform_real_distribution<double> angle(-kPi, kPi);
   IndexPrescription p;
   p.N = 4;
-  for (int f = 0; f < m.F.rows(); ++f) p.fixed[f] = angle(random);
+  // Every face but those on the boundary: fixed directions all along the boundary would decide the
+  // interior singularities' sum (check_aligned_index_sums), which random directions would not meet.
+  for (int f = 0; f < m.F.rows(); ++f) {
+    bool on_boundary = false;
+    for (int k = 0; k < 3; ++k) on_boundary |= d.topology().is_boundary_edge(d.topology().face_edges(f, k));
+    const double a = angle(random);
+    if (!on_boundary) p.fixed[f] = a;
+  }
   ASSERT_GT(p.fixed.size(), 300u);
   d.set_fixed_faces(keys(p.fixed));
   const Design r = d.design(p);
@@ -312,4 +319,95 @@ TEST(Constraints, FixedFacesBehindZeroWeightsAreStillJoined) {
     EXPECT_FALSE(p.path.edges.empty());
   }
   EXPECT_TRUE(std::all_of(group.begin(), group.end(), [&](int g) { return g == group[0]; }));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Boundary alignment decides the loop indices, and with them the sum of the vertex indices.
+
+std::vector<int> fixed_face_list(const std::map<int, double>& fixed) {
+  std::vector<int> faces;
+  for (const auto& entry : fixed) faces.push_back(entry.first);
+  return faces;
+}
+
+// The case: a boundary-aligned disk needs interior singularities summing to 1; with none, the
+// connection would be exact but turn by 2π/4 across some edges, and the field would read four +1/4.
+TEST(AlignedIndexSums, ADiskAlignedWithoutSingularitiesIsRefusedNamingTheSum) {
+  const Mesh m = make_disk(30, 120);
+  FieldDesigner designer(m.V, m.F);
+  IndexPrescription p;
+  p.N = 4;
+  p.fixed = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
+  designer.set_fixed_faces(fixed_face_list(p.fixed));
+  const std::vector<AlignedLoop> loops = aligned_loop_indices(designer.topology(), designer.geometry(), p.fixed, 4);
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_EQ(loops[0].index, 0);  // the field turns with the circle: no turning left for the virtual vertex
+  EXPECT_EQ(loops[0].ambiguous, 0);
+  const std::string message = test::error_of([&] { designer.design(p); });
+  EXPECT_EQ(message,
+            "component 0 (containing face 0): its fixed boundary directions (boundary alignment) need interior singularities summing to 1 "
+            "(Gauss-Bonnet with the boundary's turning, Euler characteristic 1), but the prescription's sum to 0; place singularities "
+            "summing to 1 (e.g. 4 of +1/4), or let trivcon place them (--auto; Python singularities=\"auto\"; the editor's auto button)");
+  // Four +1/4 at quarter turns of ring 15 (make_disk: ring k starts at vertex 1 + segments·k(k−1)/2, with
+  // k·segments vertices): accepted, and the per-face field reads exactly them.
+  const int first = 1 + 120 * 15 * 14 / 2;
+  for (int k = 0; k < 4; ++k) p.vertex[first + k * 15 * 120 / 4] = 1;
+  const Design d = designer.design(p);
+  EXPECT_TRUE(design_verified(d));
+  EXPECT_EQ(d.large_turn_edges, 0);
+  EXPECT_TRUE(d.field_exact);
+  // A loop index that Gauss-Bonnet allows but the alignment does not (a constant field's): refused too.
+  IndexPrescription wrong;
+  wrong.N = 4;
+  wrong.fixed = p.fixed;
+  wrong.loop[0] = 4;
+  EXPECT_EQ(test::error_of([&] { designer.design(wrong); }),
+            "boundary loop 0 is given index 1, but the fixed directions along it (boundary alignment) turn with index 0: the field would "
+            "turn by 2pi/N or more across edges to reach them; give it 0 or leave it out");
+}
+
+// Where the boundary's own turning needs no interior singularity, nothing is refused: a flat annulus and a
+// square with two square holes (every corner 90°: a cross turns with it), each exact with none.
+TEST(AlignedIndexSums, AnnulusAndHoledSquareNeedNone) {
+  for (const Mesh& m : {make_annulus(4, 40), make_holed_grid(12, 2)}) {
+    FieldDesigner designer(m.V, m.F);
+    IndexPrescription p;
+    p.N = 4;
+    p.fixed = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
+    designer.set_fixed_faces(fixed_face_list(p.fixed));
+    const std::vector<AlignedLoop> loops = aligned_loop_indices(designer.topology(), designer.geometry(), p.fixed, 4);
+    ASSERT_EQ(loops.size(), designer.topology().boundary_loops.size());
+    // The circles' tangent field turns with them (0, 0); on the squares the aligned cross is constant, a
+    // constant field's loop indices (+1 outside, −1 per hole). Either way nothing is left for the inside.
+    int sum = 0;
+    for (const AlignedLoop& a : loops) {
+      sum += a.index;
+      EXPECT_EQ(a.ambiguous, 0);
+    }
+    EXPECT_EQ(4 * designer.topology().euler_characteristic() - sum, 0);
+    if (loops.size() == 3) {
+      EXPECT_EQ(loops[0].index + loops[1].index + loops[2].index, -4);
+    }
+    if (loops.size() == 2) {
+      EXPECT_EQ(loops[0].index, 0);
+      EXPECT_EQ(loops[1].index, 0);
+    }
+    const Design d = designer.design(p);
+    EXPECT_TRUE(design_verified(d));
+    EXPECT_TRUE(d.field_exact);
+    EXPECT_EQ(d.large_turn_edges, 0);
+  }
+}
+
+// Loops not decided (a boundary face left free) decide nothing: the old behaviour, no error.
+TEST(AlignedIndexSums, APartlyFixedBoundaryDecidesNothing) {
+  const Mesh m = make_disk(10, 12);
+  FieldDesigner designer(m.V, m.F);
+  IndexPrescription p;
+  p.N = 4;
+  p.fixed = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
+  p.fixed.erase(p.fixed.begin());
+  designer.set_fixed_faces(fixed_face_list(p.fixed));
+  EXPECT_TRUE(aligned_loop_indices(designer.topology(), designer.geometry(), p.fixed, 4).empty());
+  EXPECT_EQ(test::error_of([&] { designer.design(p); }), "<no error>");
 }

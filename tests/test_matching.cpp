@@ -290,13 +290,13 @@ TEST(Matching, SplitLargeTurnsLetsAnyMatchingReadThePrescription) {
 }
 
 TEST(Matching, SplitLargeTurnsKeepsFixedDirections) {
-  // A coarse disk with the boundary aligned, a face fixed, and a large index at its centre: the refined mesh
-  // is aligned and fixed too.
+  // A coarse disk with the boundary aligned, a face fixed, and a large index at its centre (+1, what the
+  // aligned boundary needs): the refined mesh is aligned and fixed too.
   const Mesh m = make_disk(6, 6);
   const std::string dir = test::temp_dir("matching_split_fixed");
   const std::string mesh = save(dir, "disk", m), field = dir + "/f.txt", refined = dir + "/refined.ply";
   const test::CommandResult r =
-      run_cli("solve " + q(mesh) + " -N 4 --sing 0:-1 --align-boundary --fix 40:1,0,0 --split-large-turns -q --field-out " + q(field) +
+      run_cli("solve " + q(mesh) + " -N 4 --sing 0:1 --align-boundary --fix 40:1,0,0 --split-large-turns -q --field-out " + q(field) +
               " --mesh-out " + q(refined));
   ASSERT_EQ(r.status, 0) << r.err;
   const MeshData out = read_mesh(refined);
@@ -304,7 +304,7 @@ TEST(Matching, SplitLargeTurnsKeepsFixedDirections) {
   // Face 40 keeps the --fix direction (1, 0, 0) modulo a quarter turn.
   const double a = std::atan2(dirs(40, 1), dirs(40, 0));
   EXPECT_LE(std::abs(std::remainder(a, kPi / 2)), 1e-9);
-  std::map<int, int> want = {{0, -4}};
+  std::map<int, int> want = {{0, 4}};
   EXPECT_EQ(independent_indices(out.V, out.F, dirs, 4, nullptr), want);
 }
 

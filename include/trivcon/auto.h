@@ -59,7 +59,10 @@
 // guided by the smoothness alone; a component without any curvature (flat) keeps its smoothest field.
 //
 // Singularities: the indices of that field at interior vertices (field_indices); being read from a
-// field they satisfy Gauss–Bonnet per closed component. Boundary vertices never carry one.
+// field they satisfy Gauss–Bonnet per closed component. Boundary vertices never carry one: where the field
+// beside fixed boundary faces turns by whole 2π/N steps more around a boundary vertex than the fixed
+// directions need, that turning is moved to an interior neighbour (boundary_turns_moved_inside), so that
+// the singularities sum to what the fixed boundary needs (check_aligned_index_sums).
 //
 // Coincident vertices (joined by edges of length exactly 0, as in meshes with duplicated vertices): the
 // corner angles of a face with a zero-length edge are a convention (trivcon/geometry.h: π/2 at both ends),
@@ -108,6 +111,8 @@ struct AutoResult {
   Field field;                             // the smoothest field, angle = arg(u_f)/N in [0, 2π/N)
   std::map<int, int> found;                // its singularities: vertex → n (index n/N)
   int coincident_removed = 0;              // singularities of `found` that summing over coincident vertices removed
+  int boundary_moved = 0;                  // 1/N steps of turning at boundary vertices beside fixed faces, moved into `found` at
+                                           // an interior neighbour (boundary_turns_moved_inside, trivcon/constraints.h)
   std::map<int, int> vertex;               // after that and cancellation: the singularities to prescribe
   std::vector<std::pair<int, int>> pairs;  // cancelled pairs (vertex of index +n, vertex of −n), in order
   double energy = 0;                       // E(u) / ‖u‖²_M over the whole mesh (the Rayleigh quotient without fixed faces)
@@ -134,5 +139,16 @@ std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topo
 
 // Mean length of the mesh's edges (the unit of AutoOptions::cancel_distance).
 double mean_edge_length(const MatrixX3d& V, const Topology& topology);
+
+// The roots (face, angle) that turn each component's field to agree best with `guide`, an N-field (e.g. the
+// smoothest field AutoResult::field that --auto read its singularities from: the trivial connection then
+// keeps its orientation, instead of starting each component at angle 0). `field` is the field
+// FieldDesigner::design made with `roots`; for each component with neither a root in `roots` nor a fixed face
+// (whose directions decide its rotation), the rotation θ maximizing Σ_f A_f cos(N(α_f − β_f − θ)), i.e.
+// θ = arg(Σ_f A_f e^{iN(α_f − β_f)}) / N (A_f the face areas), is returned as a root at the component's
+// first face with angle β + θ (nothing where that sum vanishes). `roots` are returned first, unchanged.
+std::vector<std::pair<int, double>> roots_toward(const FieldDesigner& designer, const Field& field, const Field& guide,
+                                                 const std::vector<std::pair<int, double>>& roots = {},
+                                                 const std::map<int, double>& fixed = {});
 
 }  // namespace trivcon

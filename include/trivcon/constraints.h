@@ -17,7 +17,9 @@
 #include <vector>
 
 #include "trivcon/cycles.h"
+#include "trivcon/field.h"
 #include "trivcon/geometry.h"
+#include "trivcon/indices.h"
 #include "trivcon/topology.h"
 
 namespace trivcon {
@@ -54,5 +56,39 @@ struct FixedConflict {
   double turn;  // radians, in (−π/N, π/N]
 };
 std::vector<FixedConflict> fixed_conflicts(const Topology& topology, const Geometry& geometry, const std::map<int, double>& fixed, int N);
+
+// Fixed directions along a whole boundary loop decide its index, and with it (Gauss–Bonnet) the sum of the
+// component's vertex indices. A loop is decided when every face with an edge on it is fixed (as
+// boundary_alignment fixes them). Its index is the one a field holding the fixed directions reads around it
+// (field_indices, trivcon/field.h): the fan of faces around each loop vertex is walked from one boundary
+// face to the other, the direction carried by parallel transport between fixed faces and, at each fixed
+// face, turned onto its direction by the closest of the N choices. A turn of exactly π/N (e.g. a 45° corner
+// of the boundary with N = 4) can be read either way: `ambiguous` counts them (each may move the index by
+// ±1/N).
+struct AlignedLoop {
+  int loop = 0;
+  int index = 0;      // n (index n/N)
+  int ambiguous = 0;  // turns within 1e-6 rad of π/N
+};
+std::vector<AlignedLoop> aligned_loop_indices(const Topology& topology, const Geometry& geometry, const std::map<int, double>& fixed,
+                                              int N);
+
+// A field that holds such fixed directions may still turn by whole 2π/N steps more than that reading around a
+// boundary vertex (a singularity on the boundary, which trivcon does not place: boundary vertices carry no
+// index). For each boundary vertex whose fan's end faces are fixed (and whose reading is not ambiguous), the
+// difference between `field`'s own reading of the fan (each jump by the closest matching, as field_indices)
+// and the reading above, in units of 2π/N, is moved to the smallest interior vertex joined to it by an edge:
+// returns those vertices and the indices (n, index n/N) to add to their singularities so that the vertex
+// indices sum to what check_aligned_index_sums asks (auto_singularities does this).
+std::map<int, int> boundary_turns_moved_inside(const Topology& topology, const Geometry& geometry, const std::map<int, double>& fixed,
+                                               const Field& field);
+
+// Throws trivcon::Error when fixed directions decide every boundary loop of a component (above) and the
+// prescription's vertex indices there do not sum to N χ − Σ loop indices (up to the ambiguous turns), or a
+// prescribed loop index differs from the one its fixed directions decide. The connection would otherwise
+// be exact but turn by 2π/N or more across some edges to reach the fixed directions, and the per-face field
+// would read singularities nobody placed (e.g. a boundary-aligned disk with none: four of +1/4). The message
+// names the component, the sum needed and the sum given, and suggests placing them (or --auto).
+void check_aligned_index_sums(const Topology& topology, const Geometry& geometry, const IndexPrescription& prescription);
 
 }  // namespace trivcon

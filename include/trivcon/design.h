@@ -46,6 +46,11 @@ struct Design {
   int large_turn_edges = 0;                  // edges with |x_e| ≥ π/N (where a field cannot show the index)
   // Mismatches at vertices none of whose edges turns by π/N or more (less 1e-9): these would be real errors.
   std::vector<int> unexplained_mismatch_vertices;
+  // What a consumer of the per-face field sees: true when the field, read on its own with the closest
+  // matching across every edge (field_indices), shows exactly the connection's indices at every vertex,
+  // generator and boundary loop. False where the connection turns by π/N or more across some edge (then
+  // split_large_turns, trivcon/refine.h, refines the mesh until it is true); design_verified does not look at it.
+  bool field_exact = true;
   double max_fixed_error = 0;            // largest |field − fixed direction| modulo 2π/N over fixed faces
   std::vector<FixedConflict> conflicts;  // adjacent fixed faces the field must turn sharply between
   double solve_seconds = 0, field_seconds = 0, verify_seconds = 0;
