@@ -184,8 +184,11 @@ def test_fixed_directions(disk):
 
 def test_align_boundary(disk):
     V, F, d = disk
-    r = d.solve(N=4, align_boundary=True)
-    check_result(V, d, r, {})
+    # The aligned boundary turns once around the flat disk: the interior singularities must sum to 1.
+    with pytest.raises(ValueError, match=r"need interior singularities summing to 1 .*, but the prescription's sum to 0; .*auto"):
+        d.solve(N=4, align_boundary=True)
+    r = d.solve(N=4, singularities={0: 1}, align_boundary=True)
+    check_result(V, d, r, {0: 1})
     ref = reference.Mesh(V, d.F)
     boundary_faces = set(int(f) for f in ref.edge_faces[~ref.interior].max(axis=1))
     assert set(r.fixed) == boundary_faces
