@@ -35,6 +35,9 @@ struct EditOptions {
 // Ports tried after the default one when it is taken (an explicit --port is used as given).
 constexpr int kDefaultPortTries = 20;
 
+// How long a stop (SIGINT, SIGTERM) waits for requests still being computed before the process exits anyway.
+constexpr std::chrono::milliseconds kStopGrace{1500};
+
 // SIGINT and SIGTERM write a byte into this pipe (all a signal handler may safely do); a thread reading it
 // stops the server. A handler rather than a blocked mask because the libraries' worker threads (OpenBLAS
 // starts its own when it is loaded) exist before any code here runs, and a signal may land on any of them.
@@ -97,6 +100,15 @@ void run_edit(const EditOptions& o) {
     // A stop before the server's loop runs would be lost (Ctrl+C during the set-up): wait for it.
     while (!editor.running() && !run_returned) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     editor.stop();
+    // Open connections end at once, but run() waits for the requests being computed (a solve, a re-factoring
+    // of a big mesh), which cannot be interrupted. The server writes no file, so nothing is lost by not
+    // waiting for them: past a short grace the process exits.
+    const auto give_up = std::chrono::steady_clock::now() + kStopGrace;
+    while (!run_returned && std::chrono::steady_clock::now() < give_up) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (!run_returned) {
+      std::cout << "trivcon edit: stopped (a request still being computed was abandoned)" << std::endl;
+      _exit(0);
+    }
   });
   const bool ok = editor.run();
   run_returned = true;

@@ -1,15 +1,28 @@
 #include "editor_server.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <algorithm>
-#include <charconv>
-#include <numeric>
 #include <atomic>
+#include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <deque>
+#include <functional>
+#include <limits>
 #include <mutex>
+#include <numeric>
+#include <thread>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
@@ -39,10 +52,20 @@ using Clock = std::chrono::steady_clock;
 // The CLI's range for -N (apps/prescription_options.cpp).
 constexpr int kMaxN = 1000;
 
-// cpp-httplib compresses (brotli, gzip) any body whose type is exactly "application/json" or text/… when the
-// client accepts it: seconds for a big mesh or field, on a connection that is almost always this machine's
-// loopback. A type with its charset parameter is not on its list, so answers go out as they are.
+// cpp-httplib compresses (brotli, gzip) any answer whose type is application/json or text/… when the client
+// accepts it, brotli at its slowest level: a field export of 400k faces took over a minute that way, on a
+// connection that is almost always this machine's loopback. No answer is compressed: the server drops the
+// request's Accept-Encoding before routing (Http::process_and_close_socket).
 constexpr const char* kJson = "application/json; charset=utf-8";
+
+// What a chunked body may add to its payload on the wire (chunk-size lines): reads past the body limit by
+// more than this fail, so that no line of a body, however long, is held in memory.
+constexpr size_t kChunkFraming = 1u << 20;
+// A request line and its headers: at most this many bytes (cpp-httplib reads a line of any length into
+// memory before it checks its length).
+constexpr size_t kMaxHeaderBytes = 64u << 10;
+// Requests served on one keep-alive connection before it is closed.
+constexpr int kKeepAliveRequests = 100;
 
 // A request the client got wrong: its status and the message of the {"error": …} body.
 struct BadRequest {
@@ -72,9 +95,53 @@ std::string number_text(double v) {
   return buffer;
 }
 
+// Whether s[i…] starts a well-formed UTF-8 sequence of 2 to 4 bytes; its length, or 0.
+size_t utf8_length(const std::string& s, size_t i) {
+  const auto byte = [&](size_t k) { return i + k < s.size() ? static_cast<unsigned char>(s[i + k]) : 0u; };
+  const unsigned c = byte(0);
+  const auto cont = [&](size_t k, unsigned lo = 0x80, unsigned hi = 0xBF) { return byte(k) >= lo && byte(k) <= hi; };
+  if (c >= 0xC2 && c <= 0xDF) return cont(1) ? 2 : 0;
+  if (c >= 0xE0 && c <= 0xEF) {
+    const bool second = c == 0xE0 ? cont(1, 0xA0) : c == 0xED ? cont(1, 0x80, 0x9F) : cont(1);
+    return second && cont(2) ? 3 : 0;
+  }
+  if (c >= 0xF0 && c <= 0xF4) {
+    const bool second = c == 0xF0 ? cont(1, 0x90) : c == 0xF4 ? cont(1, 0x80, 0x8F) : cont(1);
+    return second && cont(2) && cont(3) ? 4 : 0;
+  }
+  return 0;
+}
+
+// Text as a message shows it: control characters (NUL too, which would end the text for anything reading it
+// as a C string) as \u00XX, bytes that are not UTF-8 as \xHH, everything else as it is.
+std::string printable(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (size_t i = 0; i < s.size();) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    char escape[8];
+    if (c < 0x20 || c == 0x7F) {
+      std::snprintf(escape, sizeof escape, "\\u%04x", c);
+      out += escape;
+      ++i;
+    } else if (c < 0x80) {
+      out += static_cast<char>(c);
+      ++i;
+    } else if (const size_t n = utf8_length(s, i)) {
+      out.append(s, i, n);
+      i += n;
+    } else {
+      std::snprintf(escape, sizeof escape, "\\x%02X", c);
+      out += escape;
+      ++i;
+    }
+  }
+  return out;
+}
+
 void set_error(httplib::Response& res, int status, const std::string& message) {
   res.status = status;
-  res.set_content(json{{"error", message}}.dump() + "\n", kJson);
+  res.set_content(json{{"error", printable(message)}}.dump() + "\n", kJson);
 }
 
 // Little-endian container of the binary responses: a uint32 byte count, that many bytes of JSON padded
@@ -122,6 +189,17 @@ std::string index_text(const json& j, const std::string& where) {
   throw BadRequest{400, where + ": the index must be a string such as \"1/4\" or an integer, got " + brief(j)};
 }
 
+// The command line's "ID:INDEX" for one entry. A NUL in the index is refused here, in the command line's
+// words: passed on, it would cut the parser's message (an exception's text is a C string) right there.
+std::string index_spec(const std::string& id, const std::string& index, const char* option) {
+  if (index.find('\0') != std::string::npos) {
+    const std::string spec = printable(id + ":" + index);
+    throw BadRequest{400, std::string(option) + " " + spec + ": malformed index '" + printable(index) +
+                              "' (expected an integer or a fraction p/q, q > 0)"};
+  }
+  return id + ":" + index;
+}
+
 const json& pairs_field(const json& body, const char* key) {
   static const json empty = json::array();
   const auto it = body.find(key);
@@ -137,6 +215,259 @@ const json& pair_at(const json& list, size_t i, const char* key) {
   return e;
 }
 
+// --- connections ---------------------------------------------------------------------------------
+//
+// cpp-httplib 0.11.4 (Debian bookworm) serves each connection on one of a fixed pool of threads (8 here),
+// and its socket stream gives each read a timeout but a request none: eight connections sending a header
+// byte every half second held every thread, and every other request waited. It also reads a header or
+// chunk-size line of any length into memory, and after stop() a worker writing a big answer to a client that
+// does not read waits out its write timeout. So the server serves connections itself (Http below overrides
+// process_and_close_socket): a thread per connection up to max_connections (WorkerPool), and this stream,
+// which gives the request line and headers, then the body, a deadline and a byte budget, and fails any wait
+// as soon as the server stops.
+
+struct Limits {
+  Clock::duration header, body, idle, keep_alive;
+  size_t body_bytes;
+};
+
+Clock::duration seconds(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
+
+class Connection : public httplib::Stream {
+ public:
+  Connection(int sock, const Limits& limits, const std::atomic<bool>& stopping) : sock_(sock), limits_(limits), stopping_(stopping) {}
+
+  // Waits for the first byte of the next request, at most the keep-alive time.
+  bool wait_for_request() {
+    if (begin_ < end_) return true;
+    deadline_ = Clock::now() + limits_.keep_alive;
+    return wait(POLLIN, limits_.keep_alive);
+  }
+  // The request line and headers: header seconds, kMaxHeaderBytes.
+  void start_request() {
+    phase_ = Phase::Headers;
+    deadline_ = Clock::now() + limits_.header;
+    budget_ = kMaxHeaderBytes;
+    close_ = timed_out_ = overflowed_ = false;
+  }
+  // The body: body seconds, the body limit plus what chunked framing may add.
+  void start_body() {
+    phase_ = Phase::Body;
+    deadline_ = Clock::now() + limits_.body;
+    budget_ = limits_.body_bytes + kChunkFraming;
+  }
+  // The answer: no deadline (a big download on a slow link takes what it takes), but each write must make
+  // progress within the idle time.
+  void start_answer() {
+    phase_ = Phase::Answer;
+    deadline_ = Clock::time_point::max();
+  }
+
+  // The connection is closed after this answer (its body was not read, or not to its end).
+  void close_after_answer() { close_ = true; }
+  bool closing() const { return close_; }
+  bool timed_out() const { return timed_out_; }
+  bool overflowed() const { return overflowed_; }
+  bool in_headers() const { return phase_ == Phase::Headers; }
+
+  // After an answer that left a body unread: closing at once, with unread bytes, would make the kernel reset
+  // the connection, and the client could lose the answer before reading it. So reading stops, and what the
+  // client still sends is read and dropped for a second at most (1 MiB at most), then the socket is closed.
+  void linger() {
+    ::shutdown(sock_, SHUT_WR);
+    deadline_ = Clock::now() + std::chrono::seconds(1);
+    char drop[16384];
+    for (size_t dropped = 0; dropped < (1u << 20) && wait(POLLIN, std::chrono::seconds(1));) {
+      const ssize_t n = ::recv(sock_, drop, sizeof drop, MSG_DONTWAIT);
+      if (n <= 0 && !(n < 0 && (errno == EAGAIN || errno == EINTR))) break;
+      if (n > 0) dropped += static_cast<size_t>(n);
+    }
+  }
+
+  bool is_readable() const override { return begin_ < end_; }
+  bool is_writable() const override {
+    pollfd p{sock_, POLLOUT, 0};
+    return ::poll(&p, 1, 0) > 0 && (p.revents & POLLOUT);
+  }
+
+  ssize_t read(char* ptr, size_t size) override {
+    if (begin_ == end_) {
+      if (budget_ == 0) {  // more than this part of a request may hold
+        overflowed_ = true;
+        return -1;
+      }
+      begin_ = end_ = 0;
+      for (;;) {
+        if (!wait(POLLIN, limits_.idle)) return -1;
+        const ssize_t n = ::recv(sock_, buffer_, std::min(sizeof buffer_, budget_), MSG_DONTWAIT);
+        if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
+        if (n <= 0) return n;
+        end_ = static_cast<size_t>(n);
+        budget_ -= end_;
+        break;
+      }
+    }
+    const size_t n = std::min(size, end_ - begin_);
+    std::memcpy(ptr, buffer_ + begin_, n);
+    begin_ += n;
+    return static_cast<ssize_t>(n);
+  }
+
+  ssize_t write(const char* ptr, size_t size) override {
+    for (;;) {
+      if (!wait(POLLOUT, limits_.idle)) return -1;
+      const ssize_t n = ::send(sock_, ptr, size, MSG_DONTWAIT | MSG_NOSIGNAL);
+      if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
+      return n;
+    }
+  }
+
+  void get_remote_ip_and_port(std::string& ip, int& port) const override { address(::getpeername, ip, port); }
+  void get_local_ip_and_port(std::string& ip, int& port) const override { address(::getsockname, ip, port); }
+  socket_t socket() const override { return sock_; }
+
+ private:
+  enum class Phase { Headers, Body, Answer };
+
+  // Waits until the socket is ready for `events`: false when the phase's deadline passes, nothing happens for
+  // `idle`, or the server stops (checked every 50 ms).
+  bool wait(short events, Clock::duration idle) {
+    const Clock::time_point give_up = std::min(deadline_, Clock::now() + idle);
+    for (;;) {
+      if (stopping_) return false;
+      const Clock::time_point now = Clock::now();
+      if (now >= give_up) {
+        timed_out_ = true;
+        return false;
+      }
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(give_up - now).count();
+      pollfd p{sock_, events, 0};
+      const int r = ::poll(&p, 1, static_cast<int>(std::clamp<long long>(left, 1, 50)));
+      if (r < 0 && errno != EINTR) return false;
+      if (r > 0) return true;  // ready, or an error or hang-up that the read or write reports
+    }
+  }
+
+  template <class Get>
+  void address(Get get, std::string& ip, int& port) const {
+    sockaddr_storage a{};
+    socklen_t len = sizeof a;
+    ip.clear();
+    port = 0;
+    if (get(sock_, reinterpret_cast<sockaddr*>(&a), &len) != 0) return;
+    char text[INET6_ADDRSTRLEN] = "";
+    if (a.ss_family == AF_INET) {
+      const auto* v4 = reinterpret_cast<const sockaddr_in*>(&a);
+      ::inet_ntop(AF_INET, &v4->sin_addr, text, sizeof text);
+      port = ntohs(v4->sin_port);
+    } else if (a.ss_family == AF_INET6) {
+      const auto* v6 = reinterpret_cast<const sockaddr_in6*>(&a);
+      ::inet_ntop(AF_INET6, &v6->sin6_addr, text, sizeof text);
+      port = ntohs(v6->sin6_port);
+    }
+    ip = text;
+  }
+
+  int sock_;
+  const Limits& limits_;
+  const std::atomic<bool>& stopping_;
+  Phase phase_ = Phase::Headers;
+  Clock::time_point deadline_ = Clock::time_point::max();
+  size_t budget_ = kMaxHeaderBytes;
+  bool close_ = false, timed_out_ = false, overflowed_ = false;
+  char buffer_[16384];
+  size_t begin_ = 0, end_ = 0;
+};
+
+// The connection the calling thread serves (the handlers mark it to be closed after their answer).
+thread_local Connection* current_connection = nullptr;
+
+// A thread per connection, started when a connection arrives and no thread is free, up to `max`; more
+// connections wait for one. shutdown() lets the queued ones run (they end at once: the server is stopping)
+// and joins every thread.
+class WorkerPool : public httplib::TaskQueue {
+ public:
+  explicit WorkerPool(size_t max) : max_(std::max<size_t>(1, max)) {}
+
+  void enqueue(std::function<void()> fn) override {
+    std::lock_guard lock(mutex_);
+    jobs_.push_back(std::move(fn));
+    if (jobs_.size() > idle_ && threads_.size() < max_) threads_.emplace_back([this] { work(); });
+    wake_.notify_one();
+  }
+
+  void shutdown() override {
+    {
+      std::lock_guard lock(mutex_);
+      shutdown_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& t : threads_) t.join();
+  }
+
+ private:
+  void work() {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      ++idle_;
+      wake_.wait(lock, [&] { return shutdown_ || !jobs_.empty(); });
+      --idle_;
+      if (jobs_.empty()) return;
+      std::function<void()> job = std::move(jobs_.front());
+      jobs_.pop_front();
+      lock.unlock();
+      job();
+      lock.lock();
+    }
+  }
+
+  const size_t max_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> jobs_;
+  std::vector<std::thread> threads_;
+  size_t idle_ = 0;
+  bool shutdown_ = false;
+};
+
+class Http : public httplib::Server {
+ public:
+  Http(const Limits& limits, const std::atomic<bool>& stopping, int max_connections) : limits_(limits), stopping_(stopping) {
+    new_task_queue = [max_connections] { return new WorkerPool(static_cast<size_t>(max_connections)); };
+  }
+
+ private:
+  // Serves one connection: up to kKeepAliveRequests requests, each with the deadlines of Connection.
+  bool process_and_close_socket(socket_t sock) override {
+    // Answers go out in two writes (headers, body); without TCP_NODELAY the second waits for the ACK of the
+    // first, which the client delays (about 40 ms on Linux) on every request of a keep-alive connection.
+    const int one = 1;
+    ::setsockopt(sock, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    Connection c(sock, limits_, stopping_);
+    current_connection = &c;
+    bool ok = true;
+    for (int left = kKeepAliveRequests; left > 0 && !stopping_; --left) {
+      if (!c.wait_for_request()) break;
+      c.start_request();
+      bool closed = false;
+      ok = process_request(c, left == 1, closed, [&c](httplib::Request& req) {
+        // The headers are in: the body's deadline starts. No answer is compressed (see kJson).
+        c.start_body();
+        req.headers.erase("Accept-Encoding");
+      });
+      if (!ok || closed || c.closing()) break;
+    }
+    if (c.closing() && !stopping_) c.linger();
+    current_connection = nullptr;
+    ::shutdown(sock, SHUT_RDWR);
+    ::close(sock);
+    return ok;
+  }
+
+  const Limits& limits_;
+  const std::atomic<bool>& stopping_;
+};
+
 }  // namespace
 
 struct EditorServer::Impl {
@@ -145,8 +476,11 @@ struct EditorServer::Impl {
   std::string token;
   std::unique_ptr<FieldDesigner> designer;
   int port = -1;
-  httplib::Server http;
   std::atomic<bool> bound{false};
+  std::atomic<bool> stopping{false};
+  const Limits limits{seconds(options.header_seconds), seconds(options.body_seconds), seconds(options.io_idle_seconds),
+                      seconds(options.keep_alive_seconds), options.max_body_bytes};
+  Http http{limits, stopping, options.max_connections};
 
   // design() is const and shares the designer; set_fixed_faces refactors and takes it exclusively.
   // `fixed_faces` is what the designer is set up for (nullopt after a set-up that failed: set it up again).
@@ -180,7 +514,8 @@ struct EditorServer::Impl {
     // Not validated here: a session may well start unbalanced (a bare sphere); the page says what is missing.
     designer->set_fixed_faces(initial.fixed_faces);  // factor now: the first edit should be as fast as the others
     fixed_faces = initial.fixed_faces;
-    state = {{"revision", 0}, {"request", normalized(initial)}, {"solved", nullptr}, {"error", nullptr}, {"last_solved", nullptr}};
+    state = {{"revision", 0},    {"initial", normalized(initial)}, {"request", normalized(initial)}, {"solved", nullptr},
+             {"error", nullptr}, {"last_solved", nullptr}};
   }
 
   int num_generators() const { return static_cast<int>(designer->cycles().generators.size()); }
@@ -217,6 +552,15 @@ struct EditorServer::Impl {
         return true;
       });
     } catch (const json::parse_error& e) {
+      // Its text quotes the last bytes read, which may be anything (set_error shows them escaped).
+      throw BadRequest{400, std::string("the request body is not valid JSON: ") + e.what()};
+    } catch (const json::out_of_range& e) {
+      // 406: a number beyond a double's range, such as 1e400 ("number overflow parsing '1e400'").
+      std::string what = e.what();
+      const size_t text = what.find("] ");
+      if (text != std::string::npos) what = what.substr(text + 2);
+      throw BadRequest{400, "the request body has a number out of range: " + what + " (numbers must be within ±1.8e308)"};
+    } catch (const json::exception& e) {
       throw BadRequest{400, std::string("the request body is not valid JSON: ") + e.what()};
     }
     if (!body.is_object()) throw BadRequest{400, "the request body must be a JSON object, got " + std::string(body.type_name())};
@@ -231,28 +575,35 @@ struct EditorServer::Impl {
     }
     try {
       // [[id, index], …] lists, each entry passed on as the CLI's "ID:INDEX" (so errors are the CLI's).
-      auto index_pairs = [&](const char* key, const char* what, void (*add)(const std::string&, IndexPrescription&)) {
+      auto index_pairs = [&](const char* key, const char* what, const char* option, void (*add)(const std::string&, IndexPrescription&)) {
         const json& list = pairs_field(body, key);
         for (size_t i = 0; i < list.size(); ++i) {
           const json& e = pair_at(list, i, key);
           const std::string where = std::string(key) + "[" + std::to_string(i) + "]";
-          add(id_text(e[0], where, what) + ":" + index_text(e[1], where), p);
+          add(index_spec(id_text(e[0], where, what), index_text(e[1], where), option), p);
         }
       };
-      index_pairs("singularities", "vertex", add_vertex_index);
-      index_pairs("generators", "generator", add_generator_index);
-      index_pairs("boundary", "boundary loop", add_loop_index);
+      index_pairs("singularities", "vertex", "--sing", add_vertex_index);
+      index_pairs("generators", "generator", "--generator", add_generator_index);
+      index_pairs("boundary", "boundary loop", "--boundary", add_loop_index);
       const json& fixed = pairs_field(body, "fixed");
       for (size_t i = 0; i < fixed.size(); ++i) {
         const json& e = pair_at(fixed, i, "fixed");
         const std::string where = "fixed[" + std::to_string(i) + "]";
         std::string spec = id_text(e[0], where, "face") + ":";
-        if (e[1].is_array() && e[1].size() == 3 && e[1][0].is_number() && e[1][1].is_number() && e[1][2].is_number())
-          spec += number_text(e[1][0].get<double>()) + "," + number_text(e[1][1].get<double>()) + "," + number_text(e[1][2].get<double>());
-        else if (e[1].is_object() && e[1].size() == 1 && e[1].contains("angle") && e[1]["angle"].is_number())
+        if (e[1].is_array() && e[1].size() == 3 && e[1][0].is_number() && e[1][1].is_number() && e[1][2].is_number()) {
+          double d[3] = {e[1][0].get<double>(), e[1][1].get<double>(), e[1][2].get<double>()};
+          // Only the direction counts: one near the ends of a double's range is scaled first, so that projecting
+          // it to the face neither overflows (1e308: "perpendicular") nor underflows (1e-320: "zero").
+          const double largest = std::max({std::abs(d[0]), std::abs(d[1]), std::abs(d[2])});
+          if (largest > 1e100 || (largest > 0 && largest < 1e-100))
+            for (double& x : d) x /= largest;
+          spec += number_text(d[0]) + "," + number_text(d[1]) + "," + number_text(d[2]);
+        } else if (e[1].is_object() && e[1].size() == 1 && e[1].contains("angle") && e[1]["angle"].is_number()) {
           spec += "angle=" + number_text(e[1]["angle"].get<double>());
-        else
+        } else {
           throw BadRequest{400, where + ": expected a direction [x, y, z] or {\"angle\": A}, got " + brief(e[1])};
+        }
         add_fixed_direction(spec, designer->topology(), designer->geometry(), r.explicit_fixed);
       }
     } catch (const Error& e) {
@@ -355,11 +706,55 @@ struct EditorServer::Impl {
       for (int f = 0; f < nF; ++f)
         for (int k = 0; k < 3; ++k) F[3 * f + k] = static_cast<uint32_t>(mesh.F(f, k));
       const std::vector<int>& comp = designer->topology().vertex_component;
+      const GlyphOrder& glyphs = get_glyph_order();
       ojson j = mesh_header();
-      j["binary"] = {{"vertices", "float32[3 * vertices]"}, {"faces", "uint32[3 * faces]"}, {"vertex_component", "int32[vertices]"}};
-      mesh_binary = binary_container(j.dump(), {{V.data(), V.size() * 4}, {F.data(), F.size() * 4}, {comp.data(), comp.size() * 4}});
+      j["binary"] = {{"vertices", "float32[3 * vertices]"},
+                     {"faces", "uint32[3 * faces]"},
+                     {"vertex_component", "int32[vertices]"},
+                     {"glyph_order", "uint32[faces]"},
+                     {"glyph_times", "float32[faces]"}};
+      mesh_binary = binary_container(j.dump(), {{V.data(), V.size() * 4},
+                                                {F.data(), F.size() * 4},
+                                                {comp.data(), comp.size() * 4},
+                                                {glyphs.faces.data(), glyphs.faces.size() * 4},
+                                                {glyphs.times.data(), glyphs.times.size() * 4}});
     });
     return mesh_binary;
+  }
+
+  // The order in which the page draws the field's glyphs, so that every prefix of it covers the surface in
+  // proportion to area: face f's first glyph comes at "time" u_f / area_f (u_f in (0, 1), a hash of f), its
+  // j-th at (u_f + j) / area_f (the page places those, web/src/glyphs.js), and a prefix up to time t holds
+  // about area_f · t glyphs of every face. Faces are sorted by their first time (zero-area faces last); the
+  // page receives the order and the times with the mesh, and asks for the directions of the first faces.
+  struct GlyphOrder {
+    std::vector<uint32_t> faces;
+    std::vector<float> times;  // in the order of `faces`
+  };
+  std::once_flag glyph_order_once;
+  GlyphOrder glyph_order;
+
+  const GlyphOrder& get_glyph_order() {
+    std::call_once(glyph_order_once, [&] {
+      const Eigen::VectorXd& area = designer->geometry().face_area;
+      const uint32_t nF = static_cast<uint32_t>(area.size());
+      std::vector<double> time(nF);
+      for (uint32_t f = 0; f < nF; ++f) {
+        uint64_t z = (f + 1) * 0x9E3779B97F4A7C15ull;  // splitmix64's finalizer: a well-spread u_f per face
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        z ^= z >> 31;
+        const double u = (static_cast<double>(z >> 11) + 0.5) / 9007199254740992.0;
+        time[f] = area(f) > 0 ? u / area(f) : std::numeric_limits<double>::infinity();
+      }
+      glyph_order.faces.resize(nF);
+      std::iota(glyph_order.faces.begin(), glyph_order.faces.end(), 0u);
+      std::sort(glyph_order.faces.begin(), glyph_order.faces.end(),
+                [&](uint32_t a, uint32_t b) { return time[a] < time[b] || (time[a] == time[b] && a < b); });
+      glyph_order.times.resize(nF);
+      for (uint32_t i = 0; i < nF; ++i) glyph_order.times[i] = static_cast<float>(time[glyph_order.faces[i]]);
+    });
+    return glyph_order;
   }
 
   // What `trivcon info --json --cycles` says, and the session's symmetry.
@@ -372,8 +767,6 @@ struct EditorServer::Impl {
   }
 
   // --- HTTP ---
-
-  std::string cookie_name() const { return "trivcon_token_" + std::to_string(port); }
 
   bool host_allowed(const std::string& host_header) const {
     const std::string p = ":" + std::to_string(port);
@@ -392,24 +785,157 @@ struct EditorServer::Impl {
     return false;
   }
 
-  std::string cookie_token(const httplib::Request& req) const {
-    const std::string cookies = req.get_header_value("Cookie");
-    const std::string key = cookie_name() + "=";
-    for (size_t pos = 0; pos < cookies.size();) {
-      while (pos < cookies.size() && (cookies[pos] == ' ' || cookies[pos] == ';')) ++pos;
-      const size_t end = std::min(cookies.find(';', pos), cookies.size());
-      if (cookies.compare(pos, key.size(), key) == 0) return cookies.substr(pos + key.size(), end - pos - key.size());
-      pos = end;
-    }
-    return "";
-  }
-
+  // The token comes in a header only. Not in a cookie: cookies are not limited to a port, so every other web
+  // service of this host would receive it. Not in the query: URLs stay in histories and logs.
   bool token_ok(const httplib::Request& req) const {
     if (same_secret(req.get_header_value("X-Trivcon-Token"), token)) return true;
     const std::string auth = req.get_header_value("Authorization");
-    if (auth.rfind("token ", 0) == 0 && same_secret(auth.substr(6), token)) return true;
-    if (same_secret(cookie_token(req), token)) return true;
-    return req.has_param("token") && same_secret(req.get_param_value("token"), token);
+    return auth.rfind("token ", 0) == 0 && same_secret(auth.substr(6), token);
+  }
+
+  static bool same_text_ignoring_case(const std::string& a, const std::string& b) {
+    return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+             return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+           });
+  }
+
+  // Why an API call from a page is refused, or "": the page that sent it must be this editor's own (its
+  // Origin, or lacking one its Referer, is the served origin). Another port of this host is another origin
+  // but the same site, so SameSite rules do not separate the two. A call with neither header (a script, curl)
+  // is not a page's and is judged by its token alone.
+  std::string origin_problem(const httplib::Request& req) const {
+    const std::string served = "http://" + req.get_header_value("Host");
+    if (req.has_header("Origin")) {
+      const std::string origin = req.get_header_value("Origin");
+      if (same_text_ignoring_case(origin, served)) return "";
+      return "refused: the request comes from another origin (Origin: " + brief_text(origin) + "); only the editor's own page (" + served +
+             ") may call its API";
+    }
+    if (req.has_header("Referer")) {
+      const std::string referer = req.get_header_value("Referer");
+      const bool same = referer.size() >= served.size() && same_text_ignoring_case(referer.substr(0, served.size()), served) &&
+                        (referer.size() == served.size() || std::strchr("/?#", referer[served.size()]));
+      if (same) return "";
+      // Its origin only: the rest of the address may hold anything.
+      const size_t scheme = referer.find("://");
+      const size_t path = referer.find_first_of("/?#", scheme == std::string::npos ? 0 : scheme + 3);
+      return "refused: the request comes from another origin (Referer: " + brief_text(referer.substr(0, path)) +
+             "); only the editor's own page (" + served + ") may call its API";
+    }
+    // A page may keep its Referer to itself, and a GET without CORS carries no Origin; what browsers send
+    // then still says whether the page was another origin's.
+    const std::string site = req.get_header_value("Sec-Fetch-Site");
+    if (site == "cross-site" || site == "same-site")
+      return "refused: the request comes from another origin (Sec-Fetch-Site: " + site + "); only the editor's own page (" + served +
+             ") may call its API";
+    return "";
+  }
+
+  static std::string brief_text(const std::string& s) { return s.size() > 200 ? s.substr(0, 200) + "…" : s; }
+
+  static bool is_json_type(const std::string& content_type) {
+    const std::string type = content_type.substr(0, content_type.find(';'));
+    const size_t a = type.find_first_not_of(" \t"), b = type.find_last_not_of(" \t");
+    return a != std::string::npos && same_text_ignoring_case(type.substr(a, b - a + 1), "application/json");
+  }
+
+  // A refusal before the body is read: the connection is closed after the answer (the body's bytes would
+  // otherwise be read as the next request).
+  static httplib::Server::HandlerResponse refuse(httplib::Response& res, int status, const std::string& message, bool body_unread) {
+    set_error(res, status, message);
+    if (body_unread && current_connection) {
+      current_connection->close_after_answer();
+      res.set_header("Connection", "close");
+    }
+    return httplib::Server::HandlerResponse::Handled;
+  }
+
+  // Everything checked before a request is routed (and before its body is read).
+  httplib::Server::HandlerResponse screen(const httplib::Request& req, httplib::Response& res) const {
+    const bool has_body = req.has_header("Content-Length") || req.has_header("Transfer-Encoding");
+    const std::string host = req.get_header_value("Host");
+    if (!host_allowed(host))
+      return refuse(res, 403,
+                    "refused: the Host header '" + host + "' is not the address this editor serves (" + options.host + ":" +
+                        std::to_string(port) + "); open the URL that trivcon edit printed",
+                    has_body);
+    const bool api = req.path.rfind("/api/", 0) == 0;
+    if (api) {
+      if (const std::string why = origin_problem(req); !why.empty()) return refuse(res, 403, why, has_body);
+      if (!token_ok(req))
+        return refuse(res, 403,
+                      "missing or wrong token: open the URL that trivcon edit printed (API calls send it as the X-Trivcon-Token header)",
+                      has_body);
+    }
+    const bool get = req.method == "GET" || req.method == "HEAD";
+    if (!get && req.method != "POST") return refuse(res, 405, "method " + req.method + " not allowed (GET and POST only)", has_body);
+    if (get) {
+      if (has_body && !(req.get_header_value("Content-Length") == "0" && !req.has_header("Transfer-Encoding")))
+        return refuse(res, 400, "a " + req.method + " request has no body", true);
+      return httplib::Server::HandlerResponse::Unhandled;
+    }
+    static const std::vector<std::string> posts = {"/api/solve", "/api/auto", "/api/export", "/api/streamlines"};
+    if (std::find(posts.begin(), posts.end(), req.path) == posts.end())
+      return refuse(res, 404, "no such endpoint (see README.md, Editor)", has_body);
+    // A form of any web page can POST text/plain, form data or multipart without asking; only a script of the
+    // editor's own origin can send application/json.
+    if (!is_json_type(req.get_header_value("Content-Type")))
+      return refuse(res, 403,
+                    "refused: a POST to the API must have Content-Type: application/json (got '" +
+                        brief_text(req.get_header_value("Content-Type")) + "')",
+                    has_body);
+    // The body's framing: one Content-Length of digits, or Transfer-Encoding: chunked alone, never compressed
+    // (its limit would count the compressed bytes).
+    const std::string encoding = req.get_header_value("Content-Encoding");
+    if (!encoding.empty() && !same_text_ignoring_case(encoding, "identity"))
+      return refuse(res, 415, "request bodies must not be compressed (Content-Encoding: " + brief_text(encoding) + ")", has_body);
+    const size_t lengths = req.get_header_value_count("Content-Length");
+    if (req.has_header("Transfer-Encoding")) {
+      if (req.get_header_value_count("Transfer-Encoding") != 1 ||
+          !same_text_ignoring_case(req.get_header_value("Transfer-Encoding"), "chunked"))
+        return refuse(res, 501,
+                      "Transfer-Encoding '" + brief_text(req.get_header_value("Transfer-Encoding")) + "' is not supported (chunked only)",
+                      true);
+      if (lengths) return refuse(res, 400, "a request has Content-Length or Transfer-Encoding, not both", true);
+      return httplib::Server::HandlerResponse::Unhandled;  // counted while it is read (read_body)
+    }
+    if (lengths == 0) return refuse(res, 411, "a POST needs a Content-Length (or Transfer-Encoding: chunked)", true);
+    if (lengths > 1) return refuse(res, 400, "a request has one Content-Length, not " + std::to_string(lengths), true);
+    const std::string length = req.get_header_value("Content-Length");
+    unsigned long long n = 0;
+    const auto [end, ec] = std::from_chars(length.data(), length.data() + length.size(), n);
+    if (length.empty() || ec != std::errc() || end != length.data() + length.size())
+      return refuse(res, 400, "malformed Content-Length '" + brief_text(length) + "'", true);
+    if (n > options.max_body_bytes) return refuse(res, 413, too_large_message(), true);
+    return httplib::Server::HandlerResponse::Unhandled;
+  }
+
+  std::string too_large_message() const {
+    return "request body too large (the limit is " + std::to_string(options.max_body_bytes) + " bytes)";
+  }
+
+  // Reads a POST's body, counting it against the limit as it arrives: cpp-httplib limits a Content-Length
+  // but reads a chunked body whole, however long.
+  std::string read_body(const httplib::ContentReader& reader) const {
+    std::string body;
+    bool too_large = false;
+    const bool ok = reader([&](const char* data, size_t n) {
+      if (n > options.max_body_bytes - body.size()) {
+        too_large = true;
+        return false;
+      }
+      body.append(data, n);
+      return true;
+    });
+    if (ok) return body;
+    Connection* c = current_connection;
+    if (c) c->close_after_answer();  // the rest of the body is still to come
+    if (too_large) throw BadRequest{413, too_large_message()};
+    if (stopping) throw BadRequest{503, "the editor is stopping"};
+    if (c && c->timed_out())
+      throw BadRequest{408, "the request body did not arrive in time (" + number_text(options.body_seconds) + " s in all, " +
+                                number_text(options.io_idle_seconds) + " s without a byte)"};
+    throw BadRequest{400, "the request body could not be read (cut short, or malformed chunked encoding)"};
   }
 
   // Wraps an API handler: answers a BadRequest, or a library error it did not expect, with {"error": …}.
@@ -417,16 +943,34 @@ struct EditorServer::Impl {
   httplib::Server::Handler api(Handler handler) {
     return [this, handler](const httplib::Request& req, httplib::Response& res) {
       res.set_header("Cache-Control", "no-store");
-      try {
-        handler(req, res);
-      } catch (const BadRequest& e) {
-        set_error(res, e.status, e.message);
-      } catch (const Error& e) {
-        set_error(res, 400, e.what());
-      } catch (const std::bad_alloc&) {
-        set_error(res, 507, "out of memory");
-      }
+      answer_errors(res, [&] { handler(req, res); });
     };
+  }
+
+  // The same for a POST: its body is read first (read_body), then given to the handler.
+  template <class Handler>
+  httplib::Server::HandlerWithContentReader api_post(Handler handler) {
+    return [this, handler](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader) {
+      res.set_header("Cache-Control", "no-store");
+      answer_errors(res, [&] {
+        const std::string body = read_body(reader);
+        handler(req, body, res);
+      });
+      if (current_connection && current_connection->closing()) res.set_header("Connection", "close");
+    };
+  }
+
+  template <class Work>
+  static void answer_errors(httplib::Response& res, Work work) {
+    try {
+      work();
+    } catch (const BadRequest& e) {
+      set_error(res, e.status, e.message);
+    } catch (const Error& e) {
+      set_error(res, 400, e.what());
+    } catch (const std::bad_alloc&) {
+      set_error(res, 507, "out of memory");
+    }
   }
 
   static bool wants_binary(const httplib::Request& req) {
@@ -458,46 +1002,39 @@ struct EditorServer::Impl {
 
   void routes() {
     http.set_payload_max_length(options.max_body_bytes);
+    http.set_keep_alive_timeout(static_cast<time_t>(std::ceil(options.keep_alive_seconds)));
+    http.set_keep_alive_max_count(kKeepAliveRequests);
+    http.set_tcp_nodelay(true);
     http.set_default_headers({{"X-Content-Type-Options", "nosniff"}, {"Referrer-Policy", "no-referrer"}, {"X-Frame-Options", "DENY"}});
-    http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-      const std::string host = req.get_header_value("Host");
-      if (!host_allowed(host)) {
-        set_error(res, 403,
-                  "refused: the Host header '" + host + "' is not the address this editor serves (" + options.host + ":" +
-                      std::to_string(port) + "); open the URL that trivcon edit printed");
-        return httplib::Server::HandlerResponse::Handled;
-      }
-      if (req.path.rfind("/api/", 0) == 0 && !token_ok(req)) {
-        set_error(res, 403,
-                  "missing or wrong token: open the URL that trivcon edit printed (API calls send it as the X-Trivcon-Token header)");
-        return httplib::Server::HandlerResponse::Handled;
-      }
-      return httplib::Server::HandlerResponse::Unhandled;
+    http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) { return screen(req, res); });
+    // Every answer, errors too: from here on the connection writes, with no deadline but the idle time.
+    http.set_post_routing_handler([](const httplib::Request&, httplib::Response&) {
+      if (current_connection) current_connection->start_answer();
     });
-    http.set_error_handler([](const httplib::Request&, httplib::Response& res) {
+    http.set_error_handler([this](const httplib::Request&, httplib::Response& res) {
+      Connection* c = current_connection;
+      if (c && c->in_headers()) {  // a request that could not be read: what follows on the connection is not a request
+        c->close_after_answer();
+        res.set_header("Connection", "close");
+      }
       if (!res.body.empty()) return;
-      if (res.status == 404)
+      if (c && c->in_headers() && c->overflowed())
+        set_error(res, 431, "the request line and headers are too large (more than " + std::to_string(kMaxHeaderBytes) + " bytes)");
+      else if (c && c->in_headers() && c->timed_out())
+        set_error(res, 408, "the request's headers did not arrive in time (" + number_text(options.header_seconds) + " s)");
+      else if (res.status == 404)
         set_error(res, 404, "no such endpoint (see README.md, Editor)");
       else if (res.status == 413)
-        set_error(res, 413, "request body too large");
+        set_error(res, 413, too_large_message());
       else
         set_error(res, res.status, "request refused (HTTP " + std::to_string(res.status) + ")");
     });
     http.set_exception_handler(
         [](const httplib::Request&, httplib::Response& res, std::exception_ptr) { set_error(res, 500, "internal error"); });
 
-    http.Get("/", [this](const httplib::Request& req, httplib::Response& res) {
-      const bool by_query = req.has_param("token") && same_secret(req.get_param_value("token"), token);
-      if (!by_query && !same_secret(cookie_token(req), token)) {
-        res.status = 403;
-        res.set_content(
-            "<!doctype html><title>trivcon edit</title><p>This page needs its token: open the URL that <code>trivcon edit</code> "
-            "printed.</p>",
-            "text/html; charset=utf-8");
-        return;
-      }
-      // The cookie lets a reload without ?token= work; SameSite=Strict keeps other sites' pages from sending it.
-      if (by_query) res.set_header("Set-Cookie", cookie_name() + "=" + token + "; Path=/; HttpOnly; SameSite=Strict");
+    // The page holds no secret (the API does): it is served without the token, which it takes from its
+    // address (?token=, then removed from the address bar) or, on a reload, from the tab's sessionStorage.
+    http.Get("/", [this](const httplib::Request&, httplib::Response& res) {
       serve_asset("/index.html", res);
       res.set_header("Cache-Control", "no-store");
       res.set_header(
@@ -518,25 +1055,31 @@ struct EditorServer::Impl {
                std::lock_guard lock(state_mutex);
                res.set_content(state.dump() + "\n", kJson);
              }));
-    http.Post("/api/solve", api([this](const httplib::Request& req, httplib::Response& res) {
+    http.Post("/api/solve", api_post([this](const httplib::Request& req, const std::string& body, httplib::Response& res) {
                 check_format(req, {"json", "binary", "oct16"});
                 const auto t0 = Clock::now();
-                const Request r = parse_request(req.body);
+                const Request r = parse_request(body);
                 const Solved s = solve(r);
                 const Geometry& g = designer->geometry();
                 const int nF = static_cast<int>(s.field.angle.size());
                 if (req.has_param("format") && req.get_param_value("format") == "oct16") {
                   // What the page uses: a third of the bytes of Float32 x y z (the transfer is most of an edit's time
-                  // on a big mesh), at an angular error below 1e-4 radians, plenty for drawing; and with stride/count
-                  // only the faces it draws (faces i · stride mod F, i < count).
+                  // on a big mesh), at an angular error below 1e-4 radians, plenty for drawing; and with count only
+                  // the faces it draws: the first `count` faces of the mesh's glyph order (order=area), or the faces
+                  // i · stride mod F, i < count.
+                  const bool by_area = req.has_param("order");
+                  if (by_area && req.get_param_value("order") != "area")
+                    throw BadRequest{400, "unknown order '" + req.get_param_value("order") + "' (known: area)"};
+                  if (by_area && req.has_param("stride")) throw BadRequest{400, "order=area and stride exclude each other"};
                   const long long stride = int_param(req, "stride", 1, 1, nF > 0 ? nF : 1);
                   const long long count = int_param(req, "count", nF, 0, nF);
                   if (std::gcd(stride, static_cast<long long>(nF > 0 ? nF : 1)) != 1)
                     throw BadRequest{400, "stride " + std::to_string(stride) + " shares a factor with the face count " +
                                               std::to_string(nF) + ": the faces i * stride mod F would repeat"};
+                  const std::vector<uint32_t>* order = by_area ? &get_glyph_order().faces : nullptr;
                   std::vector<int16_t> d(2 * static_cast<size_t>(count));
                   for (long long i = 0; i < count; ++i) {
-                    const int f = static_cast<int>((i * stride) % nF);
+                    const int f = order ? static_cast<int>((*order)[i]) : static_cast<int>((i * stride) % nF);
                     const Eigen::Vector3d dir = g.direction_in_face(f, s.field.angle(f));  // only the faces asked for
                     const double x = dir.x(), y = dir.y(), z = dir.z();
                     const double l1 = std::abs(x) + std::abs(y) + std::abs(z);
@@ -570,8 +1113,8 @@ struct EditorServer::Impl {
                   res.set_content(out.dump() + "\n", kJson);
                 }
               }));
-    http.Post("/api/auto", api([this](const httplib::Request& req, httplib::Response& res) {
-                const Request r = parse_request(req.body);
+    http.Post("/api/auto", api_post([this](const httplib::Request&, const std::string& body, httplib::Response& res) {
+                const Request r = parse_request(body);
                 AutoOptions ao;
                 ao.N = r.prescription.N;
                 ao.cancel_distance = r.auto_cancel;
@@ -584,10 +1127,10 @@ struct EditorServer::Impl {
                 ojson out = {{"N", ao.N}, {"singularities", sing}, {"found", a.found.size()}, {"cancelled_pairs", a.pairs.size()}};
                 res.set_content(out.dump() + "\n", kJson);
               }));
-    http.Post("/api/export", api([this](const httplib::Request& req, httplib::Response& res) {
+    http.Post("/api/export", api_post([this](const httplib::Request& req, const std::string& body, httplib::Response& res) {
                 const std::string format = req.has_param("format") ? req.get_param_value("format") : "txt";
                 check_format(req, {"txt", "rawfield", "ply", "sing"});
-                const Request r = parse_request(req.body);
+                const Request r = parse_request(body);
                 std::ostringstream out;
                 std::string name;
                 if (format == "sing") {
@@ -600,14 +1143,15 @@ struct EditorServer::Impl {
                   name = "singularities.txt";
                 } else {
                   const Solved s = solve(r);
+                  if (stopping) throw BadRequest{503, "the editor is stopping"};  // no file to write for nobody
                   name = "field." + format;
                   write_field_to(out, name, mesh.V, mesh.F, designer->geometry(), s.field);
                 }
                 res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
                 res.set_content(out.str(), format == "ply" ? "application/octet-stream" : "text/plain; charset=utf-8");
               }));
-    http.Post("/api/streamlines", api([this](const httplib::Request& req, httplib::Response& res) {
-                const Request r = parse_request(req.body);
+    http.Post("/api/streamlines", api_post([this](const httplib::Request&, const std::string& body, httplib::Response& res) {
+                const Request r = parse_request(body);
                 const Solved s = solve(r);
                 std::vector<std::pair<int, int>> sing(s.prescription.vertex.begin(), s.prescription.vertex.end());
                 const std::vector<Streamline> lines = trace_streamlines(mesh.V, designer->topology(), designer->geometry(), s.field, sing);
@@ -655,6 +1199,7 @@ int EditorServer::bind(int port) {
 
 bool EditorServer::run() { return impl_->http.listen_after_bind(); }
 void EditorServer::stop() {
+  impl_->stopping = true;  // first: the connections' waits end at once
   if (impl_->bound) impl_->http.stop();
 }
 bool EditorServer::running() const { return impl_->http.is_running(); }

@@ -5,10 +5,14 @@
 // by solve_report (report/report.h). The endpoints are documented in README.md ("Editor").
 //
 // Safety (README.md, "Editor"): it listens on the host it is given (the CLI's default is 127.0.0.1);
-// every API call needs the per-run token (header X-Trivcon-Token, cookie, or ?token=); a request whose
-// Host header is not the served address is refused (DNS rebinding); bodies are size-limited; no endpoint
-// reads or writes a file. Requests are served on several threads: designs share the designer (design() is
-// const) and a change of the fixed faces (set_fixed_faces refactors) takes it exclusively.
+// every API call needs the per-run token in a header (X-Trivcon-Token, or Authorization: token T; never a
+// cookie, which every other port of the same host would be sent too); an API call from another origin
+// (Origin or Referer not the served one) or a POST that is not application/json is refused (a page on
+// another local port could send it); a request whose Host header is not the served address is refused
+// (DNS rebinding); bodies are size-limited (chunked ones too), every request has deadlines for its headers
+// and body, and no answer is compressed; no endpoint reads or writes a file. Requests are served on
+// several threads: designs share the designer (design() is const) and a change of the fixed faces
+// (set_fixed_faces refactors) takes it exclusively.
 #pragma once
 #include <cstddef>
 #include <memory>
@@ -28,6 +32,15 @@ struct EditorOptions {
   double read_seconds = 0;            // reading the mesh (the report's seconds.read)
   IndexPrescription initial;          // the session the page starts with (-N, -s, --sing, --fix angles)
   bool align_boundary = false;        // --align-boundary at start
+  // Connections: each is served on a thread of its own, up to max_connections at once (more wait for one to
+  // end). A request's line and headers must arrive within header_seconds of its first byte, its body within
+  // body_seconds after them; a read or write that makes no progress for io_idle_seconds fails; an idle
+  // keep-alive connection is closed after keep_alive_seconds.
+  int max_connections = 128;
+  double header_seconds = 10;
+  double body_seconds = 60;
+  double io_idle_seconds = 10;
+  double keep_alive_seconds = 5;
 };
 
 class EditorServer {
@@ -43,7 +56,8 @@ class EditorServer {
   // Binds host:port (port 0: a free one); returns the port. Throws trivcon::Error when it cannot (then another
   // port may be tried).
   int bind(int port);
-  // Serves until stop() (from any thread). Returns false if the listening socket failed.
+  // Serves until stop() (from any thread). Returns false if the listening socket failed. After stop(), open
+  // connections end at their next read or write, and run() returns once the requests being computed finish.
   bool run();
   void stop();
   bool running() const;

@@ -1,7 +1,21 @@
 // Tests of the editor's server (server/editor_server.h): every endpoint, its answers checked for what
 // they mean (unit tangent directions, the prescription honoured, the CLI's error texts), and the refusals
-// (token, Host, body size, malformed requests), against a server started in-process on a free port.
+// (token, origin, content type, Host, body size, malformed requests), against a server started in-process
+// on a free port; connections that cpp-httplib's client does not make (slow, chunked past the limit, a
+// client that does not read) over raw sockets; and `trivcon edit` itself stopped by SIGTERM mid-export.
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <Eigen/Geometry>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -81,6 +95,66 @@ std::pair<json, std::string> unpack(const std::string& body) {
   return {json::parse(body.substr(4, n)), body.substr(4 + n)};
 }
 
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// A raw TCP connection to 127.0.0.1:port, for what cpp-httplib's client does not do: send slowly, send a
+// chunked body past the limit, leave an answer unread.
+struct Raw {
+  int fd = -1;
+  explicit Raw(int port, int receive_buffer = 0) {
+    fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (receive_buffer > 0) ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof receive_buffer);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<uint16_t>(port));
+    ::inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    EXPECT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  }
+  ~Raw() { ::close(fd); }
+  Raw(const Raw&) = delete;
+  Raw& operator=(const Raw&) = delete;
+  bool send_all(const std::string& s) const {
+    for (size_t done = 0; done < s.size();) {
+      const ssize_t n = ::send(fd, s.data() + done, s.size() - done, MSG_NOSIGNAL);
+      if (n <= 0) return false;
+      done += static_cast<size_t>(n);
+    }
+    return true;
+  }
+  // Whether something (an answer, or the end) arrives within `seconds`.
+  bool readable(double seconds) const {
+    pollfd p{fd, POLLIN, 0};
+    return ::poll(&p, 1, static_cast<int>(seconds * 1000)) > 0;
+  }
+  // What arrives until the server closes the connection, or `seconds` pass.
+  std::string read_until_closed(double seconds) const {
+    std::string out;
+    const auto t0 = Clock::now();
+    char buffer[65536];
+    while (seconds_since(t0) < seconds) {
+      if (!readable(0.1)) continue;
+      const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
+      if (n <= 0) break;
+      out.append(buffer, static_cast<size_t>(n));
+    }
+    return out;
+  }
+};
+
+// The status of a raw answer, and the "error" of its JSON body.
+int status_of(const std::string& answer) { return answer.rfind("HTTP/1.1 ", 0) == 0 ? std::atoi(answer.c_str() + 9) : -1; }
+std::string raw_error(const std::string& answer) {
+  const size_t body = answer.find("\r\n\r\n");
+  if (body == std::string::npos) return "";
+  const json j = json::parse(answer.substr(body + 4), nullptr, false);
+  return j.is_object() && j.contains("error") ? j["error"].get<std::string>() : "";
+}
+std::string raw_head(const std::string& method, const std::string& path, int port, const std::string& token) {
+  return method + " " + path + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\nX-Trivcon-Token: " + token +
+         "\r\nContent-Type: application/json\r\n";
+}
+
 class Server : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -120,7 +194,7 @@ TEST_F(Server, MeshBinaryMatchesJson) {
   ASSERT_EQ(res->status, 200);
   auto [header, payload] = unpack(res->body);
   const size_t nV = sphere().V.rows(), nF = sphere().F.rows();
-  ASSERT_EQ(payload.size(), nV * 12 + nF * 12 + nV * 4);
+  ASSERT_EQ(payload.size(), nV * 12 + nF * 12 + nV * 4 + nF * 8);
   EXPECT_EQ(header["faces"].get<size_t>(), nF);
   std::vector<float> V(3 * nV);
   std::vector<uint32_t> F(3 * nF);
@@ -303,6 +377,71 @@ TEST_F(Server, MalformedRequestsGet400AndTheServerKeepsServing) {
   EXPECT_EQ(error_of(r().client->Get("/api/nothing")), "no such endpoint (see README.md, Editor)");
 }
 
+// The glyph order: every face once, first times ascending, and format=oct16&order=area sends the
+// directions of the first faces of it.
+TEST_F(Server, TheGlyphOrderCoversEveryFaceAndSolvesFollowIt) {
+  auto res = r().client->Get("/api/mesh?format=binary");
+  ASSERT_TRUE(res);
+  auto [header, payload] = unpack(res->body);
+  const size_t nV = sphere().V.rows(), nF = sphere().F.rows();
+  EXPECT_EQ(header["binary"]["glyph_order"].get<std::string>(), "uint32[faces]");
+  std::vector<uint32_t> order(nF);
+  std::vector<float> times(nF);
+  std::memcpy(order.data(), payload.data() + 16 * nV + 12 * nF, 4 * nF);
+  std::memcpy(times.data(), payload.data() + 16 * nV + 16 * nF, 4 * nF);
+  EXPECT_EQ(std::set<uint32_t>(order.begin(), order.end()).size(), nF);
+  EXPECT_LT(*std::max_element(order.begin(), order.end()), nF);
+  EXPECT_TRUE(std::is_sorted(times.begin(), times.end()));
+  EXPECT_GT(times[0], 0.0f);
+  const json body = {{"N", 4}, {"singularities", eight_quarters(sphere())}};
+  auto all = r().post("/api/solve?format=oct16", body);
+  auto part = r().post("/api/solve?format=oct16&order=area&count=100", body);
+  ASSERT_TRUE(all && part);
+  ASSERT_EQ(part->status, 200) << part->body;
+  auto [all_header, all_payload] = unpack(all->body);
+  auto [part_header, part_payload] = unpack(part->body);
+  ASSERT_EQ(part_payload.size(), 400u);
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(part_payload.substr(4 * i, 4), all_payload.substr(4 * order[i], 4)) << i;
+  EXPECT_EQ(error_of(r().post("/api/solve?format=oct16&order=id", body)), "unknown order 'id' (known: area)");
+  EXPECT_EQ(error_of(r().post("/api/solve?format=oct16&order=area&stride=7", body)), "order=area and stride exclude each other");
+}
+
+// Numbers beyond a double, text that is not UTF-8, a NUL in an index: 400 with a message that says so (the
+// bytes shown escaped, nothing cut), never a 500.
+TEST_F(Server, OutOfRangeNumbersAndBadTextGet400WithTheirMessage) {
+  const std::string overflow =
+      "the request body has a number out of range: number overflow parsing '1e400' (numbers must be within ±1.8e308)";
+  const std::string sing = eight_quarters(sphere()).dump();
+  auto check = [&](const std::string& body, const std::string& message) {
+    auto res = r().post_text("/api/solve", body);
+    ASSERT_TRUE(res) << body;
+    EXPECT_EQ(res->status, 400) << body;
+    EXPECT_EQ(error_of(res), message) << body;
+  };
+  check("{\"N\": 1e400}", overflow);
+  check("{\"N\": 4, \"singularities\": " + sing + ", \"fixed\": [[0, [1e400, 0, 0]]]}", overflow);
+  check("{\"N\": 4, \"cancel\": -1e400}",
+        "the request body has a number out of range: number overflow parsing '-1e400' (numbers must be within ±1.8e308)");
+  check("{\"N\": 4, \"singularities\": [[3, \"1/4\xff\"]]}",
+        "the request body is not valid JSON: [json.exception.parse_error.101] parse error at line 1, column 36: syntax error while "
+        R"(parsing value - invalid string: ill-formed UTF-8 byte; last read: '"1/4\xFF')");
+  check("{\"N\": 4, \"singularities\": [[3, \"1/4\\u0000\"]]}",
+        R"(--sing 3:1/4\u0000: malformed index '1/4\u0000' (expected an integer or a fraction p/q, q > 0))");
+  check("{\"N\": 4, \"boundary\": [[0, \"\\u0000\"]]}",
+        R"(--boundary 0:\u0000: malformed index '\u0000' (expected an integer or a fraction p/q, q > 0))");
+  auto res = r().post("/api/solve?format=x%00y", json::object());
+  EXPECT_EQ(error_of(res), R"(unknown format 'x\u0000y' (known: json, binary, oct16))");
+  // Directions at the ends of a double's range are directions all the same.
+  const json unit =
+      json::parse(r().post_text("/api/solve", "{\"N\": 4, \"singularities\": " + sing + ", \"fixed\": [[0, [1, 1, 1]]]}")->body);
+  for (const std::string d : {"[1e308, 1e308, 1e308]", "[1e-320, 1e-320, 1e-320]"}) {
+    auto big = r().post_text("/api/solve", "{\"N\": 4, \"singularities\": " + sing + ", \"fixed\": [[0, " + d + "]]}");
+    ASSERT_TRUE(big);
+    ASSERT_EQ(big->status, 200) << d << ": " << big->body;
+    EXPECT_EQ(json::parse(big->body)["directions"], unit["directions"]) << d;
+  }
+}
+
 TEST_F(Server, EveryApiCallNeedsTheToken) {
   httplib::Client bare("127.0.0.1", r().port);
   for (const char* path : {"/api/mesh", "/api/state"}) {
@@ -318,26 +457,90 @@ TEST_F(Server, EveryApiCallNeedsTheToken) {
   EXPECT_EQ(bare.Get("/api/state", {{"X-Trivcon-Token", ""}})->status, 403);
   const std::string token = r().editor->token();
   EXPECT_EQ(token.size(), 32u);
-  EXPECT_EQ(bare.Get(("/api/state?token=" + token).c_str())->status, 200);
+  EXPECT_EQ(bare.Get("/api/state", {{"X-Trivcon-Token", token}})->status, 200);
   EXPECT_EQ(bare.Get("/api/state", {{"Authorization", "token " + token}})->status, 200);
-  EXPECT_EQ(bare.Get("/api/state", {{"Cookie", "other=1; trivcon_token_" + std::to_string(r().port) + "=" + token}})->status, 200);
-  EXPECT_EQ(bare.Get("/api/state", {{"Cookie", "trivcon_token_1=" + token}})->status, 403);  // another editor's cookie name
+  // Not in a cookie (every port of this host is sent it), not in the address (it stays in histories).
+  const std::string token_message =
+      "missing or wrong token: open the URL that trivcon edit printed (API calls send it as the X-Trivcon-Token header)";
+  EXPECT_EQ(error_of(bare.Get("/api/state", {{"Cookie", "trivcon_token_" + std::to_string(r().port) + "=" + token}})), token_message);
+  EXPECT_EQ(error_of(bare.Get("/api/state", {{"Cookie", "trivcon_token=" + token + "; token=" + token}})), token_message);
+  EXPECT_EQ(error_of(bare.Get(("/api/state?token=" + token).c_str())), token_message);
+  EXPECT_EQ(
+      bare.Post("/api/solve", {{"Cookie", "trivcon_token_" + std::to_string(r().port) + "=" + token}}, "{}", "application/json")->status,
+      403);
 }
 
-TEST_F(Server, ThePageNeedsTheTokenAndSetsTheCookie) {
+TEST_F(Server, ThePageIsServedWithoutTokenOrCookie) {
   httplib::Client bare("127.0.0.1", r().port);
-  EXPECT_EQ(bare.Get("/")->status, 403);
-  EXPECT_EQ(bare.Get("/?token=wrong")->status, 403);
-  auto res = bare.Get(("/?token=" + r().editor->token()).c_str());
-  ASSERT_TRUE(res);
-  EXPECT_EQ(res->status, 200);
-  EXPECT_TRUE(test::contains(res->body, "/app.js"));
-  EXPECT_TRUE(test::contains(res->get_header_value("Set-Cookie"), "trivcon_token_" + std::to_string(r().port) + "=" + r().editor->token()));
-  EXPECT_TRUE(test::contains(res->get_header_value("Set-Cookie"), "SameSite=Strict"));
+  const std::string token = r().editor->token();
+  for (const std::string& path : std::vector<std::string>{"/", "/?token=" + token, "/?token=wrong"}) {
+    auto res = bare.Get(path.c_str());
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 200) << path;
+    EXPECT_TRUE(test::contains(res->body, "/app.js"));
+    EXPECT_FALSE(test::contains(res->body, token));  // the page holds no secret: the API does
+    EXPECT_FALSE(res->has_header("Set-Cookie")) << path;
+    EXPECT_EQ(res->get_header_value("Referrer-Policy"), "no-referrer");
+  }
   auto js = bare.Get("/app.js");
   ASSERT_TRUE(js);
   EXPECT_EQ(js->status, 200);
   EXPECT_GT(js->body.size(), 1000u);  // three.js is in it: the page needs no network
+  // No answer of the API sets a cookie either.
+  for (const char* path : {"/api/mesh", "/api/state"}) EXPECT_FALSE(r().client->Get(path)->has_header("Set-Cookie")) << path;
+  EXPECT_FALSE(r().post("/api/solve", {{"N", 4}, {"singularities", eight_quarters(sphere())}})->has_header("Set-Cookie"));
+}
+
+// Another port of 127.0.0.1 is another origin but the same site: its pages' requests are refused by their
+// Origin (or Referer), and a form's text/plain POST by its type, before the token is even looked at.
+TEST_F(Server, RequestsFromAnotherOriginOrNotJsonAreRefused) {
+  const std::string served = "http://127.0.0.1:" + std::to_string(r().port);
+  const json body = {{"N", 4}, {"singularities", eight_quarters(sphere())}};
+  const int revision = json::parse(r().client->Get("/api/state")->body)["revision"].get<int>();
+  const std::string other = "http://127.0.0.1:18777";
+  const std::string from_other = "refused: the request comes from another origin (Origin: " + other + "); only the editor's own page (" +
+                                 served + ") may call its API";
+  auto post = [&](const httplib::Headers& h, const std::string& type) {
+    return r().client->Post("/api/solve", h, body.dump(), type.c_str());
+  };
+  auto res = post({{"Origin", other}}, "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 403);
+  EXPECT_EQ(error_of(res), from_other);
+  res = r().client->Get("/api/state", {{"Origin", other}});
+  EXPECT_EQ(res->status, 403);
+  EXPECT_EQ(error_of(res), from_other);
+  // The form of the report: text/plain from the other port, with or without the token.
+  httplib::Client bare("127.0.0.1", r().port);
+  res = bare.Post("/api/solve", {{"Origin", other}}, body.dump(), "text/plain");
+  EXPECT_EQ(res->status, 403);
+  EXPECT_EQ(error_of(res), from_other);
+  res = post({{"Referer", other + "/form.html?x=1"}}, "application/json");
+  EXPECT_EQ(res->status, 403);
+  EXPECT_EQ(error_of(res), "refused: the request comes from another origin (Referer: " + other + "); only the editor's own page (" +
+                               served + ") may call its API");
+  EXPECT_EQ(post({{"Origin", "null"}}, "application/json")->status, 403);
+  EXPECT_EQ(error_of(r().client->Get("/api/state", {{"Sec-Fetch-Site", "same-site"}})),
+            "refused: the request comes from another origin (Sec-Fetch-Site: same-site); only the editor's own page (" + served +
+                ") may call its API");
+  EXPECT_EQ(r().client->Get("/api/state", {{"Sec-Fetch-Site", "same-origin"}})->status, 200);
+  EXPECT_EQ(post({{"Referer", served + ".evil.example/"}}, "application/json")->status, 403);
+  // Not JSON: refused whoever sends it (a form can send these types to any address without asking).
+  for (const std::string type :
+       {"text/plain", "text/plain;charset=UTF-8", "application/x-www-form-urlencoded", "multipart/form-data; boundary=x"}) {
+    res = post({}, type);
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 403) << type;
+    EXPECT_EQ(error_of(res), "refused: a POST to the API must have Content-Type: application/json (got '" + type + "')");
+  }
+  EXPECT_EQ(json::parse(r().client->Get("/api/state")->body)["revision"].get<int>(), revision);  // nothing above reached the session
+  // The page's own requests pass: its origin, any of the served names, or no Origin at all (a script).
+  EXPECT_EQ(post({{"Origin", served}}, "application/json")->status, 200);
+  EXPECT_EQ(post({{"Referer", served + "/"}}, "application/json; charset=utf-8")->status, 200);
+  const std::string localhost = "localhost:" + std::to_string(r().port);
+  EXPECT_EQ(post({{"Origin", "http://" + localhost}, {"Host", localhost}}, "application/json")->status, 200);
+  EXPECT_EQ(post({{"Origin", "http://" + localhost}}, "application/json")->status, 403);  // not the Host it was sent to
+  EXPECT_EQ(post({}, "application/json")->status, 200);
 }
 
 TEST_F(Server, RequestsForAnotherHostAreRefused) {
@@ -465,7 +668,278 @@ TEST(ServerLimits, LargeBodiesAreRefusedWith413) {
   auto res = r.post_text("/api/solve", std::string(5000, ' '));
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 413);
+  EXPECT_EQ(error_of(res), "request body too large (the limit is 1000 bytes)");
   EXPECT_EQ(r.client->Get("/api/state")->status, 200);
+  // A chunked body within the limit is read as any other.
+  const std::string small = json{{"N", 4}, {"singularities", eight_quarters(make_icosphere(1))}}.dump();
+  auto chunked = r.client->Post(
+      "/api/export?format=sing",
+      [&](size_t, httplib::DataSink& sink) {
+        sink.write(small.data(), small.size());
+        sink.done();
+        return true;
+      },
+      "application/json");
+  ASSERT_TRUE(chunked);
+  EXPECT_EQ(chunked->status, 200) << chunked->body;
+  EXPECT_TRUE(test::contains(chunked->body, "# N 4"));
+}
+
+// A chunked body counts against the same limit as it arrives: 413 once past it, and the rest is not read
+// (the client here would send 200 MiB; it stops when the answer comes).
+TEST(ServerLimits, ChunkedBodiesPastTheLimitGet413WithoutBeingReadWhole) {
+  server::EditorOptions options;
+  options.max_body_bytes = 1u << 20;
+  Running r(make_icosphere(1), options);
+  Raw c(r.port);
+  ASSERT_TRUE(c.send_all(raw_head("POST", "/api/solve", r.port, r.editor->token()) + "Transfer-Encoding: chunked\r\n\r\n"));
+  ::fcntl(c.fd, F_SETFL, ::fcntl(c.fd, F_GETFL) | O_NONBLOCK);
+  const std::string chunk = "10000\r\n" + std::string(65536, ' ') + "\r\n";
+  size_t sent = 0;
+  const auto t0 = Clock::now();
+  bool answered = false;
+  while (sent < (200u << 20) && seconds_since(t0) < 60) {
+    pollfd p{c.fd, POLLIN | POLLOUT, 0};
+    if (::poll(&p, 1, 100) <= 0) continue;
+    if (p.revents & (POLLIN | POLLHUP | POLLERR)) {
+      answered = true;
+      break;
+    }
+    const size_t at = sent % chunk.size();
+    const ssize_t n = ::send(c.fd, chunk.data() + at, chunk.size() - at, MSG_NOSIGNAL);
+    if (n > 0) sent += static_cast<size_t>(n);
+  }
+  ASSERT_TRUE(answered) << "no answer after " << sent << " bytes";
+  EXPECT_LT(sent, 32u << 20);
+  ::fcntl(c.fd, F_SETFL, ::fcntl(c.fd, F_GETFL) & ~O_NONBLOCK);
+  const std::string answer = c.read_until_closed(10);
+  EXPECT_EQ(status_of(answer), 413) << answer.substr(0, 200);
+  EXPECT_EQ(raw_error(answer), "request body too large (the limit is 1048576 bytes)");
+  EXPECT_TRUE(test::contains(answer, "Connection: close"));
+  EXPECT_EQ(r.client->Get("/api/state")->status, 200);
+}
+
+// Requests whose framing the server does not take are refused before their body is read.
+TEST(ServerLimits, BodiesOfUnknownFramingAreRefused) {
+  Running r(make_icosphere(1));
+  auto answer = [&](const std::string& request) {
+    Raw c(r.port);
+    EXPECT_TRUE(c.send_all(request));
+    return c.read_until_closed(10);
+  };
+  const std::string head = raw_head("POST", "/api/solve", r.port, r.editor->token());
+  std::string a = answer(head + "\r\n");
+  EXPECT_EQ(status_of(a), 411);
+  EXPECT_EQ(raw_error(a), "a POST needs a Content-Length (or Transfer-Encoding: chunked)");
+  a = answer(head + "Content-Length: 2\r\nContent-Encoding: gzip\r\n\r\n{}");
+  EXPECT_EQ(status_of(a), 415);
+  EXPECT_EQ(raw_error(a), "request bodies must not be compressed (Content-Encoding: gzip)");
+  a = answer(head + "Transfer-Encoding: gzip, chunked\r\n\r\n");
+  EXPECT_EQ(status_of(a), 501);
+  a = answer(head + "Content-Length: 2\r\nContent-Length: 3\r\n\r\n{}");
+  EXPECT_EQ(status_of(a), 400);
+  EXPECT_EQ(raw_error(a), "a request has one Content-Length, not 2");
+  a = answer(head + "Content-Length: 2x\r\n\r\n{}");
+  EXPECT_EQ(status_of(a), 400);
+  EXPECT_EQ(raw_error(a), "malformed Content-Length '2x'");
+  a = answer(raw_head("PUT", "/api/solve", r.port, r.editor->token()) + "Transfer-Encoding: chunked\r\n\r\n");
+  EXPECT_EQ(status_of(a), 405);
+  EXPECT_EQ(raw_error(a), "method PUT not allowed (GET and POST only)");
+  a = answer(raw_head("POST", "/api/nothing", r.port, r.editor->token()) + "Transfer-Encoding: chunked\r\n\r\n");
+  EXPECT_EQ(status_of(a), 404);
+  // A header line of any length is not read into memory: 431 past 64 KiB.
+  a = answer("GET /api/state HTTP/1.1\r\nX-Long: " + std::string(100000, 'x') + "\r\n\r\n");
+  EXPECT_EQ(status_of(a), 431);
+  EXPECT_EQ(raw_error(a), "the request line and headers are too large (more than 65536 bytes)");
+  EXPECT_EQ(r.client->Get("/api/state")->status, 200);
+}
+
+// Connections that send their headers a byte at a time hold a thread each, not the server: other requests
+// are answered meanwhile, and the slow ones get 408 when their header time is up.
+TEST(ServerLimits, SlowConnectionsDoNotStallTheOthers) {
+  server::EditorOptions options;
+  options.header_seconds = 2;
+  Running r(make_icosphere(1), options);
+  const std::string head = "GET /api/state HTTP/1.1\r\n";
+  const std::string rest = "Host: 127.0.0.1:" + std::to_string(r.port) + "\r\nX-Trivcon-Token: " + r.editor->token() + "\r\n\r\n";
+  std::vector<std::unique_ptr<Raw>> slow;
+  for (int i = 0; i < 12; ++i) {
+    slow.push_back(std::make_unique<Raw>(r.port));
+    ASSERT_TRUE(slow.back()->send_all(head));
+  }
+  std::atomic<bool> done{false};
+  std::thread dribble([&] {
+    for (size_t k = 0; k < rest.size() && !done; ++k) {
+      for (auto& s : slow) ::send(s->fd, &rest[k], 1, MSG_NOSIGNAL);
+      for (int t = 0; t < 50 && !done; ++t) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  for (int i = 0; i < 5; ++i) {
+    httplib::Client fresh("127.0.0.1", r.port);
+    const auto t0 = Clock::now();
+    auto res = fresh.Get("/api/state", {{"X-Trivcon-Token", r.editor->token()}});
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 200);
+    EXPECT_LT(seconds_since(t0), 1.5) << "request " << i << " waited behind the slow connections";
+  }
+  for (auto& s : slow) {
+    const std::string answer = s->read_until_closed(8);
+    EXPECT_EQ(status_of(answer), 408) << answer.substr(0, 100);
+    EXPECT_EQ(raw_error(answer), "the request's headers did not arrive in time (2 s)");
+  }
+  done = true;
+  dribble.join();
+}
+
+// Requests on one keep-alive connection do not wait for delayed ACKs: an answer's headers and body go out
+// in two writes, and without TCP_NODELAY the second waited about 40 ms on most requests.
+TEST(ServerLimits, KeepAliveRequestsDoNotStall) {
+  Running r(make_icosphere(1));
+  Raw c(r.port);
+  const std::string request =
+      "GET /api/state HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(r.port) + "\r\nX-Trivcon-Token: " + r.editor->token() + "\r\n\r\n";
+  const auto t0 = Clock::now();
+  std::string pending;
+  for (int i = 0; i < 50; ++i) {
+    ASSERT_TRUE(c.send_all(request));
+    // One whole answer: its headers, then Content-Length bytes.
+    size_t end = std::string::npos, length = 0;
+    while (seconds_since(t0) < 30) {
+      end = pending.find("\r\n\r\n");
+      if (end != std::string::npos) {
+        length = std::stoul(pending.substr(pending.find("Content-Length: ") + 16));
+        if (pending.size() >= end + 4 + length) break;
+      }
+      char buffer[65536];
+      const ssize_t n = ::recv(c.fd, buffer, sizeof buffer, 0);
+      ASSERT_GT(n, 0) << "request " << i;
+      pending.append(buffer, static_cast<size_t>(n));
+    }
+    ASSERT_EQ(status_of(pending), 200) << i;
+    pending.erase(0, end + 4 + length);
+  }
+  EXPECT_LT(seconds_since(t0), 1.0);  // 50 requests: well under a millisecond each here, ~40 ms each with the stall
+}
+
+// No answer is compressed: cpp-httplib would brotli-compress text (a field export of 400k faces took over
+// a minute); the export comes as it is, whatever the client accepts.
+TEST(ServerLimits, AnswersAreNotCompressed) {
+  Running r(make_icosphere(5));
+  const json body = {{"N", 4}, {"singularities", eight_quarters(make_icosphere(5))}};
+  auto res = r.client->Post("/api/export?format=txt", {{"Accept-Encoding", "br, gzip, deflate"}}, body.dump(), "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  EXPECT_FALSE(res->has_header("Content-Encoding"));
+  EXPECT_EQ(test::lines_of(res->body).size(), 3u + 20480u);
+  for (const char* path : {"/", "/app.js", "/api/mesh", "/api/state"}) {
+    auto page = r.client->Get(path, {{"Accept-Encoding", "br, gzip"}});
+    ASSERT_TRUE(page);
+    EXPECT_EQ(page->status, 200) << path;
+    EXPECT_FALSE(page->has_header("Content-Encoding")) << path;
+  }
+}
+
+// stop() during an export whose answer the client does not read, with an idle keep-alive connection open:
+// run() returns at once (a write waits no timeout after the stop).
+TEST(ServerStop, StopDuringAnExportReturnsPromptly) {
+  const Mesh m = make_icosphere(5);
+  server::EditorOptions options;
+  options.mesh_path = "generated.obj";
+  auto editor = std::make_unique<server::EditorServer>(mesh_data(m), options);
+  const int port = editor->bind(0);
+  std::thread thread([&] { editor->run(); });
+  while (!editor->running()) std::this_thread::yield();
+  httplib::Client idle("127.0.0.1", port);
+  idle.set_keep_alive(true);
+  EXPECT_EQ(idle.Get("/api/state", {{"X-Trivcon-Token", editor->token()}})->status, 200);
+  Raw c(port, 4096);
+  const std::string body = json{{"N", 4}, {"singularities", eight_quarters(m)}}.dump();
+  ASSERT_TRUE(c.send_all(raw_head("POST", "/api/export?format=txt", port, editor->token()) +
+                         "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body));
+  ASSERT_TRUE(c.readable(60));  // the answer has begun; the rest waits for a reader
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const auto t0 = Clock::now();
+  editor->stop();
+  thread.join();
+  EXPECT_LT(seconds_since(t0), 2.0);
+}
+
+// `trivcon edit` itself: a big export with Accept-Encoding: br comes at once and uncompressed, and SIGTERM
+// during an export ends the program within 2 s with status 0.
+TEST(ServerStop, SigtermDuringAnExportEndsTheProgramPromptly) {
+  const Mesh m = make_icosphere(6);
+  const std::string path = test::temp_file("sphere.obj");
+  write_obj(path, m.V, m.F);
+  int out[2];
+  ASSERT_EQ(::pipe(out), 0);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, out[1], 1);
+  posix_spawn_file_actions_addclose(&actions, out[0]);
+  std::vector<std::string> args = {TRIVCON_CLI, "edit", path, "--port", "0"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, TRIVCON_CLI, &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(out[1]);
+  auto wait_exit = [&](double seconds) {
+    const auto t0 = Clock::now();
+    int status = 0;
+    while (seconds_since(t0) < seconds) {
+      if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return -1;
+  };
+  // The URL it prints: http://127.0.0.1:PORT/?token=T
+  std::string printed;
+  const auto t0 = Clock::now();
+  while (printed.find("token=") == std::string::npos || printed.find('\n', printed.find("token=")) == std::string::npos) {
+    pollfd p{out[0], POLLIN, 0};
+    if (seconds_since(t0) > 120 || (::poll(&p, 1, 100) > 0 && [&] {
+          char b[4096];
+          const ssize_t n = ::read(out[0], b, sizeof b);
+          if (n > 0) printed.append(b, static_cast<size_t>(n));
+          return n <= 0;
+        }()))
+      break;
+  }
+  const size_t at = printed.find("http://127.0.0.1:");
+  const size_t token_at = printed.find("token=");
+  if (at == std::string::npos || token_at == std::string::npos) {
+    ::kill(pid, SIGKILL);
+    wait_exit(10);
+    FAIL() << "no URL printed: " << printed;
+  }
+  const int port = std::atoi(printed.c_str() + at + 17);
+  const std::string token = printed.substr(token_at + 6, 32);
+  const std::string body = json{{"N", 4}, {"singularities", eight_quarters(m)}}.dump();
+  httplib::Client client("127.0.0.1", port);
+  client.set_read_timeout(120, 0);
+  const auto t1 = Clock::now();
+  auto res = client.Post("/api/export?format=txt", {{"X-Trivcon-Token", token}, {"Accept-Encoding", "br, gzip"}}, body, "application/json");
+  const double export_seconds = seconds_since(t1);
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_FALSE(res->has_header("Content-Encoding"));
+  EXPECT_EQ(test::lines_of(res->body).size(), 3u + static_cast<size_t>(m.F.rows()));
+  EXPECT_LT(export_seconds, 30.0);  // seconds, not the minutes of brotli
+  // Another export, its answer left unread; SIGTERM while it is being computed or sent.
+  Raw c(port, 4096);
+  ASSERT_TRUE(c.send_all(raw_head("POST", "/api/export?format=txt", port, token) + "Content-Length: " + std::to_string(body.size()) +
+                         "\r\n\r\n" + body));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const auto t2 = Clock::now();
+  ::kill(pid, SIGTERM);
+  const int status = wait_exit(5);
+  const double stop_seconds = seconds_since(t2);
+  if (status < 0) ::kill(pid, SIGKILL), wait_exit(10);
+  EXPECT_EQ(status, 0);
+  EXPECT_LT(stop_seconds, 2.0);
+  ::close(out[0]);
 }
 
 TEST(ServerCycles, GeneratorsAndBoundaryLoopsAreListedAndPrescribed) {

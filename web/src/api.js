@@ -1,11 +1,29 @@
-// The server's API (README.md, "Editor"): every call sends the token of the page's URL.
+// The server's API (README.md, "Editor"): every call sends the token as the X-Trivcon-Token header.
 
-const params = new URLSearchParams(location.search);
-// Without ?token= (a reload after the URL was cleaned) the HttpOnly cookie set with the page authenticates.
-export const token = params.get('token') || '';
+// The token comes in the page's address (?token=…, as `trivcon edit` prints it). It is kept in this tab's
+// sessionStorage (per origin, so no other port of this host sees it, unlike a cookie) and removed from the
+// address bar and the history; a reload of the tab finds it there.
+const TOKEN_KEY = 'trivcon-token';
+function takeToken() {
+  const url = new URL(location.href);
+  const given = url.searchParams.get('token');
+  let stored = '';
+  try {
+    stored = sessionStorage.getItem(TOKEN_KEY) || '';
+    if (given) sessionStorage.setItem(TOKEN_KEY, given);
+  } catch (e) {
+    // storage refused (a private mode): the token lives as long as the page
+  }
+  if (given !== null) {
+    url.searchParams.delete('token');
+    history.replaceState(history.state, '', url.pathname + url.search + url.hash);
+  }
+  return given || stored;
+}
+export const token = takeToken();
 
 function headers(extra = {}) {
-  return token ? { 'X-Trivcon-Token': token, ...extra } : extra;
+  return { 'X-Trivcon-Token': token, ...extra };
 }
 
 async function fail(res) {
@@ -37,7 +55,10 @@ export async function getMesh() {
   const positions = new Float32Array(buffer, offset, 3 * nV);
   const faces = new Uint32Array(buffer, offset + 12 * nV, 3 * nF);
   const component = new Int32Array(buffer, offset + 12 * nV + 12 * nF, nV);
-  return { info: header, positions, faces, component };
+  // The glyphs' order (server/editor_server.cpp, GlyphOrder): faces, and their first times.
+  const glyphOrder = new Uint32Array(buffer, offset + 16 * nV + 12 * nF, nF);
+  const glyphTimes = new Float32Array(buffer, offset + 16 * nV + 16 * nF, nF);
+  return { info: header, positions, faces, component, glyphOrder, glyphTimes };
 }
 
 export async function getState() {
@@ -63,11 +84,11 @@ export function decodeOct(oct, f, out, o) {
   out[3 * o] = x / l, out[3 * o + 1] = y / l, out[3 * o + 2] = z / l;
 }
 
-// One solve: the directions of faces i · stride mod F (i < count), octahedral-encoded, the report, and
-// the server's own time.
-export async function solve(body, stride, count) {
+// One solve: the directions of the first `count` faces of the glyph order, octahedral-encoded, the report,
+// and the server's own time.
+export async function solve(body, count) {
   const tSend = performance.now();
-  const res = await post(`/api/solve?format=oct16&stride=${stride}&count=${count}`, body);
+  const res = await post(`/api/solve?format=oct16&order=area&count=${count}`, body);
   if (!res.ok) await fail(res);
   const buffer = await res.arrayBuffer();
   const tReceived = performance.now();

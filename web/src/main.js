@@ -10,10 +10,11 @@ import { formatIndex, parseIndex, componentBalance } from './indices.js';
 const $ = (id) => document.getElementById(id);
 const tLoadStart = performance.now();
 // Asked for at once: creating the WebGL context (below) can take a while, the downloads go on meanwhile.
-const meshPromise = api.getMesh();
-const statePromise = api.getState();
-meshPromise.catch(() => {});
-statePromise.catch(() => {});
+// (Without a token there is nothing to ask: start() says what is missing.)
+const meshPromise = api.token ? api.getMesh() : null;
+const statePromise = api.token ? api.getState() : null;
+meshPromise?.catch(() => {});
+statePromise?.catch(() => {});
 
 // --- the session ---------------------------------------------------------------------------------
 // n are integers meaning n/N (as in trivcon/indices.h); fixed directions are world vectors.
@@ -64,8 +65,10 @@ let isBoundaryVertex = null;
 let adjacency = null; // CSR: vertex → neighbours
 let meanEdge = 1;
 let faceNormals = null, faceCentroids = null;
-let fieldOct = null; // last drawn, octahedral-encoded (src/api.js)
+let fieldOct = null; // last drawn, octahedral-encoded (src/api.js); null: no field on screen
+let fieldN = 0; // the symmetry of that field
 let fieldVersion = 0;
+let notice = ''; // what the last edit did that the user should know (shown until the next edit)
 let lastReport = null;
 let lastTimings = null;
 let lastError = '';
@@ -150,7 +153,8 @@ function draw() {
   if (glyphs) {
     glyphs.adapt(camera, renderer.domElement.clientHeight, +$('spacing').value);
     // Zoomed in past the directions received: ask for more (a re-solve of the same session).
-    if (fieldOct && glyphs.count > glyphs.received && !inflight && !pending && !lastError) requestSolve();
+    if (fieldOct && glyphs.count > glyphs.usable() && glyphs.received < wantedDirections(glyphs) && !inflight && !pending && !lastError)
+      requestSolve();
   }
   updateMarkerSizes();
   camera.updateMatrixWorld();
@@ -179,6 +183,7 @@ controls.addEventListener('change', () => ((cache.dirty = true), invalidate()));
 
 function status(text) {
   $('status').textContent = text;
+  $('status').title = text;
 }
 
 function buildMesh() {
@@ -194,10 +199,10 @@ function buildMesh() {
   surface = new THREE.Mesh(geometry, material);
   scene.add(surface);
 
-  // Per face: centroid, unit normal; mean edge length; total area (the glyphs' density).
+  // Per face: centroid, unit normal; mean edge length.
   faceNormals = new Float32Array(3 * nF);
   faceCentroids = new Float32Array(3 * nF);
-  let edgeSum = 0, area = 0;
+  let edgeSum = 0;
   const vertexNormals = new Float32Array(3 * nV); // area-weighted sums of the face normals, then normalized
   for (let f = 0; f < nF; ++f) {
     const a = 3 * faces[3 * f], b = 3 * faces[3 * f + 1], c = 3 * faces[3 * f + 2];
@@ -206,7 +211,6 @@ function buildMesh() {
     let nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
     for (const v of [a, b, c]) (vertexNormals[v] += nx), (vertexNormals[v + 1] += ny), (vertexNormals[v + 2] += nz);
     const len = Math.hypot(nx, ny, nz);
-    area += len / 2;
     if (len > 0) (nx /= len), (ny /= len), (nz /= len);
     faceNormals[3 * f] = nx, faceNormals[3 * f + 1] = ny, faceNormals[3 * f + 2] = nz;
     for (let k = 0; k < 3; ++k) faceCentroids[3 * f + k] = (positions[a + k] + positions[b + k] + positions[c + k]) / 3;
@@ -242,7 +246,7 @@ function buildMesh() {
     loopsGroup.add(line);
   }
 
-  glyphs = new FieldGlyphs(faceCentroids, faceNormals, area, meanEdge);
+  glyphs = new FieldGlyphs({ positions, faces, normals: faceNormals, order: mesh.glyphOrder, times: mesh.glyphTimes, meanEdge });
   overlay.add(glyphs.object);
 
   const sphere = geometry.boundingSphere;
@@ -369,16 +373,16 @@ async function pump() {
     timer = setTimeout(() => status('solving…'), 250);
   }
   try {
-    const r = await api.solve(requestBody(job.session), glyphs.stride, wantedDirections(glyphs));
+    const r = await api.solve(requestBody(job.session), wantedDirections(glyphs));
     if (refactor) refactorSeconds = (performance.now() - t0) / 1000;
     solvedFixedKey = fixedKey(job.session);
     showField(r, job);
     lastError = '';
     status(`solved: energy ${r.report.energy.toPrecision(6)}${r.report.verified ? '' : ' (verification failed: see the report)'}`);
   } catch (e) {
-    // The last valid field stays on screen; the message says what went wrong (the CLI's text).
+    // The last valid field of this symmetry stays on screen; the message says what went wrong (the CLI's text).
     lastError = e.message;
-    status('not solved: the last valid field is shown');
+    status(fieldOct ? 'not solved: the last valid field is shown' : `not solved: no valid field for N = ${session.N} yet`);
   } finally {
     if (timer) clearInterval(timer), clearTimeout(timer);
     $('progress').hidden = true;
@@ -394,6 +398,7 @@ async function pump() {
 }
 function showField(r, job) {
   fieldOct = r.oct;
+  fieldN = job.session.N;
   lastReport = r.report;
   glyphs.setDirections(r.oct, r.count, job.session.N);
   draw();
@@ -448,6 +453,7 @@ function updateReadout() {
   for (const r of rows) {
     const div = document.createElement('div');
     const sum = formatIndex(r.sum, session.N);
+    out.appendChild(div);
     if (r.free) {
       div.textContent = `component ${r.component}: Σ ${sum} (free boundary loops take the rest of χ ${r.chi})`;
       div.className = 'ok';
@@ -459,24 +465,36 @@ function updateReadout() {
       div.className = 'bad';
       missing.push(`add ${formatIndex(r.missing, session.N)} on component ${r.component}`);
     }
-    out.appendChild(div);
+    div.title = div.textContent; // one line each, cut to the panel: the whole line on hover
   }
   $('balance').disabled = missing.length === 0;
-  let text = '';
-  if (missing.length) text = `Indices do not balance (Gauss–Bonnet): ${missing.join('; ')}. The last valid field is shown.`;
+  let text = notice;
+  const shown = fieldOct ? 'The last valid field is shown.' : 'No field is shown: none has solved yet for this N.';
+  if (missing.length) text += (text ? '\n' : '') + `Indices do not balance (Gauss–Bonnet): ${missing.join('; ')}. ${shown}`;
   if (lastError && !(missing.length && /Gauss-Bonnet/.test(lastError))) text += (text ? '\n' : '') + lastError;
   $('message').textContent = text;
+  $('message').title = text;
 }
 
 // --- edits and history ----------------------------------------------------------------------------
-function commit(label, next, tEdit = performance.now()) {
+// `label`: one line in the history list; `detail`: its tooltip (what a long edit did in full); `told`: what
+// the user should know about the edit (the message area, until the next edit).
+function commit(label, next, { detail = '', told = '', tEdit = performance.now() } = {}) {
   session = next;
+  notice = told;
   history.length = historyIndex + 1;
-  history.push({ label, session: cloneSession(next) });
+  history.push({ label, detail, session: cloneSession(next) });
   historyIndex = history.length - 1;
   applySession(tEdit);
 }
 function applySession(tEdit = performance.now()) {
+  // A field of another symmetry is not this session's: no crosses until one solves for this N.
+  if (fieldOct && fieldN !== session.N) {
+    fieldOct = null;
+    lastReport = null;
+    glyphs.clear();
+    fieldVersion++;
+  }
   requestSolve(tEdit); // first: the panel's updates below need not delay the solve
   rebuildMarkers();
   rebuildFixedArrows();
@@ -487,11 +505,13 @@ function applySession(tEdit = performance.now()) {
   updateHistory();
   updateReadout();
   invalidate();
+  saveTabSoon();
 }
 function goTo(i) {
   if (i < 0 || i >= history.length) return;
   historyIndex = i;
   session = cloneSession(history[i].session);
+  notice = '';
   applySession();
 }
 const undo = () => goTo(historyIndex - 1);
@@ -502,12 +522,18 @@ function updateHistory() {
   history.forEach((h, i) => {
     const div = document.createElement('div');
     div.textContent = `${i}. ${h.label}`;
+    div.title = h.detail || h.label;
     div.className = i === historyIndex ? 'current' : i > historyIndex ? 'future' : '';
     div.onclick = () => goTo(i);
     box.appendChild(div);
   });
+  // The current entry in view, scrolling the list only (scrollIntoView would scroll the panel too).
   const cur = box.querySelector('.current');
-  if (cur) cur.scrollIntoView({ block: 'nearest' });
+  if (cur) {
+    if (cur.offsetTop < box.scrollTop) box.scrollTop = cur.offsetTop;
+    else if (cur.offsetTop + cur.offsetHeight > box.scrollTop + box.clientHeight)
+      box.scrollTop = cur.offsetTop + cur.offsetHeight - box.clientHeight;
+  }
   $('undo').disabled = historyIndex <= 0;
   $('redo').disabled = historyIndex >= history.length - 1;
 }
@@ -529,7 +555,11 @@ function removeSingularity(v) {
   commit(`remove ${formatIndex(n, session.N)} at vertex ${v}`, next);
 }
 function setN(N) {
-  if (!(N >= 1 && N <= 1000) || N === session.N) return;
+  if (!(N >= 1 && N <= 1000) || N === session.N) {
+    if (!(N >= 1 && N <= 1000)) status(`N: ${$('N').value || 'nothing'} is not a whole number from 1 to 1000`);
+    $('N').value = session.N;
+    return;
+  }
   // Indices carry over where they are multiples of 1/N in the new symmetry too; otherwise the set is cleared.
   const convert = (m) => {
     const out = new Map();
@@ -547,7 +577,16 @@ function setN(N) {
   next.gens = g || new Map();
   next.loops = l || new Map();
   indexChoice = Math.sign(indexChoice) || 1;
-  commit(`N = ${N}${s && g && l ? '' : ' (indices cleared: not multiples of 1/' + N + ')'}`, next);
+  const removed = [];
+  const count = (n, one, many) => `${n} ${n === 1 ? one : many}`;
+  if (!s && session.sings.size) removed.push(count(session.sings.size, 'singularity', 'singularities'));
+  if (!g && session.gens.size) removed.push(count(session.gens.size, 'generator index', 'generator indices'));
+  if (!l && session.loops.size) removed.push(count(session.loops.size, 'boundary loop index', 'boundary loop indices'));
+  const told = removed.length
+    ? `N = ${N}: removed ${removed.join(' and ')} (their indices are not multiples of 1/${N}); Ctrl+Z brings them back.`
+    : '';
+  if (told) status(told);
+  commit(`N = ${N}${removed.length ? ` (removed ${removed.join(', ')})` : ''}`, next, { told });
 }
 function balance() {
   const rows = componentBalance(mesh.info, mesh.component, session);
@@ -560,7 +599,10 @@ function balance() {
     next.sings.set(v, r.missing);
     placed.push(`${formatIndex(r.missing, session.N)} at ${v}`);
   }
-  if (placed.length) commit(`balance: ${placed.join(', ')}`, next);
+  // One entry however many components: its line says how many, its tooltip what went where.
+  const label =
+    placed.length <= 2 ? `balance: ${placed.join(', ')}` : `balance: ${placed.length} singularities on ${placed.length} components`;
+  if (placed.length) commit(label, next, { detail: `balance: ${placed.join(', ')}` });
 }
 // The interior vertex of the component farthest from the singularities already there (a sample of the
 // component's vertices on big meshes), so the balancing singularity disturbs the field least.
@@ -877,8 +919,23 @@ function wireControls() {
   $('dl-rawfield').onclick = () => downloadExport('rawfield', 'field.rawfield');
   $('dl-sing').onclick = () => downloadExport('sing', 'singularities.txt');
   $('dl-png').onclick = async () => download(await viewPng(), 'view.png');
+  // In a text or number field: Enter commits it and Escape gives it up, and either leaves the field, so that
+  // the keys are shortcuts again. While a field has the focus, keys are its own.
+  const typing = (t) => t instanceof HTMLInputElement && t.type !== 'checkbox' && t.type !== 'range';
+  $('panel').addEventListener('keydown', (e) => {
+    if (!typing(e.target)) return;
+    if (e.key === 'Escape') {
+      e.target.value = e.target.dataset.committed ?? e.target.defaultValue;
+      e.target.blur();
+    } else if (e.key === 'Enter') {
+      e.target.blur(); // fires its change first
+    }
+  });
+  $('panel').addEventListener('focusin', (e) => {
+    if (typing(e.target)) e.target.dataset.committed = e.target.value;
+  });
   window.addEventListener('keydown', (e) => {
-    if (e.target instanceof HTMLInputElement && e.target.type !== 'checkbox' && e.target.type !== 'range') return;
+    if (typing(e.target)) return;
     const key = e.key.toLowerCase();
     if ((e.ctrlKey || e.metaKey) && key === 'z') {
       e.preventDefault();
@@ -897,8 +954,58 @@ function wireControls() {
   });
 }
 
+// --- this tab's session, kept across reloads ------------------------------------------------------
+// sessionStorage belongs to this tab and this origin: a reload restores the tab's own session and history
+// (not the last request of any tab, which is what the server knows), another tab starts on its own.
+const TAB_KEY = 'trivcon-tab';
+let saveTimer = null;
+function meshId() {
+  return { file: mesh.info.file, vertices: mesh.info.vertices, faces: mesh.info.faces };
+}
+function saveTab() {
+  clearTimeout(saveTimer);
+  saveTimer = null;
+  if (!mesh || historyIndex < 0) return;
+  let entries = history.map((h) => ({ label: h.label, detail: h.detail, body: requestBody(h.session) }));
+  let index = historyIndex;
+  // Too big for the storage: the oldest entries go first (the current one stays).
+  for (;;) {
+    try {
+      sessionStorage.setItem(TAB_KEY, JSON.stringify({ token: api.token, mesh: meshId(), index, history: entries }));
+      return;
+    } catch (e) {
+      const drop = Math.min(index, Math.ceil(entries.length / 2));
+      if (drop === 0) return;
+      entries = entries.slice(drop);
+      index -= drop;
+    }
+  }
+}
+function saveTabSoon() {
+  if (!saveTimer) saveTimer = setTimeout(saveTab, 200);
+}
+window.addEventListener('pagehide', saveTab);
+// The saved history of this tab for this run of the editor (its token) and this mesh, or null.
+function restoreTab() {
+  try {
+    const saved = JSON.parse(sessionStorage.getItem(TAB_KEY) || 'null');
+    if (!saved || saved.token !== api.token || JSON.stringify(saved.mesh) !== JSON.stringify(meshId())) return null;
+    const entries = saved.history.map((h) => ({
+      label: h.label, detail: h.detail || '', session: sessionFromRequest(h.body, mesh.info.N),
+    }));
+    if (!entries.length || !(saved.index >= 0 && saved.index < entries.length)) return null;
+    return { entries, index: saved.index };
+  } catch (e) {
+    return null;
+  }
+}
+
 // --- start ----------------------------------------------------------------------------------------
 async function start() {
+  if (!api.token) {
+    $('overlay').textContent = 'This page needs its token: open the URL that trivcon edit printed (with ?token=…).';
+    return;
+  }
   try {
     mesh = await meshPromise;
   } catch (e) {
@@ -917,16 +1024,24 @@ async function start() {
   phases.built = (performance.now() - tLoadStart) / 1000;
   // The first solve is asked for before the first frame is drawn (the first frame of a big mesh is slow on
   // a CPU rasterizer): the server solves while the page draws.
-  try {
-    session = sessionFromRequest(state.request, info.N);
-  } catch (e) {
-    session = emptySession(info.N);
-    status(`the starting prescription: ${e.message}`);
+  const restored = restoreTab();
+  if (restored) {
+    history.push(...restored.entries);
+    historyIndex = restored.index;
+    session = cloneSession(history[historyIndex].session);
+  } else {
+    // A new tab starts from the command line's session.
+    try {
+      session = sessionFromRequest(state.initial || state.request, info.N);
+    } catch (e) {
+      session = emptySession(info.N);
+      status(`the starting prescription: ${e.message}`);
+    }
+    // Ids the mesh does not have cannot be shown: they are dropped (the server said so at start).
+    for (const v of [...session.sings.keys()]) if (!(v >= 0 && v < info.vertices)) session.sings.delete(v);
+    history.push({ label: 'start', detail: '', session: cloneSession(session) });
+    historyIndex = 0;
   }
-  // Ids the mesh does not have cannot be shown: they are dropped (the server said so at start).
-  for (const v of [...session.sings.keys()]) if (!(v >= 0 && v < info.vertices)) session.sings.delete(v);
-  history.push({ label: 'start', session: cloneSession(session) });
-  historyIndex = 0;
   applySession();
   await idle();
   $('overlay').textContent = '';
@@ -952,6 +1067,8 @@ window.__trivcon = {
   get faces() { return mesh ? mesh.info.faces : 0; },
   async pngSize() { return (await viewPng()).size; },
   get streamlinePoints() { return streamlineObject ? streamlineObject.geometry.getAttribute('position').count : 0; },
+  // The faces of the glyphs drawn now (one entry per glyph; a large face has several).
+  get glyphFaces() { return glyphs && fieldOct && glyphs.object.visible ? glyphs.drawnFaces() : []; },
   // One redraw of what an edit redraws, waited for on the GPU: milliseconds (the benchmark's "drawing" alone).
   redraw(surfaceToo = false) {
     const t0 = performance.now();
@@ -961,8 +1078,9 @@ window.__trivcon = {
     gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
     return performance.now() - t0;
   },
-  // The last drawn field, decoded: x y z per face, NaN for faces not received (only those drawn are, on a
-  // mesh of more than 20000 faces).
+  // The last drawn field, decoded: x y z per face, NaN for faces not received (the server sends the faces
+  // of the glyph order up to what the view draws, at least 20000 of those with glyphs: every face of an
+  // even mesh of up to 20000 faces); null when no field is on screen.
   get directions() {
     if (!fieldOct) return null;
     const out = new Float32Array(3 * mesh.info.faces).fill(NaN);
@@ -973,6 +1091,7 @@ window.__trivcon = {
   get message() { return $('message').textContent; },
   get session() { return requestBody(session); },
   get historyLength() { return history.length; },
+  get historyLabels() { return history.map((h) => h.label); },
   get historyIndex() { return historyIndex; },
 };
 

@@ -19,6 +19,35 @@ const trivcon = opt('--trivcon', resolve(root, 'build/trivcon'));
 const meshPath = opt('--mesh', resolve(root, 'data/cube_sphere.obj'));
 const singPath = opt('--sing', resolve(root, 'data/cube_sphere.sing'));
 
+// A mesh of two flat squares side by side: one of two triangles, one of 2 n² (a CAD part's large faces next
+// to a finely tessellated region).
+function writeUnevenMesh(path, n = 100) {
+  const v = [[-1.2, 0, 0], [-0.2, 0, 0], [-0.2, 1, 0], [-1.2, 1, 0]], f = [[1, 2, 3], [1, 3, 4]];
+  const id = (i, j) => 5 + j * (n + 1) + i;
+  for (let j = 0; j <= n; ++j) for (let i = 0; i <= n; ++i) v.push([i / n, j / n, 0]);
+  for (let j = 0; j < n; ++j)
+    for (let i = 0; i < n; ++i) f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)], [id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+  writeFileSync(path, v.map((p) => `v ${p.join(' ')}\n`).join('') + f.map((t) => `f ${t.join(' ')}\n`).join(''));
+}
+
+// Pixels of the field's colour (blue) in a screenshot, within the clip.
+async function fieldPixels(page, clip) {
+  const shot = await page.screenshot({ clip, encoding: 'base64' });
+  return page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width, c.height = img.height;
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    let field = 0;
+    for (let i = 0; i < d.length; i += 4) field += d[i + 2] > d[i] + 40 && d[i + 2] > d[i + 1] + 30; // not the green fixed arrows
+    return field;
+  }, shot);
+}
+
 // Starts `trivcon edit` on a free port; resolves with the printed URL.
 export async function startEditor(program, extra) {
   const child = spawn(program, ['edit', ...extra, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
@@ -80,6 +109,22 @@ async function main() {
     });
     const mesh = await api('/api/mesh');
 
+    await check('the token is kept out of the address bar, the history and cookies', async () => {
+      assert.equal(new URL(page.url()).search, '');
+      assert.equal(await T(() => location.href.includes('token')), false);
+      assert.equal(await T(() => document.cookie), '');
+      assert.equal(await T(() => sessionStorage.getItem('trivcon-token')), editor.token);
+      // A page without it (another tab, no token in its address) says what it needs and calls nothing.
+      const context = await browser.createBrowserContext();
+      const bare = await context.newPage();
+      const calls = [];
+      bare.on('request', (r) => r.url().includes('/api/') && calls.push(r.url()));
+      await bare.goto(new URL('/', editor.url).href);
+      await bare.waitForFunction(() => /needs its token/.test(document.getElementById('overlay').textContent), { timeout: 30000 });
+      assert.deepEqual(calls, []);
+      await context.close();
+    });
+
     let start = null;
     await check('the page loads the mesh and draws a field of unit vectors, one per face', async () => {
       assert.equal(await T(() => window.__trivcon.message), '');
@@ -121,9 +166,15 @@ async function main() {
     const pos = (v) => page.evaluate((u) => window.__trivcon.projectVertex(u), v);
 
     let afterB = null;
+    // Where the panel's sections are (in the panel's own scrolled content): an edit must not move them.
+    const layout = () => page.evaluate(() => {
+      const panel = document.getElementById('panel');
+      return [...panel.querySelectorAll('h2, button')].map((e) => Math.round(e.getBoundingClientRect().top + panel.scrollTop));
+    });
     await check('an unbalanced set shows what to add and keeps the last field', async () => {
       assert.notEqual(A, B);
       const version = await T(() => window.__trivcon.fieldVersion);
+      const before = await layout();
       await page.keyboard.down('Shift');
       await page.keyboard.press('Digit1'); // palette: −1/4
       await page.keyboard.up('Shift');
@@ -133,6 +184,8 @@ async function main() {
       assert.deepEqual((await singularities()).find((s) => s[0] === A), [A, '-1/4']);
       const message = await T(() => window.__trivcon.message);
       assert.match(message, /add 1\/4 on component 0/);
+      assert.match(message, /The last valid field is shown\./);
+      assert.deepEqual(await layout(), before, 'the panel moved');
       assert.equal(await T(() => window.__trivcon.fieldVersion), version);
       assert.deepEqual(await directions(), start);
       const state = await api('/api/state');
@@ -281,7 +334,7 @@ async function main() {
         assert.match(res.headers()['content-disposition'], new RegExp(name.replace('.', '\\.')), button);
       }
       const file = async (format) => (await fetch(new URL(`/api/export?format=${format}`, editor.url), {
-        method: 'POST', headers: { 'X-Trivcon-Token': editor.token }, body: JSON.stringify(session),
+        method: 'POST', headers: { 'X-Trivcon-Token': editor.token, 'Content-Type': 'application/json' }, body: JSON.stringify(session),
       })).text();
       const txt = await file('txt');
       assert.match(txt, /^# trivcon field.*\n# N 4\n# faces 3072\n/);
@@ -309,10 +362,137 @@ async function main() {
       assert.equal((await api('/api/state')).solved, true);
     });
 
-    await check('a PNG of the view can be saved', async () => {
+    await check('a reload of the tab restores its singularities and its undo history (and needs no token in the address)', async () => {
+      await idle();
+      const session = () => page.evaluate(() => window.__trivcon.session);
+      const key = async (k) => {
+        await page.keyboard.down('Control');
+        await page.keyboard.press(k);
+        await page.keyboard.up('Control');
+        await idle();
+      };
+      await key('KeyZ');
+      const previous = await session();
+      await key('KeyY');
+      const saved = await session();
+      const labels = await T(() => window.__trivcon.historyLabels);
+      const index = await T(() => window.__trivcon.historyIndex);
+      assert.ok(labels.length > 5);
+      await page.reload();
+      await page.waitForFunction(() => window.__trivcon && window.__trivcon.ready, { timeout: 120000 });
+      assert.equal(new URL(page.url()).search, '');
+      assert.deepEqual(await page.evaluate(() => window.__trivcon.session), saved);
+      assert.deepEqual(await T(() => window.__trivcon.historyLabels), labels);
+      assert.equal(await T(() => window.__trivcon.historyIndex), index);
+      assert.equal(await T(() => window.__trivcon.message), '');
+      // Undo and redo go through this tab's own history.
+      await key('KeyZ');
+      assert.equal(await T(() => window.__trivcon.historyIndex), index - 1);
+      assert.deepEqual(await session(), previous);
+      await key('KeyY');
+      assert.deepEqual(await session(), saved);
+    });
+
+    const typeIn = async (selector, text) => {
+      await page.click(selector, { clickCount: 3 });
+      await page.keyboard.type(text);
+      await page.keyboard.press('Enter');
+    };
+    await check('after typing in the N box (Enter), the keys are shortcuts again', async () => {
+      await typeIn('#N', '4'); // the same N: no edit
+      assert.equal(await T(() => document.activeElement === document.getElementById('N')), false);
+      await page.keyboard.press('KeyF');
+      assert.equal(await T(() => document.getElementById('mode-fix').className), 'on');
+      await page.keyboard.press('KeyS');
+      assert.equal(await T(() => document.getElementById('mode-sing').className), 'on');
+      // Escape gives up what was typed and leaves the box too.
+      await page.click('#N', { clickCount: 3 });
+      await page.keyboard.type('7');
+      await page.keyboard.press('Escape');
+      assert.equal(await T(() => document.getElementById('N').value), '4');
+      await page.keyboard.press('KeyF');
+      assert.equal(await T(() => document.getElementById('mode-fix').className), 'on');
+      await page.keyboard.press('KeyS');
+    });
+
+    await check('changing N when the singularities cannot follow says so and clears the crosses; undo brings them back', async () => {
+      const saved = await page.evaluate(() => window.__trivcon.session);
+      const count = saved.singularities.length;
+      assert.ok(count > 0 && (await T(() => window.__trivcon.glyphFaces.length)) > 0);
+      const clip = { x: view.x, y: view.y, width: view.w, height: view.h };
+      assert.ok((await fieldPixels(page, clip)) > 500);
+      await typeIn('#N', '3');
+      await idle();
+      const message = await T(() => window.__trivcon.message);
+      assert.match(message, new RegExp(`^N = 3: removed ${count} singularities \\(their indices are not multiples of 1/3\\); Ctrl\\+Z brings them back\\.`));
+      assert.match(message, /No field is shown: none has solved yet for this N\./);
+      assert.doesNotMatch(message, /last valid field/);
+      assert.deepEqual(await singularities(), []);
+      assert.equal(await T(() => window.__trivcon.directions), null);
+      assert.equal(await T(() => window.__trivcon.glyphFaces.length), 0);
+      assert.ok((await fieldPixels(page, clip)) < 50, 'crosses still on screen');
+      assert.match(await T(() => document.getElementById('status').textContent), /^not solved: no valid field for N = 3 yet$/);
+      await page.keyboard.down('Control');
+      await page.keyboard.press('KeyZ');
+      await page.keyboard.up('Control');
+      await idle();
+      assert.deepEqual(await page.evaluate(() => window.__trivcon.session), saved);
+      assert.equal(await T(() => window.__trivcon.message), '');
+      assert.ok((await fieldPixels(page, clip)) > 500);
+    });
+
+    await check('a PNG of the view can be saved; its button is whole on screen', async () => {
       const png = await page.evaluate(() => window.__trivcon.pngSize());
       assert.ok(png > 10000, `PNG of ${png} bytes`);
+      const box = await page.evaluate(() => {
+        const b = document.getElementById('dl-png');
+        b.scrollIntoView({ block: 'nearest' });
+        const r = b.getBoundingClientRect(), p = document.getElementById('panel').getBoundingClientRect();
+        return { r: r.toJSON(), p: p.toJSON(), w: innerWidth, h: innerHeight };
+      });
+      assert.ok(box.r.left >= box.p.left && box.r.right <= box.p.right && box.r.right <= box.w, JSON.stringify(box));
+      assert.ok(box.r.top >= 0 && box.r.bottom <= box.h + 0.5, JSON.stringify(box));
+      assert.equal(await page.evaluate(() => document.getElementById('panel').scrollWidth <= document.getElementById('panel').clientWidth), true);
       await page.click('#dl-png');
+    });
+
+    await check('glyphs cover large faces in proportion to area (two big triangles beside 20000 small ones)', async () => {
+      const path = resolve(tmpdir(), `trivcon-uneven-${process.pid}.obj`);
+      writeUnevenMesh(path);
+      // Started with the big square's boundary loop at index 0: it does not balance, no field yet.
+      const other = await startEditor(trivcon, [path, '-N', '4', '--boundary', '0:0']);
+      const tab = await browser.newPage();
+      await tab.setViewport({ width: 1200, height: 800 });
+      tab.on('pageerror', (e) => pageErrors.push(e.message));
+      try {
+        await tab.goto(other.url);
+        await tab.waitForFunction(() => window.__trivcon && window.__trivcon.ready, { timeout: 120000 });
+        const message = await tab.evaluate(() => window.__trivcon.message);
+        assert.match(message, /No field is shown: none has solved yet for this N\./);
+        assert.doesNotMatch(message, /last valid field/);
+        assert.equal(await tab.evaluate(() => window.__trivcon.glyphFaces.length), 0);
+        // Left to the solver ("smoothest"), the loop balances: the field is drawn on both squares alike.
+        await tab.click('#cycles .row[data-kind="loop"][data-id="0"] input', { clickCount: 3 });
+        await tab.keyboard.press('Backspace');
+        await tab.keyboard.press('Enter');
+        await tab.evaluate(() => window.__trivcon.idle());
+        assert.equal(await tab.evaluate(() => window.__trivcon.message), '');
+        const faces = await tab.evaluate(() => window.__trivcon.glyphFaces);
+        const big = faces.filter((f) => f < 2).length;
+        assert.ok(faces.length > 100, `${faces.length} glyphs`);
+        assert.ok(big > 0.35 * faces.length && big < 0.65 * faces.length, `${big} of ${faces.length} glyphs on the big square (half the area)`);
+        // On screen: the big square shows about as much of the field as the fine one.
+        const rect = async (a, b) => {
+          const [p, q] = await tab.evaluate((u, v) => [window.__trivcon.projectVertex(u), window.__trivcon.projectVertex(v)], a, b);
+          return { x: Math.min(p.x, q.x) + 5, y: Math.min(p.y, q.y) + 5, width: Math.abs(q.x - p.x) - 10, height: Math.abs(q.y - p.y) - 10 };
+        };
+        const onBig = await fieldPixels(tab, await rect(0, 2)), onFine = await fieldPixels(tab, await rect(4, 4 + 101 * 101 - 1));
+        assert.ok(onBig > 0.5 * onFine && onFine > 200, `field pixels: ${onBig} on the big square, ${onFine} on the fine one`);
+      } finally {
+        await tab.close();
+        other.child.kill('SIGTERM');
+        await once(other.child, 'exit');
+      }
     });
 
     await check('the page raised no script error', async () => assert.deepEqual(pageErrors, []));
