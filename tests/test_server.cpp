@@ -968,5 +968,34 @@ TEST(ServerCycles, GeneratorsAndBoundaryLoopsAreListedAndPrescribed) {
   EXPECT_GT(json::parse(b->body)["report"]["fixed"]["faces"].get<int>(), 0);
 }
 
+// The report says whether the per-face field reads exactly the prescription (the page shows it): two +1
+// crosses on a coarse icosphere turn by more than π/4 across edges, so it does not; the same two as vector
+// field singularities (N = 1, where the limit is π) it does.
+TEST(ServerField, TheReportSaysWhetherTheFieldIsExact) {
+  Running coarse(make_icosphere(1));
+  auto r = coarse.post("/api/solve", {{"N", 4}, {"singularities", {{0, "1"}, {3, "1"}}}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  json j = json::parse(r->body);
+  EXPECT_TRUE(j["report"]["verified"].get<bool>());
+  EXPECT_FALSE(j["report"]["field_exact"].get<bool>());
+  r = coarse.post("/api/solve", {{"N", 1}, {"singularities", {{0, "1"}, {3, "1"}}}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_TRUE(json::parse(r->body)["report"]["field_exact"].get<bool>());
+}
+
+// A boundary alignment that needs interior singularities and gets none: 400 with the library's message.
+TEST(ServerField, AnAlignedDiskWithoutSingularitiesIsRefused) {
+  Running disk(make_disk(8, 8));
+  auto r = disk.post("/api/solve", {{"N", 4}, {"align_boundary", true}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 400) << r->body;
+  EXPECT_NE(r->body.find("need interior singularities summing to 1"), std::string::npos) << r->body;
+  r = disk.post("/api/solve", {{"N", 4}, {"align_boundary", true}, {"singularities", {{0, "1"}}}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200) << r->body;
+}
+
 }  // namespace
 }  // namespace trivcon

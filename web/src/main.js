@@ -378,7 +378,13 @@ async function pump() {
     solvedFixedKey = fixedKey(job.session);
     showField(r, job);
     lastError = '';
-    status(`solved: energy ${r.report.energy.toPrecision(6)}${r.report.verified ? '' : ' (verification failed: see the report)'}`);
+    // Whether the crosses, read face to face by the closest matching (as Directional, QuadWild or MIQ read an
+    // exported field), show exactly the singularities placed (the report's field_exact).
+    const read = r.report.large_turns ? r.report.large_turns.principal_matching_singularities.length : 0;
+    const exact = r.report.field_exact
+      ? ' · field exact'
+      : ` · field NOT exact: read face to face it shows ${read} singular vertices, not those placed (edges turn by π/N or more; trivcon solve --split-large-turns refines the mesh until they do not)`;
+    status(`solved: energy ${r.report.energy.toPrecision(6)}${r.report.verified ? '' : ' (verification failed: see the report)'}${exact}`);
   } catch (e) {
     // The last valid field of this symmetry stays on screen; the message says what went wrong (the CLI's text).
     lastError = e.message;

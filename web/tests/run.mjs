@@ -300,7 +300,7 @@ async function main() {
       const seen = await page.evaluate(() => window.__progressSeen);
       assert.ok(seen.some((t) => /^re-factoring for 1 fixed face\(s\)… \d+\.\d s of about \d+\.\d s$/.test(t)), JSON.stringify(seen));
       assert.equal(await page.evaluate(() => document.getElementById('progress').hidden), true);
-      assert.match(await page.evaluate(() => document.getElementById('status').textContent), /^solved: energy /);
+      assert.match(await page.evaluate(() => document.getElementById('status').textContent), /^solved: energy \S+ · field exact$/);
       const fixed = await page.evaluate(() => window.__trivcon.session.fixed);
       assert.equal(fixed.length, 1);
       const state = await api('/api/state');
