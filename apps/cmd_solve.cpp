@@ -19,7 +19,7 @@
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
-#include "trivcon/refine.h"
+#include "trivcon/split_large_turns.h"
 #include "trivcon/features.h"
 #include "trivcon/generate.h"
 #include "trivcon/matching.h"

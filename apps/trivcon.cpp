@@ -5,7 +5,7 @@
 
 #include "commands.h"
 #include "trivcon/blas.h"
-#include "trivcon/process.h"
+#include "trivcon/tuned_process.h"
 #include "trivcon/error.h"
 
 namespace trivcon::cli {
@@ -14,7 +14,7 @@ MeshData load_mesh(const std::string& path) { return read_mesh(path); }
 }  // namespace trivcon::cli
 
 int main(int argc, char** argv) {
-  trivcon::use_tuned_process(argv);  // BLAS kernels and huge pages: see trivcon/process.h
+  trivcon::use_tuned_process(argv);  // BLAS kernels and huge pages: see trivcon/tuned_process.h
   CLI::App app{"trivcon: direction fields with exactly the singularities you ask for (trivial connections, Crane et al. 2010)"};
   app.set_version_flag("--version", std::string("trivcon ") + TRIVCON_VERSION);
   app.require_subcommand(1);

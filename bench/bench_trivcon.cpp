@@ -46,7 +46,7 @@
 #include "edits.h"
 #include "trivcon/auto.h"
 #include "trivcon/blas.h"
-#include "trivcon/process.h"
+#include "trivcon/tuned_process.h"
 #include "trivcon/cycles.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
@@ -919,7 +919,7 @@ int driver(const std::string& cache, const std::string& dragon, const std::strin
 }  // namespace
 
 int main(int argc, char** argv) {
-  use_tuned_process(argv);  // as the trivcon program does (trivcon/process.h); its children inherit it
+  use_tuned_process(argv);  // as the trivcon program does (trivcon/tuned_process.h); its children inherit it
   CLI::App app{"trivcon benchmark: reading, set-up and edits on generated and real meshes"};
   std::string child, spec, cache = "bench-cache", dragon, json_path, only;
   RunOptions o;

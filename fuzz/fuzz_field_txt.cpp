@@ -1,6 +1,6 @@
 // fuzz/fuzz_field_txt.cpp: a field file (.txt) against the fixed mesh, then what `check` does with it: the
 // field's angles and its indices (trivcon/field_io.h read_field, trivcon/field.h).
-#include "detail/readers.h"
+#include "io/readers.h"
 #include "fuzz_target.h"
 #include "trivcon/field.h"
 

@@ -2,7 +2,7 @@
 // fixed mesh (trivcon/constraints.h read_fixed_directions), then the conflicts `solve` reports for it.
 #include <cmath>
 
-#include "detail/readers.h"
+#include "io/readers.h"
 #include "fuzz_target.h"
 #include "trivcon/constraints.h"
 

@@ -1,5 +1,5 @@
 // fuzz/fuzz_gz.cpp: a gzipped mesh (read_mesh on "mesh.obj.gz" and the like): the bytes are gunzipped as
-// read_file_bytes does (src/detail/gzip.h), then what comes out is read as OBJ, OFF and PLY in turn.
+// read_file_bytes does (src/io/gzip.h), then what comes out is read as OBJ, OFF and PLY in turn.
 //
 // Under libFuzzer a custom mutator keeps most inputs valid gzip: it gunzips the input, mutates the
 // decompressed mesh and compresses it again (as one member, or split into two, sometimes with zero padding
@@ -10,7 +10,7 @@
 #include <cstring>
 #include <random>
 
-#include "detail/gzip.h"
+#include "io/gzip.h"
 #include "fuzz_target.h"
 
 TRIVCON_FUZZ_TARGET(gz) {

@@ -1,6 +1,6 @@
 // fuzz/fuzz_sing.cpp: a plain singularity file (-s FILE: "VERTEX INDEX" lines), read with N = 4 and checked
 // against the fixed mesh as `solve` does (trivcon/indices.h read_singularities, validate_prescription).
-#include "detail/readers.h"
+#include "io/readers.h"
 #include "fuzz_target.h"
 
 TRIVCON_FUZZ_TARGET(sing) {

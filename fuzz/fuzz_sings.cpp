@@ -1,6 +1,6 @@
 // fuzz/fuzz_sings.cpp: a singularity file in Directional's format (-s FILE.sings: "N count", then "vertex n"
 // lines), read with N = 4 and checked against the fixed mesh as `solve` does.
-#include "detail/readers.h"
+#include "io/readers.h"
 #include "fuzz_target.h"
 
 TRIVCON_FUZZ_TARGET(sings) {

@@ -3,7 +3,7 @@
 #include "summary.h"
 #include "trivcon/matching.h"
 #include "trivcon/blas.h"
-#include "trivcon/process.h"
+#include "trivcon/tuned_process.h"
 
 #include <cstdlib>
 #include <string>
@@ -21,13 +21,13 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
   report["weights"] = run.weights;
   report["solver"] = run.solver;
   report["blas_kernels"] = blas_kernels();
-  {  // huge pages for malloc's large blocks (trivcon/process.h)
+  {  // huge pages for malloc's large blocks (trivcon/tuned_process.h)
     const char* tunables = std::getenv("GLIBC_TUNABLES");
     const std::string t = tunables ? tunables : "";
     report["huge_pages"] = {{"kernel", transparent_huge_pages_mode()},
                             {"malloc", t.find("glibc.malloc.hugetlb=1") != std::string::npos || t.find("glibc.malloc.hugetlb=2") != std::string::npos}};
   }
-  {  // how long OpenBLAS's idle threads spin (trivcon/process.h): null where OPENBLAS_THREAD_TIMEOUT is unset
+  {  // how long OpenBLAS's idle threads spin (trivcon/tuned_process.h): null where OPENBLAS_THREAD_TIMEOUT is unset
     const char* timeout = std::getenv("OPENBLAS_THREAD_TIMEOUT");
     report["blas_thread_timeout"] = timeout ? nlohmann::ordered_json(timeout) : nlohmann::ordered_json(nullptr);
   }

@@ -132,7 +132,7 @@ TEST(Auto, CubeSphereGetsEightQuarterSingularitiesAtTheCorners) {
 }
 
 // Above 50k faces the factor's order is the better of AMD and a coordinate dissection, found side by side on
-// two threads (src/auto.cpp); with one thread AMD alone. The field does not depend on which: on the cube
+// two threads (src/field/smoothest_field.cpp); with one thread AMD alone. The field does not depend on which: on the cube
 // (a regular grid of faces, where the dissection needs fewer flops) both give the same eight corners and the
 // same smoothest field up to round-off.
 TEST(Auto, TheFactorsOrderDoesNotChangeTheField) {

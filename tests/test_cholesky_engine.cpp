@@ -1,13 +1,13 @@
 // The Cholesky route's two numeric factorizations (SolverOptions::factorization): trivcon's own on
-// several threads (src/detail/supernodal.h) and CHOLMOD's cholmod_factorize give the same connection,
+// several threads (src/linalg/supernodal.h) and CHOLMOD's cholmod_factorize give the same connection,
 // the same chosen indices and the same energy, on every kind of system (vertex rows only, with cycle
 // rows, with fixed-face paths dense and sparse), and fail alike; the numeric libraries pass the start-up
-// check (src/detail/cholmod.h).
+// check (src/linalg/cholmod.h).
 #include <gtest/gtest.h>
 
 #include <map>
 
-#include "detail/cholmod.h"
+#include "linalg/cholmod.h"
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"

@@ -19,7 +19,7 @@
 
 #include "support.h"
 #include "trivcon/blas.h"
-#include "trivcon/process.h"
+#include "trivcon/tuned_process.h"
 #include "trivcon/generate.h"
 #include "trivcon/geometry.h"
 #include "trivcon/io.h"
@@ -522,14 +522,14 @@ TEST(CliSolve, SphereWithTwoPoles) {
   if (std::getenv("OPENBLAS_CORETYPE") == nullptr && !native_blas_kernels().empty()) {
     EXPECT_NE(rep["blas_kernels"].get<std::string>(), "Prescott");
   }
-  // Huge pages (trivcon/process.h): asked for where the kernel gives them only on request, unless the
+  // Huge pages (trivcon/tuned_process.h): asked for where the kernel gives them only on request, unless the
   // environment chooses (GLIBC_TUNABLES naming glibc.malloc.hugetlb).
   EXPECT_EQ(rep["huge_pages"]["kernel"], transparent_huge_pages_mode());
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (std::string(transparent_huge_pages_mode()) == "madvise" && (!tunables || !std::strstr(tunables, "glibc.malloc.hugetlb"))) {
     EXPECT_EQ(rep["huge_pages"]["malloc"], true);
   }
-  // OpenBLAS's idle threads sleep at once (trivcon/process.h), unless OPENBLAS_THREAD_TIMEOUT chooses.
+  // OpenBLAS's idle threads sleep at once (trivcon/tuned_process.h), unless OPENBLAS_THREAD_TIMEOUT chooses.
   if (const char* timeout = std::getenv("OPENBLAS_THREAD_TIMEOUT")) {
     EXPECT_EQ(rep["blas_thread_timeout"], timeout);
   } else if (!blas_kernels().empty()) {

@@ -13,7 +13,7 @@
 #include "trivcon/field_io.h"
 #include "trivcon/io.h"
 #include "trivcon/matching.h"
-#include "trivcon/refine.h"
+#include "trivcon/split_large_turns.h"
 
 namespace trivcon {
 namespace {
@@ -308,7 +308,7 @@ TEST(Matching, SplitLargeTurnsKeepsFixedDirections) {
   EXPECT_EQ(independent_indices(out.V, out.F, dirs, 4, nullptr), want);
 }
 
-// The library function behind --split-large-turns (trivcon/refine.h): converged, ids kept, each face's
+// The library function behind --split-large-turns (trivcon/split_large_turns.h): converged, ids kept, each face's
 // parent the input face it lies in, a fixed face's direction passed to its children, and an independent
 // principal matching reads exactly the prescription on the refined mesh.
 TEST(Matching, SplitLargeTurnsLibraryFunction) {

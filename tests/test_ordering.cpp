@@ -1,4 +1,4 @@
-// The fill-reducing orders of src/detail/ordering.h (internal): the coordinate dissection against AMD and
+// The fill-reducing orders of src/linalg/ordering.h (internal): the coordinate dissection against AMD and
 // against the fill it must avoid, through CHOLMOD's own symbolic analysis.
 #include <cholmod.h>
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 #include <random>
 #include <vector>
 
-#include "detail/cholmod.h"
-#include "detail/ordering.h"
+#include "linalg/cholmod.h"
+#include "linalg/ordering.h"
 #include "trivcon/generate.h"
 #include "trivcon/topology.h"
 

@@ -1,6 +1,6 @@
-// The numeric supernodal factorization (src/supernodal.h, internal) against CHOLMOD's own, on the same
+// The numeric supernodal factorization (src/linalg/supernodal.h, internal) against CHOLMOD's own, on the same
 // symbolic factorization; the split of the elimination tree it and the backward substitution use; and the
-// parallel substitution (src/detail/substitution.h) against CHOLMOD's solve.
+// parallel substitution (src/linalg/substitution.h) against CHOLMOD's solve.
 #include <cholmod.h>
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -15,9 +15,9 @@
 #include <set>
 #include <type_traits>
 
-#include "detail/cholmod.h"
-#include "detail/substitution.h"
-#include "detail/supernodal.h"
+#include "linalg/cholmod.h"
+#include "linalg/substitution.h"
+#include "linalg/supernodal.h"
 #include "trivcon/error.h"
 #include "trivcon/generate.h"
 
@@ -58,7 +58,7 @@ Upper shifted_laplacian(const Mesh& mesh, double shift, unsigned seed) {
 
 cholmod_sparse view(const Upper& M) { return detail::upper_view(M.outer, M.inner, M.values, M.n); }
 
-// The library's CHOLMOD workspace (src/detail/cholmod.h), as the solver sets it up.
+// The library's CHOLMOD workspace (src/linalg/cholmod.h), as the solver sets it up.
 struct Cholmod {
   detail::CholmodContext context;
   cholmod_common& c = *context;
@@ -348,7 +348,7 @@ TEST(Supernodal, ReportsTheColumnThatIsNotPositiveDefinite) {
   }
 }
 
-// Checks a split against split_tree's contract (src/detail/supernodal.h) and returns what it left below
+// Checks a split against split_tree's contract (src/linalg/supernodal.h) and returns what it left below
 // the top: the loads of the parts (the sum of `work` over each) and the subtree roots there.
 struct BelowTop {
   std::vector<double> load;

@@ -1,6 +1,6 @@
 // trivcon/blas.h: which BLAS kernels the factorization runs on, and how many threads each BLAS call uses.
 //
-// The supernodal factorization (src/supernodal.h) spends most of its time in BLAS (dgemm, dsyrk, dtrsm). Debian 12's
+// The supernodal factorization (src/linalg/supernodal.h) spends most of its time in BLAS (dgemm, dsyrk, dtrsm). Debian 12's
 // OpenBLAS 0.3.21 picks its kernels for the CPU when it is loaded, and does not recognise recent CPUs
 // (e.g. Intel family 6 model 207, the machine of BENCHMARKS.md): it falls back to its generic "Prescott"
 // (SSE3) kernels, which factor 1.3–1.5× slower there than its AVX-512 ("SkylakeX") ones. OpenBLAS only
@@ -18,7 +18,7 @@ std::string blas_kernels();
 // AVX-512 (F, CD, BW, DQ, VL), "Haswell" with AVX2 and FMA, else "".
 std::string native_blas_kernels();
 
-// A program's main() gets the better kernels by calling use_tuned_process(argv) (trivcon/process.h), which
+// A program's main() gets the better kernels by calling use_tuned_process(argv) (trivcon/tuned_process.h), which
 // re-executes it with OPENBLAS_CORETYPE set to native_blas_kernels() when OpenBLAS fell back to its generic ones.
 
 // While an object of this class lives, OpenBLAS runs every call on the calling thread alone (its own

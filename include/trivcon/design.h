@@ -49,7 +49,7 @@ struct Design {
   // What a consumer of the per-face field sees: true when the field, read on its own with the closest
   // matching across every edge (field_indices), shows exactly the connection's indices at every vertex,
   // generator and boundary loop. False where the connection turns by π/N or more across some edge (then
-  // split_large_turns, trivcon/refine.h, refines the mesh until it is true); design_verified does not look at it.
+  // split_large_turns, trivcon/split_large_turns.h, refines the mesh until it is true); design_verified does not look at it.
   bool field_exact = true;
   double max_fixed_error = 0;            // largest |field − fixed direction| modulo 2π/N over fixed faces
   std::vector<FixedConflict> conflicts;  // adjacent fixed faces the field must turn sharply between

@@ -21,7 +21,7 @@
 // interior vertices; on a closed component one vertex row is dropped (Gauss–Bonnet makes it redundant),
 // and on a component with boundary one loop row is (its index follows from the others). A W Aᵀ is
 // factored once (supernodal LLᵀ: CHOLMOD's symbolic analysis, our numeric factorization into CHOLMOD's
-// factor on OpenMP's threads, src/detail/supernodal.h, or CHOLMOD's own with Factorization::Cholmod; OpenBLAS), the vertex rows in a
+// factor on OpenMP's threads, src/linalg/supernodal.h, or CHOLMOD's own with Factorization::Cholmod; OpenBLAS), the vertex rows in a
 // fill-reducing order and the cycle rows last, so that the trailing block of the factor is the Cholesky factor of the Schur complement S =
 // CWCᵀ − CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is minimum degree: CAMD with the cycle rows constrained last, or AMD without cycle rows. A new
 // prescription only changes b: nothing is refactored. The forward substitution of the prescription without singularities is stored, so an
@@ -66,7 +66,7 @@ enum class SolverKind { Cholesky, QR };
 // top of the tree with multithreaded BLAS), or CHOLMOD's cholmod_factorize (Cholmod: one supernode after
 // another, slower on a mesh, the reference). Both fill the same factor and give the same results to
 // round-off. Construction throws trivcon::Error if the CHOLMOD or BLAS library loaded is not the kind the
-// library was built for (src/detail/cholmod.h).
+// library was built for (src/linalg/cholmod.h).
 enum class Factorization { Parallel, Cholmod };
 
 struct SolverOptions {
@@ -79,7 +79,7 @@ struct SolverOptions {
   // turning" measures what it does to large turns and energies). In [0, 1].
   double weight_floor = 0;
   // Per edge (empty: none): each interior edge's weight is multiplied by edge_weight_scale[e] > 0 after the
-  // rest of the policy (split_large_turns, trivcon/refine.h, lowers the weights of edges that keep turning
+  // rest of the policy (split_large_turns, trivcon/split_large_turns.h, lowers the weights of edges that keep turning
   // by π/N or more). Its size must be the edge count.
   std::vector<double> edge_weight_scale = {};
 };

@@ -1,0 +1,368 @@
+// The Cholesky route of ConnectionSolver (src/connection/cholesky_engine.h).
+#include "connection/cholesky_engine.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <memory>
+#include <string>
+
+#include "linalg/ordering.h"
+#include "linalg/parallel.h"
+#include "linalg/substitution.h"
+#include "linalg/supernodal.h"
+#include "linalg/timing.h"
+#include "trivcon/error.h"
+
+namespace trivcon::detail {
+
+AnalysisState::~AnalysisState() {
+  if (factor) cholmod_free_factor(&factor, cc.get());
+}
+
+namespace {
+
+// A fill-reducing order of the nD vertex rows of M (the nC cycle rows come last). Minimum degree (AMD;
+// CAMD when there are cycle rows, constrained to order them last, so that it sees how they couple the
+// vertices: a quarter fewer flops on the dragon), then postordered by the vertex block's elimination
+// tree so that CHOLMOD finds large supernodes without postordering the whole system (which could move
+// the cycle rows). Not CHOLMOD's default choice, which tries METIS on large meshes: its analysis alone
+// takes 3 s (the dragon) to 16 s (the dragon subdivided) on our 2-core machine, more than the fill it
+// saves. (A nested dissection by vertex coordinates, tried as a second candidate, cut the flops by a
+// third on smooth closed surfaces but not the time with AVX-512 BLAS kernels, and lost on the dragon;
+// see BENCHMARKS.md.)
+std::vector<int> vertex_order(const Csc& M, int nD, int nC, cholmod_common& cc) {
+  std::vector<int> order(nD);
+  if (nD == 0) return order;
+  if (nC > 0) {
+    cholmod_sparse A = upper_view(M.outer, M.inner, M.values, nD + nC);
+    std::vector<int> last(nD + nC, 0), full(nD + nC);
+    std::fill(last.begin() + nD, last.end(), 1);
+    require(cholmod_camd(&A, nullptr, 0, last.data(), full.data(), &cc) != 0, "CHOLMOD could not order the constraint system", cc);
+    std::copy(full.begin(), full.begin() + nD, order.begin());
+    for (int k = 0; k < nD; ++k) require(order[k] < nD, "CHOLMOD did not order the cycle rows last", cc);
+  } else {
+    cholmod_sparse A = upper_view(M.outer, M.inner, M.values, nD);
+    require(cholmod_amd(&A, nullptr, 0, order.data(), &cc) != 0, "CHOLMOD could not order the vertex Laplacian", cc);
+  }
+  const ordering::Pattern pattern = ordering::leading_block_pattern(M.outer, M.inner, nD);
+  std::vector<int> parent = ordering::elimination_tree(pattern, order), post(nD);
+  require(cholmod_postorder(parent.data(), nD, nullptr, post.data(), &cc) == nD, "CHOLMOD could not postorder the elimination tree", cc);
+  std::vector<int> postordered(nD);
+  for (int k = 0; k < nD; ++k) postordered[k] = order[post[k]];
+  return postordered;
+}
+
+// Symbolic analysis of the whole system: the vertex rows in `order`, then the cycle rows.
+cholmod_factor* symbolic(const Csc& M, std::vector<int> order, int nD, int nC, cholmod_common& c) {
+  const int n = nD + nC;
+  for (int r = nD; r < n; ++r) order.push_back(r);
+  cholmod_sparse A = upper_view(M.outer, M.inner, M.values, n);
+  c.nmethods = 1;
+  c.method[0].ordering = CHOLMOD_GIVEN;
+  c.postorder = 0;  // keep the cycle rows last (the vertex order is postordered already)
+  cholmod_factor* L = cholmod_analyze_p(&A, order.data(), nullptr, 0, &c);
+  require(L != nullptr, "CHOLMOD could not analyse the constraint system", c);
+  return L;
+}
+
+}  // namespace
+
+void analyse(const Csc& M, int nD, int nC, AnalysisState& state) {
+  if (nD + nC > 0) state.factor = symbolic(M, vertex_order(M, nD, nC, *state.cc), nD, nC, *state.cc);
+}
+
+namespace {
+
+using supernodal::Supernodes;
+
+// See src/connection/cholesky_engine.h.
+class CholeskyEngine : public SolverEngine {
+ public:
+  // CHOLMOD's workspace, and the symbolic factorization when one was given (see factorize). Mutable:
+  // CHOLMOD's solves write to their workspace.
+  mutable std::unique_ptr<AnalysisState> cholmod_ = std::make_unique<AnalysisState>();
+  cholmod_common& cc() const { return *cholmod_->cc; }
+  Factorization factorization_;
+  const char* numeric_by_ = "";  // who computed the factor's values (SetupTimings::numeric_factorization)
+  cholmod_factor* factor = nullptr;
+  bool analysis_adopted = false;
+  Eigen::VectorXd w;
+  int m = 0, nD = 0, nC = 0;
+  // The constraint rows touching each system edge (column a of A); after the factorization, as
+  // positions in factor order.
+  EdgeRows edge_rows_;
+  Eigen::MatrixXd R_CC, R_inv;  // lower triangular; P = R_invᵀ R_inv
+  // Sparse forward substitution (see forward_update).
+  std::vector<int> position_;  // factor position of each row of M (the inverse of factor->Perm)
+  std::vector<int> super_of_col_, super_parent_;
+  Eigen::VectorXd base_b_, base_z_;  // base right-hand side of the vertex rows, and L⁻¹ Π [base_b; 0]
+  mutable std::vector<int> super_stamp_;
+  mutable Eigen::VectorXd forward_work_;
+  mutable int stamp_ = 0;
+  // Backward substitution on OpenMP's threads (src/linalg/substitution.h), planned once the factor has its values.
+  std::unique_ptr<supernodal::Substitution<double>> substitution_;
+
+  // The rows of A (see normal_matrix): vertex rows given per system edge by the rows of its two ends (a
+  // boundary or dropped vertex has none), then the extra rows Et (fixed-face paths that are ordered with
+  // the vertex rows), then the cycle rows Ct (last). `analysis`, if given, is asked for a symbolic
+  // factorization once A W Aᵀ is assembled; it is used if it was made for this pattern.
+  CholeskyEngine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et, const SparseMatrix& Ct, const Eigen::VectorXd& w_,
+                 Factorization factorization, SetupTimings& timings, const std::function<std::unique_ptr<AnalysisState>()>& analysis)
+      : factorization_(factorization), w(w_) {
+    check_numeric_libraries();
+    m = static_cast<int>(ends.size()), nD = num_vertex_rows + static_cast<int>(Et.cols()), nC = static_cast<int>(Ct.cols());
+    const int n = nD + nC;
+    try {
+      auto t0 = Clock::now();
+      Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct, w, edge_rows_);
+      timings.assemble += seconds_since(t0);
+      if (n == 0) return;
+      if (analysis) {
+        t0 = Clock::now();
+        adopt(M, analysis());
+        timings.analysis_wait += seconds_since(t0);
+        timings.analysis_adopted = analysis_adopted;
+      }
+      t0 = Clock::now();
+      factorize(M);
+      timings.factor += seconds_since(t0);
+      timings.numeric_factorization = numeric_by_;
+      t0 = Clock::now();
+      prepare_schur();
+      timings.schur += seconds_since(t0);
+    } catch (...) {  // the destructor does not run for an object whose constructor throws
+      release();
+      throw;
+    }
+  }
+  ~CholeskyEngine() override { release(); }
+  void release() {
+    if (factor) cholmod_free_factor(&factor, &cc());
+  }
+
+  // Takes a symbolic factorization made for exactly this pattern (compared entry by entry; a different
+  // one is dropped and the factorization analyses its own).
+  void adopt(const Csc& M, std::unique_ptr<AnalysisState> given) {
+    if (!given || !given->factor || given->nD != nD || given->nC != nC || given->outer != M.outer || given->inner != M.inner) return;
+    factor = given->factor, given->factor = nullptr;
+    cholmod_ = std::move(given);
+    std::vector<int>().swap(cholmod_->outer), std::vector<int>().swap(cholmod_->inner);  // compared: not needed any more
+    analysis_adopted = true;
+  }
+
+  // The numeric factorization into the symbolic factor: ours (OpenMP's threads) or CHOLMOD's own. Returns
+  // the first column not positive definite, or n.
+  int numeric(const Csc& M) {
+    const int n = nD + nC;
+    if (factorization_ == Factorization::Parallel) {
+      numeric_by_ = "trivcon";
+      return supernodal::factorize(*factor, M.outer, M.inner, M.values, cc());
+    }
+    numeric_by_ = "cholmod";
+    cholmod_sparse A = upper_view(M.outer, M.inner, M.values, n);
+    const int ok = cholmod_factorize(&A, factor, &cc());
+    check(ok && (cc().status == CHOLMOD_OK || cc().status == CHOLMOD_NOT_POSDEF), "CHOLMOD factorization failed");
+    return cc().status == CHOLMOD_NOT_POSDEF ? static_cast<int>(factor->minor) : n;
+  }
+
+  void factorize(const Csc& M) {
+    const int n = nD + nC;
+    if (!factor) factor = symbolic(M, vertex_order(M, nD, nC, cc()), nD, nC, cc());
+    const int* perm = static_cast<const int*>(factor->Perm);
+    if (numeric(M) < n) {
+      const int row = static_cast<int>(factor->minor);
+      throw Error(row < n && perm[row] >= nD
+                      ? "the holonomy of the generators, boundary loops or fixed-direction paths cannot be controlled independently "
+                        "with these weights (the constraint system is singular); try --weights unit"
+                      : "the constraint system is not positive definite with these weights; try --weights unit");
+    }
+    check(cc().status == CHOLMOD_OK && factor->is_super && factor->is_ll, "CHOLMOD factorization failed");
+    for (int k = nD; k < n; ++k) check(perm[k] == k, "CHOLMOD did not keep the cycle rows last");
+    prepare_sparse_forward();
+  }
+
+  // R_CC and its inverse: the Schur complement's factor, for choosing free cycle indices.
+  void prepare_schur() {
+    extract_cycle_block();
+    if (nC > 0) {
+      const double min_diag = R_CC.diagonal().minCoeff(), max_diag = R_CC.diagonal().maxCoeff();
+      if (!(min_diag > 1e-8 * max_diag))
+        throw Error(
+            "the holonomy of the generators, boundary loops or fixed-direction paths is nearly undetermined with these weights "
+            "(ill-conditioned Schur complement); try --weights unit");
+      R_inv = R_CC.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(nC, nC));
+      P_diagonal_ = R_inv.colwise().squaredNorm().transpose();
+    }
+  }
+
+  std::string ordering() const override { return nC > 0 ? "CAMD" : "AMD"; }
+
+  void check(bool ok, const char* what) const { require(ok, what, cc()); }
+
+  // Supernodal elimination tree and the factor position of each row, for forward_update.
+  void prepare_sparse_forward() {
+    const int n = nD + nC;
+    const int* perm = static_cast<const int*>(factor->Perm);
+    position_.resize(n);
+    for (int k = 0; k < n; ++k) position_[perm[k]] = k;
+    const Supernodes L(factor);
+    super_of_col_ = L.owners();
+    super_parent_ = supernodal::supernode_parents(L, super_of_col_);
+    super_stamp_.assign(L.count, -1);
+    for (int& r : edge_rows_.row) r = position_[r];
+    substitution_ = std::make_unique<supernodal::Substitution<double>>(*factor);
+  }
+
+  // z ← L⁻ᵀ z (in factor order), on OpenMP's threads: the top of the tree, then one set of disjoint subtrees
+  // per thread (src/linalg/substitution.h).
+  void backward(Eigen::VectorXd& z) const { substitution_->backward_in_factor_order(z.data()); }
+
+  // z += L⁻¹ d for d with the few nonzeros `entries` (factor positions, values): only the supernodes on
+  // the paths from those entries to the root of the elimination tree are touched, in increasing order.
+  void forward_update(const std::vector<std::pair<int, double>>& entries, Eigen::VectorXd& z) const {
+    const Supernodes L(factor);
+    ++stamp_;
+    std::vector<int> path;
+    for (const auto& [k, value] : entries)
+      for (int s = super_of_col_[k]; s != -1 && super_stamp_[s] != stamp_; s = super_parent_[s])
+        super_stamp_[s] = stamp_, path.push_back(s);
+    std::sort(path.begin(), path.end());
+    Eigen::VectorXd& d = forward_work_;  // zero outside a call
+    if (d.size() != z.size()) d.setZero(z.size());
+    for (const auto& [k, value] : entries) d(k) += value;
+    Eigen::VectorXd below;
+    for (int s : path) {
+      const int ncol = L.cols(s), nrow = L.height(s);
+      const auto Ls = L.values(s);
+      auto block = d.segment(L.first(s), ncol);
+      Ls.topRows(ncol).triangularView<Eigen::Lower>().solveInPlace(block);
+      if (nrow == ncol) continue;
+      below.noalias() = Ls.bottomRows(nrow - ncol) * block;
+      for (int i = 0; i < nrow - ncol; ++i) d(L.row(s, ncol + i)) -= below(i);
+    }
+    // Every entry touched lies in the columns of the path's supernodes (the rows below a supernode are
+    // columns of its ancestors): add them to z and zero them again.
+    for (int s : path) {
+      auto touched = d.segment(L.first(s), L.cols(s));
+      z.segment(L.first(s), L.cols(s)) += touched;
+      touched.setZero();
+    }
+  }
+
+  // R_CC: the factor's entries at rows and columns ≥ nD (in factor order), read from the supernodes.
+  void extract_cycle_block() {
+    R_CC = Eigen::MatrixXd::Zero(nC, nC);
+    if (nC == 0) return;
+    const Supernodes L(factor);
+    for (int s = 0; s < L.count; ++s) {
+      const auto Ls = L.values(s);
+      for (int c = 0; c < L.cols(s); ++c) {
+        const int col = L.first(s) + c;
+        if (col < nD) continue;
+        for (int r = c; r < L.height(s); ++r) R_CC(L.row(s, r) - nD, col - nD) = Ls(r, c);
+      }
+    }
+  }
+
+  // L⁻¹ b by CHOLMOD (in factor order), for a right-hand side that is not an update of the base one.
+  Eigen::VectorXd lower_solve(const Eigen::VectorXd& b) const {
+    cholmod_dense B = dense_view(b);
+    cholmod_dense* X = cholmod_solve(CHOLMOD_L, factor, &B, &cc());
+    check(X != nullptr && cc().status == CHOLMOD_OK, "CHOLMOD solve failed");
+    Eigen::VectorXd out = Eigen::Map<Eigen::VectorXd>(static_cast<double*>(X->x), b.size());
+    cholmod_free_dense(&X, &cc());
+    return out;
+  }
+  // L⁻¹ Π [b_D; 0]: the forward substitution with the cycle right-hand sides zero.
+  Eigen::VectorXd forward(const Eigen::VectorXd& b_D) const {
+    Eigen::VectorXd permuted = Eigen::VectorXd::Zero(nD + nC);
+    for (int r = 0; r < nD; ++r) permuted(position_[r]) = b_D(r);
+    return lower_solve(permuted);
+  }
+
+  void set_base_rhs(const Eigen::VectorXd& b_D) override {
+    if (nD + nC == 0) return;
+    base_b_ = b_D;
+    base_z_ = forward(b_D);
+  }
+
+  Eigen::VectorXd apply_P(const Eigen::VectorXd& v) const override {
+    const Eigen::VectorXd r = R_inv.triangularView<Eigen::Lower>() * v;
+    return R_inv.triangularView<Eigen::Lower>().transpose() * r;
+  }
+  Eigen::VectorXd P_column(int i) const override {
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(nC);
+    r.tail(nC - i) = R_inv.col(i).tail(nC - i);
+    return R_inv.triangularView<Eigen::Lower>().transpose() * r;
+  }
+  Eigen::MatrixXd dense_P() const override { return R_inv.transpose() * R_inv.triangularView<Eigen::Lower>(); }
+  const Eigen::MatrixXd& P_factor(bool& lower) const override {
+    lower = true;
+    return R_inv;
+  }
+
+  Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const override {
+    const int n = nD + nC;
+    if (n == 0) return Eigen::VectorXd::Zero(m);
+    // Forward substitution with b_C = 0: z_D is final; z_C = z_C0 + R_CC⁻¹ b_C for any b_C (the cycle
+    // rows come last, in their own order, so positions ≥ nD of Πb are b_C). When b_D differs from the
+    // base in few rows, z = base_z + L⁻¹ Π (b_D − base_b) touches only their paths in the tree.
+    Eigen::VectorXd z;
+    std::vector<std::pair<int, double>> changed;
+    if (base_b_.size() == b_D.size()) {
+      for (int r = 0; r < nD && changed.size() * 64 <= static_cast<size_t>(n); ++r)
+        if (b_D(r) != base_b_(r)) changed.emplace_back(position_[r], b_D(r) - base_b_(r));
+    }
+    if (base_b_.size() == b_D.size() && changed.size() * 64 <= static_cast<size_t>(n)) {
+      z = base_z_;
+      forward_update(changed, z);
+    } else {
+      z = forward(b_D);
+    }
+    if (nC > 0) {
+      const Eigen::VectorXd z_C0 = z.tail(nC);
+      const Eigen::VectorXd b_C = choose(-(R_CC * z_C0));  // the energy ‖z‖² is least at b_C = −R_CC z_C0
+      z.tail(nC) = z_C0 + R_CC.triangularView<Eigen::Lower>().solve(b_C);
+    }
+    Eigen::VectorXd& y = z;  // [λ; μ] in factor order
+    backward(y);
+    return edge_values(y);
+  }
+
+  bool refine(const Eigen::VectorXd& b, Eigen::VectorXd& x) const override {
+    const int n = nD + nC;
+    if (n == 0) return false;
+    // r = Π (b − A x), in factor order.
+    Eigen::VectorXd r(n);
+    for (int row = 0; row < n; ++row) r(position_[row]) = b(row);
+    for (int a = 0; a < m; ++a)
+      for (int k = edge_rows_.start[a]; k < edge_rows_.start[a + 1]; ++k) r(edge_rows_.row[k]) -= edge_rows_.coefficient[k] * x(a);
+    Eigen::VectorXd y = lower_solve(r);
+    backward(y);
+    x += edge_values(y);
+    return true;
+  }
+
+ private:
+  // x = W Aᵀ y for y in factor order.
+  Eigen::VectorXd edge_values(const Eigen::VectorXd& y) const {
+    Eigen::VectorXd x(m);
+#pragma omp parallel for schedule(static) if (m > kParallelMinEditElements)
+    for (int a = 0; a < m; ++a) {
+      double sum = 0;
+      for (int k = edge_rows_.start[a]; k < edge_rows_.start[a + 1]; ++k) sum += edge_rows_.coefficient[k] * y(edge_rows_.row[k]);
+      x(a) = w(a) * sum;
+    }
+    return x;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<SolverEngine> make_cholesky_engine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et,
+                                                   const SparseMatrix& Ct, const Eigen::VectorXd& w, Factorization factorization,
+                                                   SetupTimings& timings, const std::function<std::unique_ptr<AnalysisState>()>& analysis) {
+  return std::make_unique<CholeskyEngine>(ends, num_vertex_rows, Et, Ct, w, factorization, timings, analysis);
+}
+
+}  // namespace trivcon::detail

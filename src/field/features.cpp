@@ -1,0 +1,189 @@
+#include "trivcon/features.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "io/text_lines.h"
+#include "trivcon/error.h"
+#include "trivcon/field.h"
+#include "trivcon/io.h"
+
+namespace trivcon {
+
+namespace {
+
+// The edge joining vertices i and j (either order), or −1.
+int edge_of(const Topology& t, int i, int j) {
+  for (int a = t.vertex_edge_offsets[i]; a < t.vertex_edge_offsets[i + 1]; ++a) {
+    const int e = t.vertex_edges[a];
+    if (t.edge_vertices(e, 0) == std::min(i, j) && t.edge_vertices(e, 1) == std::max(i, j)) return e;
+  }
+  return -1;
+}
+
+// Corner k of face f such that the face's half-edge k → k+1 is edge e (in the oriented Topology::F).
+int corner_of(const Topology& t, int f, int e) {
+  for (int k = 0; k < 3; ++k)
+    if (t.face_edges(f, k) == e) return k;
+  return -1;
+}
+
+using Lines = detail::TextLines;
+
+
+std::vector<std::string> split(const std::string& line, char separator) {
+  std::vector<std::string> out;
+  if (separator == ' ') {
+    std::istringstream fields(line);
+    std::string token;
+    while (fields >> token) out.push_back(token);
+    return out;
+  }
+  std::string token;
+  std::istringstream fields(line);
+  while (std::getline(fields, token, separator)) {
+    const size_t a = token.find_first_not_of(" \t"), b = token.find_last_not_of(" \t");
+    out.push_back(a == std::string::npos ? "" : token.substr(a, b - a + 1));
+  }
+  return out;
+}
+
+}  // namespace
+
+double dihedral_angle(const Topology& t, const Geometry& g, int e) {
+  if (t.is_boundary_edge(e)) return 0;
+  const Eigen::Vector3d nL = g.normal.row(t.edge_faces(e, 0)), nR = g.normal.row(t.edge_faces(e, 1));
+  return std::atan2(nL.cross(nR).norm(), nL.dot(nR));
+}
+
+bool is_convex_edge(const MatrixX3d& V, const Topology& t, const Geometry& g, int e) {
+  if (t.is_boundary_edge(e)) return false;
+  const Eigen::Vector3d nL = g.normal.row(t.edge_faces(e, 0)), nR = g.normal.row(t.edge_faces(e, 1));
+  const Eigen::Vector3d d = V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0));
+  return nL.cross(nR).dot(d) > 0;
+}
+
+std::vector<int> sharp_edges(const MatrixX3d& V, const Topology& t, const Geometry& g, double degrees) {
+  (void)V;  // the normals come from the geometry; V is taken as by the other feature functions
+  if (!(degrees >= 0 && degrees <= 180)) {
+    std::ostringstream s;
+    s << degrees;
+    throw Error("feature angle " + s.str() + " out of range: expected degrees in [0, 180]");
+  }
+  const double limit = degrees * kPi / 180;
+  std::vector<int> out;
+  for (int e = 0; e < t.num_edges; ++e)
+    if (!t.is_boundary_edge(e) && dihedral_angle(t, g, e) > limit) out.push_back(e);
+  return out;
+}
+
+std::vector<int> read_feature_edges(const std::string& path, const Topology& t) {
+  Lines lines(read_file_bytes(path), path);
+  std::vector<int> line_of(t.num_edges, 0);  // the line that listed each edge (0: none)
+  std::vector<int> out;
+  while (lines.next()) {
+    const std::vector<std::string> tokens = split(lines.line, ' ');
+    if (tokens.size() != 2)
+      throw Error(lines.where() + ": expected two vertex ids 'i j', got " + std::to_string(tokens.size()) + " fields");
+    const int i = static_cast<int>(detail::whole_number(tokens[0], lines, 0, t.num_vertices - 1, "vertex id"));
+    const int j = static_cast<int>(detail::whole_number(tokens[1], lines, 0, t.num_vertices - 1, "vertex id"));
+    const std::string pair = "(" + std::to_string(i) + ", " + std::to_string(j) + ")";
+    const int e = i == j ? -1 : edge_of(t, i, j);
+    if (e < 0) throw Error(lines.where() + ": " + pair + " is not an edge of the mesh");
+    if (t.is_boundary_edge(e))
+      throw Error(lines.where() + ": " + pair + " is a boundary edge; features are interior edges (use --align-boundary for the boundary)");
+    if (line_of[e]) throw Error(lines.where() + ": edge " + pair + " is listed twice (first at line " + std::to_string(line_of[e]) + ")");
+    line_of[e] = lines.number;
+    out.push_back(e);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const Geometry& g, const std::vector<int>& edges, int N) {
+  if (N < 1) throw Error("feature_alignment: N = " + std::to_string(N) + " (need N >= 1)");
+  // Per face, its feature edges with their direction (p_j − p_i, i < j, in the face's frame) and length.
+  struct Candidate {
+    int edge;
+    double angle, length;
+  };
+  std::map<int, std::vector<Candidate>> beside;
+  for (int e : edges) {
+    if (e < 0 || e >= t.num_edges || t.is_boundary_edge(e))
+      throw Error("feature_alignment: edge " + std::to_string(e) + " is not an interior edge of the mesh");
+    const double length = (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).norm();
+    for (int side = 0; side < 2; ++side) {
+      const int f = t.edge_faces(e, side);
+      // L holds i → j, R holds j → i: R's half-edge is turned by π to give the same sense.
+      const double angle = wrap_angle(g.half_edge_angle(f, corner_of(t, f, e)) + (side == 1 ? kPi : 0.0));
+      beside[f].push_back({e, angle, length});
+    }
+  }
+  FeatureAlignment out;
+  for (auto& [f, list] : beside) {
+    // The longest edge is followed; ties go to the smaller edge id, so the choice is deterministic.
+    std::sort(list.begin(), list.end(),
+              [](const Candidate& a, const Candidate& b) { return a.length != b.length ? a.length > b.length : a.edge < b.edge; });
+    out.fixed[f] = list[0].angle;
+    if (list.size() > 1) ++out.corner_faces;
+    for (size_t k = 1; k < list.size(); ++k) {
+      const double difference = std::abs(reduce_angle(list[k].angle - list[0].angle, N));
+      if (difference > kFeatureAngleTolerance) out.conflicts.push_back({f, list[0].edge, list[k].edge, difference});
+    }
+  }
+  return out;
+}
+
+void write_sharp(const std::string& path, const MatrixX3i& F, const Topology& t, const std::vector<int>& edges,
+                 const std::vector<char>& convex) {
+  if (convex.size() != edges.size())
+    throw Error("write_sharp: " + std::to_string(convex.size()) + " convexity flags for " + std::to_string(edges.size()) + " edges");
+  if (F.rows() != t.num_faces) throw Error("write_sharp: the faces given are not those of the topology");
+  std::vector<SharpFaceEdge> rows;
+  for (size_t n = 0; n < edges.size(); ++n) {
+    const int e = edges[n];
+    if (e < 0 || e >= t.num_edges || t.is_boundary_edge(e))
+      throw Error("write_sharp: edge " + std::to_string(e) + " is not an interior edge of the mesh");
+    const int i = t.edge_vertices(e, 0), j = t.edge_vertices(e, 1);
+    for (int side = 0; side < 2; ++side) {
+      const int f = t.edge_faces(e, side);
+      // The edge index in the face as given (a re-oriented face lists its corners in another order).
+      int k = 0;
+      while (k < 3 && !(std::min(F(f, k), F(f, (k + 1) % 3)) == i && std::max(F(f, k), F(f, (k + 1) % 3)) == j)) ++k;
+      rows.push_back({convex[n] ? 1 : 0, f, k});
+    }
+  }
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << rows.size() << "\n";
+    for (const SharpFaceEdge& r : rows) out << r.convex << "," << r.face << "," << r.edge << "\n";
+  });
+}
+
+std::vector<SharpFaceEdge> read_sharp(const std::string& path, int num_faces) {
+  Lines lines(read_file_bytes(path), path);
+  if (!lines.next()) throw Error(path + ": empty .sharp file (expected the count on the first line)");
+  const std::vector<std::string> head = split(lines.line, ' ');
+  if (head.size() != 1) throw Error(lines.where() + ": expected the number of sharp face-edges alone on the first line");
+  const long long count = detail::whole_number(head[0], lines, 0, 3LL * num_faces, "the count");
+  std::vector<SharpFaceEdge> out;
+  out.reserve(static_cast<size_t>(count));
+  for (long long n = 0; n < count; ++n) {
+    if (!lines.next()) throw Error(path + ": ends after " + std::to_string(n) + " of the " + std::to_string(count) + " lines announced");
+    const std::vector<std::string> fields = split(lines.line, ',');
+    if (fields.size() != 3)
+      throw Error(lines.where() + ": expected 'convexity,face,edge', got " + std::to_string(fields.size()) + " comma-separated fields");
+    SharpFaceEdge r;
+    r.convex = static_cast<int>(detail::whole_number(fields[0], lines, 0, 1, "convexity"));
+    r.face = static_cast<int>(detail::whole_number(fields[1], lines, 0, num_faces - 1, "face"));
+    r.edge = static_cast<int>(detail::whole_number(fields[2], lines, 0, 2, "edge"));
+    out.push_back(r);
+  }
+  if (lines.next()) throw Error(lines.where() + ": text after the " + std::to_string(count) + " lines the first line announced");
+  return out;
+}
+
+}  // namespace trivcon

@@ -1,0 +1,521 @@
+// Automatic singularities from the globally smoothest field (trivcon/auto.h).
+#include "trivcon/auto.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <queue>
+#include <random>
+#include <string>
+
+#include "linalg/cholmod.h"
+#include "linalg/ordering.h"
+#include "linalg/parallel.h"
+#include "linalg/substitution.h"
+#include "linalg/supernodal.h"
+#include "linalg/timing.h"
+#include "trivcon/constraints.h"
+#include "trivcon/curvature.h"
+#include "trivcon/design.h"
+#include "trivcon/error.h"
+
+namespace trivcon {
+
+namespace {
+
+using detail::Clock;
+using detail::seconds_since;
+using Complex = std::complex<double>;
+
+double edge_length(const MatrixX3d& V, const Topology& t, int e) {
+  return (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).norm();
+}
+
+// The per-face mass and per-edge weight of trivcon/auto.h.
+struct Weights {
+  Eigen::VectorXd mass, w;
+};
+
+Weights face_weights(const MatrixX3d& V, const Topology& t, const Geometry& g) {
+  Weights k;
+  double total = 0;
+  for (int f = 0; f < t.num_faces; ++f) total += g.face_area[f];
+  if (!(total > 0) || !std::isfinite(total))
+    throw Error("automatic singularities: every face of the mesh has zero area, so no field can be measured on it");
+  const double floor = 1e-12 * total / t.num_faces;
+  k.mass = g.mollified_area.cwiseMax(floor);
+  k.w = Eigen::VectorXd::Zero(t.num_edges);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const double len = edge_length(V, t, e) + g.component_epsilon[t.face_component[t.edge_faces(e, 0)]];
+    k.w[e] = len * len / (k.mass[t.edge_faces(e, 0)] + k.mass[t.edge_faces(e, 1)]);
+  }
+  return k;
+}
+
+// A_gf for neighbouring faces g ≠ f across interior edge e: −w e^{iNρ} from L to R, its conjugate back.
+Complex off_diagonal(const Topology& t, const Geometry& g, const Weights& k, int N, int e, int row_face) {
+  const double a = N * g.rho[e];
+  const Complex r(std::cos(a), std::sin(a));
+  return -k.w[e] * (row_face == t.edge_faces(e, 1) ? r : std::conj(r));
+}
+
+struct FactorDeleter {
+  cholmod_common* c;
+  void operator()(cholmod_factor* L) const { cholmod_free_factor(&L, c); }
+};
+
+// The symbolic factorization of the smoothest-field matrix (its upper triangle's pattern: outer, inner;
+// rows are the unknown faces face_of), with the CHOLMOD workspace it belongs to and the name of its order.
+//
+// Two candidate orders, analysed side by side on two threads, and the one with fewer flops (CHOLMOD's
+// count) kept: AMD, and a nested dissection by the faces' centroids (src/linalg/ordering.h). Neither wins
+// everywhere: on the 400k-face sphere (a regular grid of faces, AMD's worst case) AMD needs 7.0e9 flops,
+// the dissection 3.9e9; on scans the dissection needs 3-4 times AMD's (the dragon: 9.9e9 against 2.7e9;
+// armadillo 3.3e8 against 7.6e7). (METIS would need 2.1e9 on the sphere and wins on scans too, but
+// METIS_NodeND alone takes 1.2-1.5 s there, against 0.15-0.25 s for either analysis here.) Small meshes,
+// or one thread, take AMD alone. Supernodes are amalgamated less than CHOLMOD's default (zrelax 0.8, 0.1,
+// 0.05): the explicit zeros that buys are read again by each solve and first-touched by the factorization
+// (the sphere's factor: 1.90e7 entries for 1.39e7 nonzeros, 2.22e7 with the default); the factorization
+// itself did not get measurably slower.
+struct SymbolicFactor {
+  std::unique_ptr<detail::CholmodContext> context;
+  std::unique_ptr<cholmod_factor, FactorDeleter> factor{nullptr, FactorDeleter{nullptr}};
+  std::string ordering;
+};
+
+SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, const std::vector<int>& face_of, const std::vector<int>& outer,
+                                        const std::vector<int>& inner) {
+  const int n = static_cast<int>(face_of.size());
+  SymbolicFactor candidate[2];  // by AMD, by the dissection
+  for (SymbolicFactor& s : candidate) {
+    s.context = std::make_unique<detail::CholmodContext>();
+    cholmod_common* c = s.context->get();
+    c->nmethods = 1;
+    c->postorder = 1;
+    c->supernodal = CHOLMOD_SUPERNODAL;  // the numeric factorization fills a supernodal factor
+    c->zrelax[0] = 0.4, c->zrelax[1] = 0.05, c->zrelax[2] = 0.02;
+    s.factor = std::unique_ptr<cholmod_factor, FactorDeleter>(nullptr, FactorDeleter{c});
+  }
+  candidate[0].context->get()->method[0].ordering = CHOLMOD_AMD, candidate[0].ordering = "AMD";
+  candidate[1].context->get()->method[0].ordering = CHOLMOD_GIVEN, candidate[1].ordering = "coordinate dissection";
+  // The pattern alone (with the complex values the analyses copied them too: 0.04 s at 400k).
+  cholmod_sparse A = detail::upper_pattern_view(outer, inner, n);
+  const bool compare = n >= detail::kParallelMinElements && detail::max_threads() > 1;
+  std::exception_ptr error;
+#pragma omp parallel num_threads(2) if (compare)
+  {
+    try {
+      if (omp_get_thread_num() == 0) {
+        candidate[0].factor.reset(cholmod_analyze(&A, candidate[0].context->get()));
+      } else if (compare) {
+        std::vector<std::array<double, 3>> centroid(n);
+        for (int j = 0; j < n; ++j)
+          for (int a = 0; a < 3; ++a)
+            centroid[j][a] = (V(t.F(face_of[j], 0), a) + V(t.F(face_of[j], 1), a) + V(t.F(face_of[j], 2), a)) / 3;
+        std::vector<int> order = ordering::coordinate_dissection(ordering::leading_block_pattern(outer, inner, n), centroid);
+        candidate[1].factor.reset(cholmod_analyze_p(&A, order.data(), nullptr, 0, candidate[1].context->get()));
+      }
+    } catch (...) {  // an exception must not leave an OpenMP region
+#pragma omp critical
+      error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  detail::require(candidate[0].factor != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix",
+                  candidate[0].context->common());
+  const bool dissect = candidate[1].factor && candidate[1].context->common().fl < candidate[0].context->common().fl;
+  return std::move(candidate[dissect ? 1 : 0]);
+}
+
+// The smoothest field's complex values per face (see trivcon/auto.h).
+std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o,
+                                      const std::vector<Complex>* guidance, AutoTimings& time, std::string& ordering_used) {
+  auto t0 = Clock::now();
+  const int N = o.N;
+  std::vector<Complex> u(t.num_faces, Complex(0, 0));
+  std::vector<int> unknown(t.num_faces, -1), face_of;
+  std::vector<char> dirichlet_component(t.components.size(), 0);
+  for (auto [f, angle] : o.fixed) {
+    if (f < 0 || f >= t.num_faces) throw Error("automatic singularities: fixed face " + std::to_string(f) + " out of range");
+    if (!std::isfinite(angle)) throw Error("automatic singularities: fixed face " + std::to_string(f) + " has a non-finite angle");
+    u[f] = std::polar(1.0, N * angle);
+    dirichlet_component[t.face_component[f]] = 1;
+  }
+  for (int f = 0; f < t.num_faces; ++f)
+    if (!o.fixed.count(f)) unknown[f] = static_cast<int>(face_of.size()), face_of.push_back(f);
+  const int n = static_cast<int>(face_of.size());
+  if (n == 0) return u;
+
+  // The shift ε of trivcon/auto.h and the upper triangle of the Hermitian A + εM in compressed columns
+  // (n × n complex, values as (real, imaginary) pairs).
+  Eigen::VectorXd diag = Eigen::VectorXd::Zero(t.num_faces);
+  for (int e = 0; e < t.num_edges; ++e)
+    if (!t.is_boundary_edge(e)) diag[t.edge_faces(e, 0)] += k.w[e], diag[t.edge_faces(e, 1)] += k.w[e];
+  // The ratio of the sums, not the mean of the ratios: a zero-area face has the floor mass and an ordinary
+  // diagonal, so its ratio is ~1e12 times the others', and a mean over faces would make the shift swamp A
+  // on any mesh with a few such faces (the inverse iteration then barely moves from its random start).
+  const double eps = 1e-8 * diag.sum() / k.mass.sum();
+  std::vector<int> outer(n + 1, 0), inner;
+  std::vector<double> values;
+  inner.reserve(static_cast<size_t>(n) * 3), values.reserve(static_cast<size_t>(n) * 6);
+  std::vector<std::pair<int, Complex>> column;
+  for (int j = 0; j < n; ++j) {
+    const int f = face_of[j];
+    column.clear();
+    for (int c = 0; c < 3; ++c) {
+      const int e = t.face_edges(f, c);
+      if (t.is_boundary_edge(e)) continue;
+      const int h = t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
+      if (h != f && unknown[h] >= 0 && unknown[h] < j) column.emplace_back(unknown[h], off_diagonal(t, g, k, N, e, h));
+    }
+    std::sort(column.begin(), column.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (auto [i, a] : column) inner.push_back(i), values.push_back(a.real()), values.push_back(a.imag());
+    inner.push_back(j), values.push_back(diag[f] + eps * k.mass[f]), values.push_back(0.0);
+    outer[j + 1] = static_cast<int>(inner.size());
+  }
+  // Right-hand side from the fixed faces: b_g = −Σ A_gf u_f over fixed neighbours f.
+  Eigen::VectorXd dirichlet = Eigen::VectorXd::Zero(2 * n);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    for (int s = 0; s < 2; ++s) {
+      const int row = t.edge_faces(e, s), col = t.edge_faces(e, 1 - s);
+      if (unknown[row] < 0 || unknown[col] >= 0) continue;
+      const Complex b = -off_diagonal(t, g, k, N, e, row) * u[col];
+      dirichlet[2 * unknown[row]] += b.real(), dirichlet[2 * unknown[row] + 1] += b.imag();
+    }
+  }
+  time.assemble = seconds_since(t0);
+
+  t0 = Clock::now();
+  const SymbolicFactor symbolic = analyse_smoothest_matrix(V, t, face_of, outer, inner);
+  cholmod_common& c = **symbolic.context;
+  cholmod_factor* const L = symbolic.factor.get();
+  ordering_used = symbolic.ordering;
+  // The numeric factor by trivcon's own supernodal code (src/linalg/supernodal.h, the same that factors the
+  // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another,
+  // and took 3-4 times as long on the 400k-face sphere (2.8-3.1 s against 0.73-1.06 s after METIS).
+  if (const int minor = supernodal::factorize_complex(*L, outer, inner, values, c); minor < n)
+    throw Error("automatic singularities: the smoothest-field matrix is not positive definite (column " + std::to_string(minor) +
+                " of " + std::to_string(n) + "): a non-finite or degenerate weight");
+  // The solves below on both cores (src/linalg/substitution.h): CHOLMOD's own took 0.1 s each at 400k faces.
+  const supernodal::Substitution<Complex> substitution(*L);
+  time.factor = seconds_since(t0);
+
+  t0 = Clock::now();
+  const int components = static_cast<int>(t.components.size());
+  auto normalise = [&](Eigen::VectorXd& x) {  // ‖x‖_M = 1 on every component without fixed faces
+    std::vector<double> norm(components, 0);
+    for (int j = 0; j < n; ++j)
+      norm[t.face_component[face_of[j]]] += k.mass[face_of[j]] * (x[2 * j] * x[2 * j] + x[2 * j + 1] * x[2 * j + 1]);
+    for (int j = 0; j < n; ++j) {
+      const int comp = t.face_component[face_of[j]];
+      if (dirichlet_component[comp]) continue;
+      if (!(norm[comp] > 0) || !std::isfinite(norm[comp]))
+        throw Error("automatic singularities: the inverse iteration lost the field on component " + std::to_string(comp) + " (norm " +
+                    std::to_string(norm[comp]) + ")");
+      x.segment<2>(2 * j) /= std::sqrt(norm[comp]);
+    }
+  };
+  Eigen::VectorXd x(2 * n);
+  std::mt19937 random(20131);  // a fixed start: the result is deterministic
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int i = 0; i < 2 * n; ++i) x[i] = uniform(random);
+  normalise(x);
+  {
+    // The iterations in the factor's order (no permutation per solve; mass, component and Dirichlet values
+    // permuted once): x ← s (A + εM)⁻¹ (M x + b_D), s = 1 / ‖·‖_M per component, applied with the next mass
+    // product (and at the end) instead of a pass of its own.
+    const std::vector<int>& perm = substitution.permutation();
+    std::vector<Complex> xf(n), bf(n), df(n);
+    std::vector<double> mf(n), scale(components, 1.0), norm(components);
+    std::vector<int> cf(n);
+    for (int q = 0; q < n; ++q) {
+      const int j = perm[q], comp = t.face_component[face_of[j]];
+      xf[q] = Complex(x[2 * j], x[2 * j + 1]), df[q] = Complex(dirichlet[2 * j], dirichlet[2 * j + 1]);
+      cf[q] = comp, mf[q] = dirichlet_component[comp] ? 0.0 : k.mass[face_of[j]];
+    }
+    for (int it = 0; it < std::max(1, o.iterations); ++it) {
+      for (int q = 0; q < n; ++q) bf[q] = (mf[q] * scale[cf[q]]) * xf[q] + df[q];
+      substitution.solve_in_factor_order(bf.data());
+      xf.swap(bf);
+      std::fill(norm.begin(), norm.end(), 0.0);
+      for (int q = 0; q < n; ++q) norm[cf[q]] += mf[q] * std::norm(xf[q]);
+      for (int comp = 0; comp < components; ++comp) {
+        if (dirichlet_component[comp]) continue;
+        if (!(norm[comp] > 0) || !std::isfinite(norm[comp]))
+          throw Error("automatic singularities: the inverse iteration lost the field on component " + std::to_string(comp) + " (norm " +
+                      std::to_string(norm[comp]) + ")");
+        scale[comp] = 1 / std::sqrt(norm[comp]);
+      }
+    }
+    for (int q = 0; q < n; ++q) {
+      const Complex v = xf[q] * scale[cf[q]];
+      x[2 * perm[q]] = v.real(), x[2 * perm[q] + 1] = v.imag();
+    }
+  }
+  Eigen::VectorXd b(2 * n);
+  time.iterate = seconds_since(t0);
+  if (guidance) {
+    t0 = Clock::now();
+    // Per component: the Rayleigh quotient λ̂ of the field found so far (the smoothest field's eigenvalue, or the
+    // energy of the Dirichlet solution) and the guidance's scale (area-weighted mean |q| = 1).
+    auto value = [&](int f) { return unknown[f] >= 0 ? Complex(x[2 * unknown[f]], x[2 * unknown[f] + 1]) : u[f]; };
+    std::vector<double> energy(components, 0), norm(components, 0), zsum(components, 0), msum(components, 0);
+    for (int e = 0; e < t.num_edges; ++e) {
+      if (t.is_boundary_edge(e)) continue;
+      const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+      energy[t.face_component[L]] += k.w[e] * std::norm(value(R) - std::polar(1.0, N * g.rho[e]) * value(L));
+    }
+    std::vector<Complex> q(t.num_faces);  // M q, before scaling
+    for (int f = 0; f < t.num_faces; ++f) {
+      const int comp = t.face_component[f];
+      norm[comp] += k.mass[f] * std::norm(value(f)), msum[comp] += k.mass[f];
+      const Complex z = (*guidance)[f];
+      const double a = std::abs(z);
+      q[f] = a > 0 ? a * std::pow(z / a, N / 2) : Complex(0, 0);
+      zsum[comp] += a;
+    }
+    std::vector<char> guided(components, 0);
+    for (int comp = 0; comp < components; ++comp) guided[comp] = zsum[comp] > 0 && std::isfinite(zsum[comp]);
+    if (o.curvature_t != 0) {
+      // A − λ_t M with λ_t = t λ̂ per component (the shift ε kept), refactored on the same analysis.
+      for (int j = 0; j < n; ++j) {
+        const int f = face_of[j], comp = t.face_component[f];
+        const double lambda = norm[comp] > 0 ? energy[comp] / norm[comp] : 0.0;
+        values[2 * (outer[j + 1] - 1)] = diag[f] + (eps - o.curvature_t * lambda) * k.mass[f];
+      }
+      if (supernodal::factorize_complex(*L, outer, inner, values, c) < n)
+        throw Error("automatic singularities: curvature alignment with t = " + std::to_string(o.curvature_t) +
+                    " makes the system indefinite (t must be below 1, and a little below 1 can already exceed the smallest "
+                    "eigenvalue's estimate): use a smaller t");
+    }
+    for (int j = 0; j < n; ++j) {
+      const int f = face_of[j], comp = t.face_component[f];
+      const Complex mq = guided[comp] ? q[f] * (msum[comp] / zsum[comp]) : Complex(0, 0);
+      b[2 * j] = mq.real() + dirichlet[2 * j], b[2 * j + 1] = mq.imag() + dirichlet[2 * j + 1];
+    }
+    substitution.solve(reinterpret_cast<Complex*>(b.data()));
+    for (int j = 0; j < n; ++j)  // components without curvature (flat, umbilic) keep the smoothest field
+      if (guided[t.face_component[face_of[j]]]) x[2 * j] = b[2 * j], x[2 * j + 1] = b[2 * j + 1];
+    time.align = seconds_since(t0);
+  }
+  for (int j = 0; j < n; ++j) {
+    if (!std::isfinite(x[2 * j]) || !std::isfinite(x[2 * j + 1]))
+      throw Error("automatic singularities: the smoothest field is not finite at face " + std::to_string(face_of[j]));
+    u[face_of[j]] = Complex(x[2 * j], x[2 * j + 1]);
+  }
+  return u;
+}
+
+}  // namespace
+
+double mean_edge_length(const MatrixX3d& V, const Topology& t) {
+  if (t.num_edges == 0) return 0;
+  double sum = 0;
+  for (int e = 0; e < t.num_edges; ++e) sum += edge_length(V, t, e);
+  return sum / t.num_edges;
+}
+
+std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
+                                            std::vector<std::pair<int, int>>* pairs) {
+  if (!(distance >= 0) || !std::isfinite(distance))
+    throw Error("singularity cancellation: invalid distance " + std::to_string(distance) + " (need a finite number >= 0)");
+  std::map<int, int> left = vertex;
+  if (distance == 0) return left;
+  // Candidate pairs from a Dijkstra search of radius `distance` around each positive singularity.
+  struct Candidate {
+    double d;
+    int plus, minus;
+  };
+  std::vector<Candidate> candidates;
+  std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
+  std::vector<int> touched;
+  using Item = std::pair<double, int>;
+  for (auto [source, n] : vertex) {
+    if (n <= 0) continue;
+    if (source < 0 || source >= t.num_vertices) throw Error("singularity cancellation: vertex " + std::to_string(source) + " out of range");
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+    dist[source] = 0, touched.push_back(source), queue.emplace(0.0, source);
+    while (!queue.empty()) {
+      auto [d, v] = queue.top();
+      queue.pop();
+      if (d > dist[v]) continue;
+      if (v != source) {
+        auto it = vertex.find(v);
+        if (it != vertex.end() && it->second == -n) candidates.push_back({d, source, v});
+      }
+      for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
+        const int e = t.vertex_edges[q];
+        const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+        const double dw = d + edge_length(V, t, e);
+        if (dw <= distance && dw < dist[w]) {
+          if (std::isinf(dist[w])) touched.push_back(w);
+          dist[w] = dw, queue.emplace(dw, w);
+        }
+      }
+    }
+    for (int v : touched) dist[v] = std::numeric_limits<double>::infinity();
+    touched.clear();
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.d != b.d ? a.d < b.d : a.plus != b.plus ? a.plus < b.plus : a.minus < b.minus;
+  });
+  for (const Candidate& k : candidates) {
+    if (!left.count(k.plus) || !left.count(k.minus)) continue;
+    left.erase(k.plus), left.erase(k.minus);
+    if (pairs) pairs->emplace_back(k.plus, k.minus);
+  }
+  return left;
+}
+
+std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex) {
+  // Clusters of vertices joined by zero-length edges (union-find with path halving).
+  std::vector<int> parent(t.num_vertices);
+  for (int v = 0; v < t.num_vertices; ++v) parent[v] = v;
+  auto root = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  bool any = false;
+  for (int e = 0; e < t.num_edges; ++e) {
+    const int i = t.edge_vertices(e, 0), j = t.edge_vertices(e, 1);
+    if (V.row(i) != V.row(j)) continue;
+    any = true;
+    const int a = root(i), b = root(j);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the root is the cluster's smallest id
+  }
+  if (!any) return vertex;
+  std::vector<char> touches_boundary(t.num_vertices, 0);
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (t.is_boundary_vertex(v)) touches_boundary[root(v)] = 1;
+  std::map<int, int> merged;
+  for (auto [v, n] : vertex) {
+    const int c = root(v);
+    merged[touches_boundary[c] ? v : c] += n;  // a cluster on the boundary keeps its interior vertices' own
+  }
+  for (auto it = merged.begin(); it != merged.end();) it = it->second == 0 ? merged.erase(it) : std::next(it);
+  return merged;
+}
+
+AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geometry& g, const Cycles& cycles, const AutoOptions& o) {
+  if (o.N < 1) throw Error("automatic singularities: invalid N = " + std::to_string(o.N) + " (need N >= 1)");
+  if (o.iterations < 1) throw Error("automatic singularities: invalid iterations = " + std::to_string(o.iterations) + " (need at least 1)");
+  if (V.rows() != t.num_vertices)
+    throw Error("automatic singularities: V has " + std::to_string(V.rows()) + " rows, the mesh " + std::to_string(t.num_vertices) +
+                " vertices");
+  AutoResult r;
+  r.field.N = o.N;
+  r.field.angle = Eigen::VectorXd::Zero(t.num_faces);
+  if (t.num_faces == 0) return r;
+  if (o.align_curvature && o.N % 2 != 0)
+    throw Error("automatic singularities: curvature alignment needs an even N (principal directions are lines), not N = " +
+                std::to_string(o.N));
+  if (o.align_curvature && !(o.curvature_t < 1))
+    throw Error("automatic singularities: invalid curvature alignment strength t = " + std::to_string(o.curvature_t) + " (need t < 1)");
+  const Weights k = face_weights(V, t, g);
+  std::vector<Complex> guidance;
+  if (o.align_curvature) guidance = curvature_tensors(V, t, g);
+  std::vector<Complex> u = smoothest_values(V, t, g, k, o, o.align_curvature ? &guidance : nullptr, r.seconds, r.ordering);
+
+  auto t0 = Clock::now();
+  // Energy (the Rayleigh quotient), then faces where the field vanishes (trivcon/auto.h).
+  double energy = 0, norm = 0;
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    energy += k.w[e] * std::norm(u[R] - std::polar(1.0, o.N * g.rho[e]) * u[L]);
+  }
+  std::vector<double> largest(t.components.size(), 0);
+  for (int f = 0; f < t.num_faces; ++f) {
+    norm += k.mass[f] * std::norm(u[f]);
+    largest[t.face_component[f]] = std::max(largest[t.face_component[f]], std::abs(u[f]));
+  }
+  r.energy = norm > 0 ? energy / norm : 0;
+  std::vector<Complex> filled = u;
+  for (int f = 0; f < t.num_faces; ++f) {
+    const double small = 1e-9 * largest[t.face_component[f]];
+    if (std::abs(u[f]) > small) continue;
+    ++r.vanishing_faces;
+    Complex sum(0, 0);
+    for (int c = 0; c < 3; ++c) {
+      const int e = t.face_edges(f, c);
+      if (t.is_boundary_edge(e)) continue;
+      const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+      const Complex r_e = std::polar(1.0, o.N * g.rho[e]);
+      sum += f == R ? r_e * u[L] : std::conj(r_e) * u[R];
+    }
+    filled[f] = std::abs(sum) > small ? sum : Complex(1, 0);
+  }
+  for (int f = 0; f < t.num_faces; ++f) {
+    double a = std::arg(filled[f]) / o.N;
+    if (a < 0) a += kTwoPi / o.N;
+    r.field.angle[f] = std::min(a, std::nextafter(kTwoPi / o.N, 0.0));
+  }
+  const FieldIndices indices = field_indices(t, g, cycles, r.field);
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (indices.vertex[v] != 0) r.found[v] = indices.vertex[v];
+  // Turning of whole 2π/N steps at boundary vertices beside fixed faces goes to an interior neighbour, where
+  // the exact solve can place it (trivcon/constraints.h).
+  for (auto [v, n] : boundary_turns_moved_inside(t, g, o.fixed, r.field)) {
+    r.boundary_moved += std::abs(n);
+    if ((r.found[v] += n) == 0) r.found.erase(v);
+  }
+  r.seconds.indices = seconds_since(t0);
+  const std::map<int, int> merged = merge_coincident_singularities(V, t, r.found);
+  r.coincident_removed = static_cast<int>(r.found.size() - merged.size());
+
+  t0 = Clock::now();
+  if (!(o.cancel_distance >= 0) || !std::isfinite(o.cancel_distance))
+    throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
+  const double distance = o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
+  r.vertex = cancel_singularity_pairs(V, t, merged, distance, &r.pairs);
+  r.seconds.cancel = seconds_since(t0);
+  return r;
+}
+
+AutoResult auto_singularities(const FieldDesigner& designer, const AutoOptions& options) {
+  return auto_singularities(designer.V(), designer.topology(), designer.geometry(), designer.cycles(), options);
+}
+
+AutoResult auto_singularities(const MatrixX3d& V, const MatrixX3i& F, const AutoOptions& options) {
+  check_finite(V);
+  const Topology t = build_topology(F, static_cast<int>(V.rows()));
+  check_coordinate_range(V, t);
+  const Geometry g = compute_geometry(V, t);
+  const Cycles cycles = compute_cycles(t);
+  return auto_singularities(V, t, g, cycles, options);
+}
+
+std::vector<std::pair<int, double>> roots_toward(const FieldDesigner& designer, const Field& field, const Field& guide,
+                                                 const std::vector<std::pair<int, double>>& roots, const std::map<int, double>& fixed) {
+  const Topology& t = designer.topology();
+  const Geometry& g = designer.geometry();
+  if (field.angle.size() != t.num_faces || guide.angle.size() != t.num_faces)
+    throw Error("roots_toward: the field and the guide need one angle per face (" + std::to_string(t.num_faces) + ")");
+  if (field.N != guide.N) throw Error("roots_toward: the field has N = " + std::to_string(field.N) + ", the guide N = " + std::to_string(guide.N));
+  std::vector<char> decided(t.components.size(), 0);
+  for (auto [f, angle] : roots)
+    if (f >= 0 && f < t.num_faces) decided[t.face_component[f]] = 1;
+  for (const auto& entry : fixed)
+    if (entry.first >= 0 && entry.first < t.num_faces) decided[t.face_component[entry.first]] = 1;
+  std::vector<std::complex<double>> sum(t.components.size(), 0.0);
+  for (int f = 0; f < t.num_faces; ++f) {
+    const int c = t.face_component[f];
+    if (decided[c]) continue;
+    sum[c] += g.face_area(f) * std::polar(1.0, field.N * (guide.angle(f) - field.angle(f)));
+  }
+  std::vector<std::pair<int, double>> out = roots;
+  for (size_t c = 0; c < t.components.size(); ++c) {
+    if (decided[c] || std::abs(sum[c]) <= 1e-300) continue;
+    const int f = t.components[c].first_face;
+    out.emplace_back(f, wrap_angle(field.angle(f) + std::arg(sum[c]) / field.N));
+  }
+  return out;
+}
+
+}  // namespace trivcon

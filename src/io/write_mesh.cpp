@@ -1,0 +1,116 @@
+// src/io/write_mesh.cpp: the mesh writers of trivcon/io.h, OBJ (text, 17 significant digits) and binary
+// little-endian PLY (doubles). They refuse what the readers would reject (src/io/mesh_rules.h), so that
+// everything written reads back identically, and write through write_file_atomically.
+#include "trivcon/io.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <ostream>
+#include <type_traits>
+#include <vector>
+
+#include "io/mesh_rules.h"
+#include "trivcon/error.h"
+
+namespace trivcon {
+namespace {
+
+using detail::kMaxCount;
+using detail::non_finite_message;
+using detail::polygon_problem;
+
+// Refuses what the readers would reject, so that everything written reads back identically.
+void check_writable(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
+  const auto refuse = [&](const std::string& why) { throw Error("cannot write '" + path + "': " + why); };
+  if (V.rows() > kMaxCount) refuse("too many vertices");
+  if (F.rows() == 0) refuse("mesh has no faces");
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!std::isfinite(V(v, axis))) refuse(non_finite_message(v, V(v, axis)));
+    }
+  }
+  std::vector<int> corners(3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      corners[c] = F(f, c);
+      if (corners[c] < 0 || corners[c] >= V.rows()) {
+        refuse("face " + std::to_string(f) + " has vertex index " + std::to_string(corners[c]) + " out of range (mesh has " +
+               std::to_string(V.rows()) + " vertices)");
+      }
+    }
+    const std::string problem = polygon_problem(corners, f);
+    if (!problem.empty()) refuse(problem);
+  }
+}
+
+template <class T>
+void append_number(std::string& out, T value) {
+  char digits[32];
+  const auto result = std::to_chars(digits, digits + sizeof digits, value);
+  out.append(digits, result.ptr);
+}
+
+// %.17g: 17 significant digits always read back to the same double.
+void append_coordinate(std::string& out, double value) {
+  char digits[32];
+  const auto result = std::to_chars(digits, digits + sizeof digits, value, std::chars_format::general, 17);
+  out.append(digits, result.ptr);
+}
+
+template <class T>
+void append_little_endian(std::string& out, T value) {
+  static_assert(std::is_integral_v<T> || std::is_floating_point_v<T>);
+  unsigned char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof bytes);
+  const std::uint16_t probe = 1;
+  unsigned char first;
+  std::memcpy(&first, &probe, 1);
+  if (first == 0) std::reverse(bytes, bytes + sizeof bytes);  // big-endian host
+  out.append(reinterpret_cast<const char*>(bytes), sizeof bytes);
+}
+
+}  // namespace
+
+void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
+  check_writable(path, V, F);
+  std::string text = "# trivcon mesh: " + std::to_string(V.rows()) + " vertices, " + std::to_string(F.rows()) + " faces\n";
+  text.reserve(text.size() + 64 * V.rows() + 24 * F.rows());
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    text += 'v';
+    for (int axis = 0; axis < 3; ++axis) {
+      text += ' ';
+      append_coordinate(text, V(v, axis));
+    }
+    text += '\n';
+  }
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    text += 'f';
+    for (int c = 0; c < 3; ++c) {
+      text += ' ';
+      append_number(text, F(f, c) + 1);
+    }
+    text += '\n';
+  }
+  write_file_atomically(path, [&](std::ostream& out) { out.write(text.data(), static_cast<std::streamsize>(text.size())); });
+}
+
+void write_ply(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
+  check_writable(path, V, F);
+  std::string data = "ply\nformat binary_little_endian 1.0\ncomment written by trivcon\nelement vertex " + std::to_string(V.rows()) +
+                     "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(F.rows()) +
+                     "\nproperty list uchar int vertex_indices\nend_header\n";
+  data.reserve(data.size() + 24 * V.rows() + 13 * F.rows());
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    for (int axis = 0; axis < 3; ++axis) append_little_endian(data, V(v, axis));
+  }
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    data += static_cast<char>(3);
+    for (int c = 0; c < 3; ++c) append_little_endian<std::int32_t>(data, F(f, c));
+  }
+  write_file_atomically(path, [&](std::ostream& out) { out.write(data.data(), static_cast<std::streamsize>(data.size())); });
+}
+
+}  // namespace trivcon

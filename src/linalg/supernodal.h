@@ -1,0 +1,76 @@
+// Internal: the numeric supernodal Cholesky factorization behind ConnectionSolver, on several threads.
+//
+// CHOLMOD does the ordering and the symbolic factorization (trivcon/solver.h); this computes the values of
+// CHOLMOD's own supernodal factor object, so that everything else (CHOLMOD's solves, the solver's sparse
+// forward update and backward substitution) reads it unchanged. Why not cholmod_factorize: CHOLMOD 3
+// (Debian 12) visits the supernodes one after another and uses the second core only inside BLAS calls on
+// large supernodes, while on a mesh most of the time goes to the many small supernodes near the leaves of
+// the elimination tree. Here independent subtrees are factored on OpenMP's threads (one set of subtrees per thread), then the top of the
+// tree with multithreaded BLAS. Same algorithm as CHOLMOD's (left-looking supernodal: each supernode gathers the updates of its
+// descendants, then a dense Cholesky of its diagonal block and a triangular solve of the rows below), same storage.
+#pragma once
+#include <cholmod.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <vector>
+
+namespace trivcon::supernodal {
+
+// The supernodal elimination tree of a factor, split for `parts` threads: `top` (the supernodes above
+// the split, done one at a time) and `parts` sets of whole subtrees below it that do not depend on each
+// other, balanced by `work` (per supernode; a subtree's work is the sum over it): the largest remaining
+// subtree is split at its root while it holds more than 1/parts of the work below the top and more than
+// `min_split`, then the subtrees go, largest first, to the part with the least work so far. Each list is
+// in increasing supernode order (descendants first). parts ≥ 1; with 1 everything is in part[0].
+// With `refine`, the splitting then goes further down while that shortens the critical path, the work of the
+// top plus that of the heaviest part (for a top done on one thread: the parallel substitution of
+// src/linalg/substitution.h); the largest subtree left is then smaller still.
+struct TreeSplit {
+  std::vector<int> top;
+  std::vector<std::vector<int>> part;
+};
+TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& work, double min_split, int parts = 2,
+                     bool refine = false);
+
+// CHOLMOD's supernodal factor, read in place: supernode s holds the columns first(s) … first(s) + cols(s)
+// − 1; its rows (its own columns first, then rows of its ancestors) are row(s, 0 … height(s) − 1), its
+// entries the height(s) × cols(s) column-major block values(s), starting at x + px[s].
+struct Supernodes {
+  const int *super, *pi, *px, *rows;
+  const double* x;
+  int count;
+  explicit Supernodes(const cholmod_factor* L)
+      : super(static_cast<const int*>(L->super)),
+        pi(static_cast<const int*>(L->pi)),
+        px(static_cast<const int*>(L->px)),
+        rows(static_cast<const int*>(L->s)),
+        x(static_cast<const double*>(L->x)),
+        count(static_cast<int>(L->nsuper)) {}
+  int first(int s) const { return super[s]; }
+  int cols(int s) const { return super[s + 1] - super[s]; }
+  int height(int s) const { return pi[s + 1] - pi[s]; }
+  int row(int s, int i) const { return rows[pi[s] + i]; }
+  Eigen::Map<const Eigen::MatrixXd> values(int s) const { return {x + px[s], height(s), cols(s)}; }
+  // The supernode of each column.
+  std::vector<int> owners() const;
+};
+
+// Parent of each supernode in the supernodal elimination tree (−1 at a root), given owners().
+std::vector<int> supernode_parents(const Supernodes& L, const std::vector<int>& owner);
+
+// Computes the numeric LLᵀ factor in L (a supernodal symbolic factor from cholmod_analyze_p, with its
+// permutation L.Perm) of the symmetric n × n matrix whose upper triangle is given in compressed columns
+// (outer, inner, values; rows ≤ column, in the matrix's own numbering). Returns n on success, or the
+// first factor column found not positive definite (as CHOLMOD's L->minor); throws trivcon::Error if
+// CHOLMOD cannot allocate the factor.
+int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
+              cholmod_common& c);
+// The same for a Hermitian matrix (LLᴴ): `values` holds (real, imaginary) pairs, entry k at 2k, 2k + 1, as
+// CHOLMOD's complex (interleaved) storage; the factor becomes CHOLMOD_COMPLEX, so cholmod_solve reads it.
+// Used by the smoothest field of trivcon/auto.h.
+int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
+                      cholmod_common& c);
+
+}  // namespace trivcon::supernodal
