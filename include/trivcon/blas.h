@@ -34,4 +34,11 @@ class SingleThreadedBlas {
   SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
 };
 
+// OpenBLAS's own thread count, for the whole process (OpenBLAS has one setting per process): how many threads
+// each BLAS call may use. blas_threads() is the count that holds outside SingleThreadedBlas objects (0 if
+// the BLAS is not OpenBLAS); set_blas_threads(n), n >= 1, changes it (while a SingleThreadedBlas object
+// lives, it takes effect when the last one is destroyed). Does nothing if the BLAS is not OpenBLAS.
+int blas_threads();
+void set_blas_threads(int threads);
+
 }  // namespace trivcon

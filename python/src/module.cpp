@@ -10,26 +10,50 @@
 // The GIL is released around everything that takes time (reading, set-up and factorization, solves,
 // automatic placement, rendering, writing); a FieldDesigner's own mutex keeps two Python threads from
 // changing its fixed faces or solving on it at the same moment.
+//
+// Ctrl-C: the long calls (reading a mesh, a designer's set-up, solves, automatic placement, refinement,
+// reading indices, rendering, unpickling) run on a thread of their own (`interruptible`) while the calling
+// thread waits in slices of 20 ms; between slices the main thread takes the GIL and runs Python's signal
+// handlers (PyErr_CheckSignals), so a KeyboardInterrupt is raised within a slice. The work is then
+// abandoned: its flag is set (trivcon/cancel.h), the library stops at its next safe point, and the thread
+// frees what it built; it owns copies or shared pointers of everything it reads, never a Python object, so
+// nothing it touches goes away under it. The package waits for abandoned work at exit (wait_for_background).
+//
+// Threads: each such call runs with the thread count of its designer (or the module's default) as OpenMP's
+// setting of its own thread (omp_set_num_threads is per calling thread), and with one thread, OpenBLAS
+// single-threaded while it runs (trivcon::SingleThreadedBlas: OpenBLAS has one setting per process).
+#include <Python.h>
+#include <dlfcn.h>
+#include <omp.h>
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
+#include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
+#include <thread>
+#include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "trivcon/auto.h"
 #include "trivcon/blas.h"
-#include "trivcon/refine.h"
+#include "trivcon/cancel.h"
+#include "trivcon/split_large_turns.h"
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
@@ -49,6 +73,145 @@ namespace {
 
 using Int64Array = py::array_t<std::int64_t>;
 using DoubleArray = py::array_t<double>;
+
+// --- Long calls on a thread of their own, abandoned on KeyboardInterrupt (see the top of this file).
+
+// Long calls still running (abandoned or not) and their cancellation flags; never destroyed (such work may
+// outlive the module's static objects).
+struct Background {
+  std::mutex mutex;
+  std::condition_variable idle;
+  int running = 0;
+  std::set<std::shared_ptr<std::atomic<bool>>> flags;
+};
+Background& background() {
+  static Background* b = new Background();
+  return *b;
+}
+
+// The module's default thread count (0: OpenMP's, i.e. OMP_NUM_THREADS or every core); set_threads.
+std::atomic<int> default_threads{0};
+// Python's main thread: the only one whose waits run signal handlers.
+unsigned long main_thread_ident = 0;
+
+// A call's threads, on the thread that makes it: OpenMP's count for this thread only, and OpenBLAS on one
+// thread while a one-thread call runs (for the whole process: OpenBLAS has one setting).
+class CallThreads {
+ public:
+  explicit CallThreads(int threads) {
+    if (threads > 0) omp_set_num_threads(threads);
+    if (threads == 1) blas_.emplace();
+  }
+
+ private:
+  std::optional<SingleThreadedBlas> blas_;
+};
+
+template <class T>
+struct Job {
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false, abandoned = false;
+  std::shared_ptr<std::atomic<bool>> cancel = std::make_shared<std::atomic<bool>>(false);
+  std::optional<T> value;
+  std::exception_ptr error;
+};
+
+// Runs task() on a new thread with `threads` threads (0: the module's default, negative: OpenMP's) and returns its value; the
+// caller must hold the GIL. KeyboardInterrupt (or whatever a Python signal handler raises) abandons the
+// task: it is cancelled and frees its results itself. The task must own what it reads (copies, shared
+// pointers) and must not touch Python objects.
+template <class Task>
+std::invoke_result_t<Task&> interruptible(int threads, Task task) {
+  using T = std::invoke_result_t<Task&>;
+  if (threads == 0) threads = default_threads.load();
+  auto job = std::make_shared<Job<T>>();
+  Background& bg = background();
+  {
+    std::lock_guard<std::mutex> lock(bg.mutex);
+    ++bg.running;
+    bg.flags.insert(job->cancel);
+  }
+  try {
+    std::thread([job, threads, work = std::optional<Task>(std::move(task))]() mutable {
+      {
+        CallThreads setting(threads);
+        CancelScope scope(job->cancel);
+        try {
+          job->value.emplace((*work)());
+        } catch (...) {
+          job->error = std::current_exception();
+        }
+        work.reset();  // its inputs are freed here, before the work counts as finished
+      }
+      bool abandoned;
+      {
+        std::lock_guard<std::mutex> lock(job->mutex);
+        job->done = true;
+        abandoned = job->abandoned;
+      }
+      job->finished.notify_all();
+      if (abandoned) job->value.reset(), job->error = nullptr;
+      std::shared_ptr<std::atomic<bool>> flag = job->cancel;
+      job.reset();
+      Background& b = background();
+      {
+        std::lock_guard<std::mutex> lock(b.mutex);
+        --b.running;
+        b.flags.erase(flag);
+      }
+      b.idle.notify_all();
+    }).detach();
+  } catch (...) {  // no thread
+    std::lock_guard<std::mutex> lock(bg.mutex);
+    --bg.running;
+    bg.flags.erase(job->cancel);
+    throw;
+  }
+  const bool poll = PyThread_get_thread_ident() == main_thread_ident;
+  {
+    py::gil_scoped_release release;
+    std::unique_lock<std::mutex> lock(job->mutex);
+    while (!job->finished.wait_for(lock, std::chrono::milliseconds(20), [&] { return job->done; })) {
+      if (!poll) continue;
+      lock.unlock();
+      {
+        py::gil_scoped_acquire acquire;
+        if (PyErr_CheckSignals() != 0) {
+          {
+            std::lock_guard<std::mutex> abandon(job->mutex);
+            if (!job->done) job->abandoned = true, *job->cancel = true;
+          }
+          throw py::error_already_set();
+        }
+      }
+      lock.lock();
+    }
+  }
+  if (job->error) std::rethrow_exception(job->error);
+  return std::move(*job->value);
+}
+
+// Waits until no long call is running, or `seconds` have passed (negative: no limit); returns whether none
+// is left. With `cancel`, the calls still running are cancelled first (at exit: only daemon threads can still
+// be in one). Signal handlers run meanwhile (a second Ctrl-C stops the wait).
+bool wait_for_background(double seconds, bool cancel) {
+  Background& bg = background();
+  if (cancel) {
+    std::lock_guard<std::mutex> lock(bg.mutex);
+    for (const auto& flag : bg.flags) *flag = true;
+  }
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds < 0 ? 1e9 : seconds);
+  for (;;) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(bg.mutex);
+      if (bg.idle.wait_for(lock, std::chrono::milliseconds(20), [&] { return bg.running == 0; })) return true;
+    }
+    if (std::chrono::steady_clock::now() >= end) return false;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  }
+}
 
 // --- Conversions to numpy (copies; the library's arrays stay where they are).
 
@@ -148,6 +311,7 @@ struct DesignerState {
   std::unique_ptr<FieldDesigner> designer;
   std::vector<int> fixed_faces;   // those the solver is factored for
   std::vector<int> sorted_edges;  // every edge, sorted by (i, j)
+  int threads = 0;                // of its calls (0: the module's default)
   std::mutex mutex;
 
   const Topology& topology() const { return designer->topology(); }
@@ -191,19 +355,53 @@ SolverOptions solver_options(const std::string& weights, const std::string& solv
   return o;
 }
 
-DesignerPtr make_designer(const MatrixX3d& V, const MatrixX3i& F, const std::string& weights, const std::string& solver,
-                          const std::string& factorization, double weight_floor) {
-  const SolverOptions options = solver_options(weights, solver, factorization, weight_floor);
-  auto s = std::make_shared<DesignerState>();
-  {
-    py::gil_scoped_release release;
-    s->V = V;
-    s->F = F;
-    s->designer = std::make_unique<FieldDesigner>(V, F, options);
-    s->designer->set_fixed_faces({});  // factor now: the constructor of the Python object validates and factors
+int checked_threads(int threads) {
+  if (threads < 0) throw Error("threads must be at least 0 (0: OpenMP's default), not " + std::to_string(threads));
+  return threads;
+}
+
+// A designer on (V, F); factored now when `factor` (the constructor), else on its first solve (unpickling).
+DesignerPtr build_designer(MatrixX3d V, MatrixX3i F, const SolverOptions& options, int threads, bool factor) {
+  return interruptible(threads, [V = std::move(V), F = std::move(F), options, threads, factor]() mutable {
+    auto s = std::make_shared<DesignerState>();
+    s->threads = threads;
+    s->V = std::move(V);
+    s->F = std::move(F);
+    s->designer = std::make_unique<FieldDesigner>(s->V, s->F, options);
+    if (factor) s->designer->set_fixed_faces({});  // the constructor of the Python object validates and factors
     s->sort_edges();
-  }
-  return s;
+    return s;
+  });
+}
+
+DesignerPtr make_designer(MatrixX3d V, MatrixX3i F, const std::string& weights, const std::string& solver, const std::string& factorization,
+                          double weight_floor, int threads) {
+  const SolverOptions options = solver_options(weights, solver, factorization, weight_floor);
+  return build_designer(std::move(V), std::move(F), options, checked_threads(threads), true);
+}
+
+// Pickling (the package's FieldDesigner.__getstate__): the mesh as given and every solver option, including
+// the per-edge weight scales a refined designer may carry (trivcon/split_large_turns.h). Not the factorization.
+py::dict designer_state(const DesignerState& s) {
+  const SolverOptions& o = s.designer->solver_options();
+  py::dict d;
+  d["V"] = py::array_t<double>({static_cast<py::ssize_t>(s.V.rows()), static_cast<py::ssize_t>(3)}, s.V.data());
+  py::array_t<std::int32_t> F({static_cast<py::ssize_t>(s.F.rows()), static_cast<py::ssize_t>(3)}, s.F.data());
+  d["F"] = F;
+  d["weights"] = o.weights == WeightKind::Unit ? "unit" : "cotan";
+  d["solver"] = o.solver == SolverKind::QR ? "qr" : "cholesky";
+  d["factorization"] = o.factorization == Factorization::Cholmod ? "cholmod" : "own";
+  d["weight_floor"] = o.weight_floor;
+  d["edge_weight_scale"] = o.edge_weight_scale;
+  d["threads"] = s.threads;
+  return d;
+}
+
+DesignerPtr restore_designer(const py::dict& d) {
+  SolverOptions o = solver_options(d["weights"].cast<std::string>(), d["solver"].cast<std::string>(),
+                                   d["factorization"].cast<std::string>(), d["weight_floor"].cast<double>());
+  o.edge_weight_scale = d["edge_weight_scale"].cast<std::vector<double>>();
+  return build_designer(d["V"].cast<MatrixX3d>(), d["F"].cast<MatrixX3i>(), o, checked_threads(d["threads"].cast<int>()), false);
 }
 
 void check_face(const Topology& t, int f, const std::string& what) {
@@ -253,16 +451,108 @@ struct DesignResult {
     return out;
   }
 };
+using DesignResultPtr = std::shared_ptr<DesignResult>;
 
-py::array_t<std::uint8_t> render_design(const DesignResult& r, const RenderArgs& args, const std::vector<std::pair<int, int>>* singular) {
+template <class Map>
+py::list map_items(const Map& m) {
+  py::list out;
+  for (const auto& [k, v] : m) out.append(py::make_tuple(k, v));
+  return out;
+}
+
+template <class K, class V>
+std::map<K, V> items_map(const py::handle& items) {
+  std::map<K, V> out;
+  for (const auto& item : items.cast<std::vector<std::pair<K, V>>>()) out.insert(item);
+  return out;
+}
+
+// Pickling (the package's Result.__getstate__): the prescription and everything the design computed, so that
+// a restored Result gives the same numbers without solving again.
+py::dict design_state(const DesignResult& r) {
+  const Design& d = r.design;
+  const Connection& c = d.connection;
+  py::dict s;
+  s["N"] = r.prescription.N;
+  s["vertex"] = map_items(r.prescription.vertex);
+  s["generator"] = map_items(r.prescription.generator);
+  s["loop"] = map_items(r.prescription.loop);
+  s["fixed"] = map_items(r.prescription.fixed);
+  s["x"] = double_vector(c.x);
+  s["generator_index"] = c.generator_index;
+  s["loop_index"] = c.loop_index;
+  s["generator_chosen"] = std::vector<int>(c.generator_chosen.begin(), c.generator_chosen.end());
+  s["loop_chosen"] = std::vector<int>(c.loop_chosen.begin(), c.loop_chosen.end());
+  s["path_turn"] = c.path_turn;
+  s["energy"] = c.energy;
+  s["residuals"] = py::make_tuple(c.max_vertex_residual, c.max_cycle_residual, c.rhs_scale);
+  s["refinements"] = c.refinements;
+  s["angle"] = double_vector(d.field.angle);
+  s["indices"] = py::make_tuple(d.indices.vertex, d.indices.loop, d.indices.generator, d.indices.max_rounding);
+  s["transport_mismatch"] = d.transport_mismatch;
+  s["index_mismatch_vertices"] = d.index_mismatch_vertices;
+  s["large_turn_edges"] = d.large_turn_edges;
+  s["unexplained_mismatch_vertices"] = d.unexplained_mismatch_vertices;
+  s["max_fixed_error"] = d.max_fixed_error;
+  py::list conflicts;
+  for (const FixedConflict& k : d.conflicts) conflicts.append(py::make_tuple(k.face_a, k.face_b, k.turn));
+  s["conflicts"] = conflicts;
+  s["seconds"] = py::make_tuple(d.solve_seconds, d.field_seconds, d.verify_seconds);
+  s["verified"] = r.verified;
+  return s;
+}
+
+DesignResultPtr restore_design(const DesignerPtr& state, const py::dict& s) {
+  auto r = std::make_shared<DesignResult>();
+  r->state = state;
+  IndexPrescription& p = r->prescription;
+  p.N = s["N"].cast<int>();
+  p.vertex = items_map<int, int>(s["vertex"]);
+  p.generator = items_map<int, int>(s["generator"]);
+  p.loop = items_map<int, int>(s["loop"]);
+  p.fixed = items_map<int, double>(s["fixed"]);
+  Design& d = r->design;
+  Connection& c = d.connection;
+  c.N = p.N;
+  c.x = s["x"].cast<Eigen::VectorXd>();
+  c.generator_index = s["generator_index"].cast<std::vector<int>>();
+  c.loop_index = s["loop_index"].cast<std::vector<int>>();
+  for (int k : s["generator_chosen"].cast<std::vector<int>>()) c.generator_chosen.push_back(static_cast<char>(k));
+  for (int k : s["loop_chosen"].cast<std::vector<int>>()) c.loop_chosen.push_back(static_cast<char>(k));
+  c.path_turn = s["path_turn"].cast<std::vector<int>>();
+  c.energy = s["energy"].cast<double>();
+  std::tie(c.max_vertex_residual, c.max_cycle_residual, c.rhs_scale) = s["residuals"].cast<std::tuple<double, double, double>>();
+  c.refinements = s["refinements"].cast<int>();
+  d.field.N = p.N;
+  d.field.angle = s["angle"].cast<Eigen::VectorXd>();
+  std::tie(d.indices.vertex, d.indices.loop, d.indices.generator, d.indices.max_rounding) =
+      s["indices"].cast<std::tuple<std::vector<int>, std::vector<int>, std::vector<int>, double>>();
+  d.transport_mismatch = s["transport_mismatch"].cast<double>();
+  d.index_mismatch_vertices = s["index_mismatch_vertices"].cast<std::vector<int>>();
+  d.large_turn_edges = s["large_turn_edges"].cast<int>();
+  d.unexplained_mismatch_vertices = s["unexplained_mismatch_vertices"].cast<std::vector<int>>();
+  d.max_fixed_error = s["max_fixed_error"].cast<double>();
+  for (auto [a, b, turn] : s["conflicts"].cast<std::vector<std::tuple<int, int, double>>>()) d.conflicts.push_back({a, b, turn});
+  std::tie(d.solve_seconds, d.field_seconds, d.verify_seconds) = s["seconds"].cast<std::tuple<double, double, double>>();
+  r->verified = s["verified"].cast<bool>();
+  // A state of another mesh would index out of its arrays: refuse it.
+  const Topology& t = state->topology();
+  if (p.N < 1 || c.x.size() != t.num_edges || d.field.angle.size() != t.num_faces ||
+      d.indices.vertex.size() != static_cast<size_t>(t.num_vertices))
+    throw Error("cannot restore a Result: its arrays do not fit its designer's mesh (" + std::to_string(t.num_vertices) + " vertices, " +
+                std::to_string(t.num_edges) + " edges, " + std::to_string(t.num_faces) + " faces)");
+  for (const auto& [f, angle] : p.fixed) check_face(t, f, "cannot restore a Result: fixed face");
+  return r;
+}
+
+py::array_t<std::uint8_t> render_design(const DesignResultPtr& r, const RenderArgs& args,
+                                        const std::optional<std::vector<std::pair<int, int>>>& singular) {
   const RenderOptions o = args.options();
-  Image image;
-  {
-    py::gil_scoped_release release;
+  const Image image = interruptible(r->state->threads, [r, o, singular] {
     // Default: the prescription's singularities, as `trivcon solve --png` draws them.
-    const std::vector<std::pair<int, int>> given(r.prescription.vertex.begin(), r.prescription.vertex.end());
-    image = render_field(r.state->V, r.state->topology(), r.state->geometry(), r.design.field, singular ? *singular : given, o);
-  }
+    const std::vector<std::pair<int, int>> given(r->prescription.vertex.begin(), r->prescription.vertex.end());
+    return render_field(r->state->V, r->state->topology(), r->state->geometry(), r->design.field, singular ? *singular : given, o);
+  });
   return from_image(image);
 }
 
@@ -272,6 +562,46 @@ struct AutoOut {
   DesignerPtr state;
   AutoResult result;
 };
+using AutoOutPtr = std::shared_ptr<AutoOut>;
+
+py::dict auto_state(const AutoOut& a) {
+  const AutoResult& r = a.result;
+  py::dict s;
+  s["N"] = r.field.N;
+  s["angle"] = double_vector(r.field.angle);
+  s["found"] = map_items(r.found);
+  s["coincident_removed"] = r.coincident_removed;
+  s["vertex"] = map_items(r.vertex);
+  s["pairs"] = r.pairs;
+  s["energy"] = r.energy;
+  s["vanishing_faces"] = r.vanishing_faces;
+  s["ordering"] = r.ordering;
+  const AutoTimings& t = r.seconds;
+  s["seconds"] = std::vector<double>{t.assemble, t.factor, t.iterate, t.align, t.indices, t.cancel};
+  return s;
+}
+
+AutoOutPtr restore_auto(const DesignerPtr& state, const py::dict& s) {
+  auto a = std::make_shared<AutoOut>();
+  a->state = state;
+  AutoResult& r = a->result;
+  r.field.N = s["N"].cast<int>();
+  r.field.angle = s["angle"].cast<Eigen::VectorXd>();
+  r.found = items_map<int, int>(s["found"]);
+  r.coincident_removed = s["coincident_removed"].cast<int>();
+  r.vertex = items_map<int, int>(s["vertex"]);
+  r.pairs = s["pairs"].cast<std::vector<std::pair<int, int>>>();
+  r.energy = s["energy"].cast<double>();
+  r.vanishing_faces = s["vanishing_faces"].cast<int>();
+  r.ordering = s["ordering"].cast<std::string>();
+  const auto t = s["seconds"].cast<std::vector<double>>();
+  if (t.size() != 6 || r.field.N < 1 || r.field.angle.size() != state->topology().num_faces)
+    throw Error("cannot restore an AutoResult: its arrays do not fit its designer's mesh (" +
+                std::to_string(state->topology().num_faces) + " faces)");
+  r.seconds.assemble = t[0], r.seconds.factor = t[1], r.seconds.iterate = t[2], r.seconds.align = t[3], r.seconds.indices = t[4],
+  r.seconds.cancel = t[5];
+  return a;
+}
 
 }  // namespace
 
@@ -285,16 +615,58 @@ PYBIND11_MODULE(_core, m) {
   py::register_exception<Error>(m, "Error", PyExc_ValueError);
   m.attr("__version__") = TRIVCON_VERSION;
   m.attr("pi") = kPi;
+  main_thread_ident = py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
+
+  // --- Threads, and abandoned work (see the top of this file).
+  m.def(
+      "set_default_threads", [](int threads) { default_threads = checked_threads(threads); }, py::arg("threads"),
+      "The thread count of calls that name none (0: OpenMP's default).");
+  m.def("default_threads", [] { return default_threads.load(); });
+  m.def("omp_default_threads", [] { return interruptible(-1, [] { return std::max(1, omp_get_max_threads()); }); },
+        "OpenMP's thread count on a new thread (OMP_NUM_THREADS, or the cores).");
+  m.def("blas_threads", &blas_threads, "OpenBLAS's thread count for the process (0 without OpenBLAS).");
+  m.def(
+      "set_blas_threads", [](int threads) { set_blas_threads(threads); }, py::arg("threads"));
+  m.def(
+      "probe_threads",
+      [](int threads) {
+        // What a call with this thread count sees: OpenMP's count on its thread, and OpenBLAS's.
+        using Seen = std::pair<int, int>;
+        return interruptible(threads, [] {
+          const auto get = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+          return Seen(omp_get_max_threads(), get ? get() : 0);
+        });
+      },
+      py::arg("threads"), "(OpenMP threads, OpenBLAS threads) inside a call with `threads` threads (for tests).");
+  m.def(
+      "sleep_interruptibly",
+      [](double seconds) {
+        // A long call that polls its cancellation flag every millisecond (for tests of KeyboardInterrupt):
+        // returns the seconds slept, or is abandoned.
+        return interruptible(0, [seconds] {
+          const auto start = std::chrono::steady_clock::now();
+          while (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < seconds) {
+            check_cancelled();
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+          }
+          return seconds;
+        });
+      },
+      py::arg("seconds"));
+  m.def("wait_for_background", &wait_for_background, py::arg("seconds") = -1.0, py::arg("cancel") = false,
+        "Waits for the long calls still running, abandoned ones included (at most `seconds`, negative: no limit), "
+        "cancelling them first with `cancel`; whether none is left.");
+  m.def("background_running", [] {
+    Background& bg = background();
+    std::lock_guard<std::mutex> lock(bg.mutex);
+    return bg.running;
+  });
 
   // --- Files.
   m.def(
       "read_mesh",
       [](const std::string& path) {
-        MeshData mesh;
-        {
-          py::gil_scoped_release release;
-          mesh = read_mesh(path);
-        }
+        const MeshData mesh = interruptible(0, [path] { return read_mesh(path); });
         return py::make_tuple(double_matrix3(mesh.V), int64_matrix(mesh.F), int64_vector(mesh.polygon_of_triangle), mesh.polygon_count,
                               mesh.format);
       },
@@ -364,27 +736,24 @@ PYBIND11_MODULE(_core, m) {
   // --- Fields on plain (V, F).
   m.def(
       "field_indices",
-      [](const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& directions, int N) {
-        FieldIndices idx;
-        {
-          py::gil_scoped_release release;
+      [](MatrixX3d V, MatrixX3i F, MatrixX3d directions, int N) {
+        const FieldIndices idx = interruptible(0, [V = std::move(V), F = std::move(F), directions = std::move(directions), N] {
           const PreparedMesh p(V, F);
           check_rows(directions, p.topology.num_faces);
           if (N < 1) throw Error("the symmetry N must be at least 1 (got " + std::to_string(N) + ")");
-          idx = field_indices(p.topology, p.geometry, compute_cycles(p.topology), field_from_directions(p.geometry, directions, N));
-        }
+          return field_indices(p.topology, p.geometry, compute_cycles(p.topology), field_from_directions(p.geometry, directions, N));
+        });
         return indices_tuple(idx);
       },
       py::arg("V"), py::arg("F"), py::arg("directions"), py::arg("N"),
       "(vertex n, loop n, generator n) read from a per-face field, as `trivcon check` does.");
   m.def(
       "render",
-      [](const MatrixX3d& V, const MatrixX3i& F, const MatrixX3d& directions, int N,
-         const std::optional<std::vector<std::pair<int, int>>>& singular, const RenderArgs& args) {
+      [](MatrixX3d V, MatrixX3i F, MatrixX3d directions, int N, std::optional<std::vector<std::pair<int, int>>> singular,
+         const RenderArgs& args) {
         const RenderOptions o = args.options();
-        Image image;
-        {
-          py::gil_scoped_release release;
+        const Image image = interruptible(0, [V = std::move(V), F = std::move(F), directions = std::move(directions), N,
+                                              singular = std::move(singular), o] {
           const PreparedMesh p(V, F);
           check_rows(directions, p.topology.num_faces);
           if (N < 1) throw Error("the symmetry N must be at least 1 (got " + std::to_string(N) + ")");
@@ -399,8 +768,8 @@ PYBIND11_MODULE(_core, m) {
           } else {  // as `trivcon render`: where the field itself is singular
             s = singular_vertices(field_indices(p.topology, p.geometry, compute_cycles(p.topology), field).vertex);
           }
-          image = render_field(V, p.topology, p.geometry, field, s, o);
-        }
+          return render_field(V, p.topology, p.geometry, field, s, o);
+        });
         return from_image(image);
       },
       py::arg("V"), py::arg("F"), py::arg("directions"), py::arg("N"), py::arg("singularities"), py::arg("options"),
@@ -449,7 +818,12 @@ PYBIND11_MODULE(_core, m) {
   // --- FieldDesigner.
   py::class_<DesignerState, DesignerPtr>(m, "Designer", "trivcon::FieldDesigner on (V, F), factored at construction.")
       .def(py::init(&make_designer), py::arg("V"), py::arg("F"), py::arg("weights"), py::arg("solver"), py::arg("factorization"),
-           py::arg("weight_floor") = 0.0)
+           py::arg("weight_floor") = 0.0, py::arg("threads") = 0)
+      .def_static("restore", &restore_designer, py::arg("state"), "A designer of get_state()'s dict, factored on its first solve.")
+      .def("get_state", &designer_state, "The mesh as given and the solver options (for pickling).")
+      .def_property(
+          "threads", [](const DesignerState& s) { return s.threads; },
+          [](DesignerState& s, int threads) { s.threads = checked_threads(threads); })
       .def_property_readonly("V", [](const DesignerState& s) { return double_matrix3(s.V); })
       .def_property_readonly("F_input", [](const DesignerState& s) { return int64_matrix(s.F); })
       .def_property_readonly("F", [](const DesignerState& s) { return int64_matrix(s.topology().F); })
@@ -530,120 +904,137 @@ PYBIND11_MODULE(_core, m) {
       .def("boundary_alignment", [](const DesignerState& s) { return boundary_alignment(s.V, s.topology(), s.geometry()); })
       .def(
           "design",
-          [](const DesignerPtr& s, int N, const std::map<int, int>& vertex, const std::map<int, int>& generator,
-             const std::map<int, int>& loop, const std::map<int, double>& fixed, const std::vector<std::pair<int, double>>& roots) {
-            auto r = std::make_unique<DesignResult>();
+          [](const DesignerPtr& s, int N, std::map<int, int> vertex, std::map<int, int> generator, std::map<int, int> loop,
+             std::map<int, double> fixed, std::vector<std::pair<int, double>> roots, std::optional<Eigen::VectorXd> guide) {
+            auto r = std::make_shared<DesignResult>();
             r->state = s;
             r->prescription.N = N;
-            r->prescription.vertex = vertex;
-            r->prescription.generator = generator;
-            r->prescription.loop = loop;
-            r->prescription.fixed = fixed;
-            {
-              py::gil_scoped_release release;
-              std::lock_guard<std::mutex> lock(s->mutex);
-              for (const auto& [f, angle] : fixed) check_face(s->topology(), f, "fixed face");
-              s->use_fixed_faces(fixed);
-              r->design = s->designer->design(r->prescription, roots);
+            r->prescription.vertex = std::move(vertex);
+            r->prescription.generator = std::move(generator);
+            r->prescription.loop = std::move(loop);
+            r->prescription.fixed = std::move(fixed);
+            return interruptible(s->threads, [r, roots = std::move(roots), guide = std::move(guide)]() mutable {
+              DesignerState& state = *r->state;
+              std::lock_guard<std::mutex> lock(state.mutex);
+              check_cancelled();  // abandoned while it waited for the designer
+              for (const auto& [f, angle] : r->prescription.fixed) check_face(state.topology(), f, "fixed face");
+              state.use_fixed_faces(r->prescription.fixed);
+              if (guide) {  // singularities="auto": each component's rotation from the smoothest field (trivcon/auto.h)
+                const Field g{r->prescription.N, *guide};
+                roots = roots_toward(*state.designer, state.designer->design(r->prescription, roots).field, g, roots, r->prescription.fixed);
+              }
+              r->design = state.designer->design(r->prescription, roots);
               r->verified = design_verified(r->design);
-            }
-            return r;
+              return r;
+            });
           },
           py::arg("N"), py::arg("vertex"), py::arg("generator"), py::arg("loop"), py::arg("fixed"), py::arg("roots"),
-          "A Design of the prescription (n = index·N per id; fixed: face -> angle).")
+          py::arg("guide") = py::none(),
+          "A Design of the prescription (n = index·N per id; fixed: face -> angle); with `guide` (per-face angles of an N-field), "
+          "components without a root or fixed face take their rotation from it (roots_toward).")
       .def(
           "split_large_turns",
-          [](const DesignerPtr& s, int N, const std::map<int, int>& vertex, const std::map<int, double>& fixed, bool align_boundary,
-             int max_rounds, const std::string& weights, const std::string& solver, const std::string& factorization, double weight_floor) {
+          [](const DesignerPtr& s, int N, std::map<int, int> vertex, std::map<int, double> fixed, bool align_boundary, int max_rounds,
+             const std::string& weights, const std::string& solver, const std::string& factorization, double weight_floor) {
             const SolverOptions options = solver_options(weights, solver, factorization, weight_floor);
-            auto r = std::make_unique<DesignResult>();
-            r->prescription.N = N;
-            r->prescription.vertex = vertex;
-            r->prescription.fixed = fixed;
-            if (align_boundary)
-              for (auto [f, angle] : boundary_alignment(s->V, s->topology(), s->geometry())) r->prescription.fixed.emplace(f, angle);
-            std::vector<RefineRound> rounds;
-            std::vector<int> parent;
-            bool converged = false;
-            DesignerPtr refined = s;
-            {
-              py::gil_scoped_release release;
+            struct Refined {
+              DesignerPtr designer;
+              DesignResultPtr result;
+              std::vector<int> parent;
+              std::vector<RefineRound> rounds;
+              bool converged = false;
+            };
+            Refined out = interruptible(s->threads, [s, N, vertex = std::move(vertex), fixed = std::move(fixed), align_boundary, max_rounds,
+                                                     options] {
+              Refined o;
+              auto r = std::make_shared<DesignResult>();
+              r->prescription.N = N;
+              r->prescription.vertex = vertex;
+              r->prescription.fixed = fixed;
               std::lock_guard<std::mutex> lock(s->mutex);
+              check_cancelled();  // abandoned while it waited for the designer
               for (const auto& [f, angle] : fixed) check_face(s->topology(), f, "fixed face");
+              if (align_boundary)
+                for (auto [f, angle] : boundary_alignment(s->V, s->topology(), s->geometry())) r->prescription.fixed.emplace(f, angle);
               s->use_fixed_faces(r->prescription.fixed);
               // Each refined mesh: the boundary aligned again, the given fixed faces' directions (world
               // vectors) on their children (they win, as on the input mesh).
               std::map<int, Eigen::Vector3d> world;
               for (auto [f, angle] : fixed) world[f] = s->geometry().direction_in_face(f, angle);
               auto constraints = [&](const FieldDesigner& d, const std::vector<int>& parent_face) {
-                std::map<int, double> out;
-                if (align_boundary) out = boundary_alignment(d.V(), d.topology(), d.geometry());
+                std::map<int, double> c;
+                if (align_boundary) c = boundary_alignment(d.V(), d.topology(), d.geometry());
                 for (int f = 0; f < static_cast<int>(parent_face.size()); ++f) {
                   const auto it = world.find(parent_face[f]);
-                  if (it != world.end()) out[f] = d.geometry().angle_in_face(f, it->second);
+                  if (it != world.end()) c[f] = d.geometry().angle_in_face(f, it->second);
                 }
-                return out;
+                return c;
               };
               RefinedDesign d = split_large_turns(*s->designer, s->F, r->prescription, options, constraints, max_rounds);
-              rounds = d.rounds, parent = d.parent_face, converged = d.converged;
+              o.rounds = d.rounds, o.parent = d.parent_face, o.converged = d.converged;
+              o.designer = s;
               if (d.designer) {
-                refined = std::make_shared<DesignerState>();
+                auto refined = std::make_shared<DesignerState>();
+                refined->threads = s->threads;
                 refined->V = d.V, refined->F = d.F;
                 refined->designer = std::move(d.designer);
                 for (const auto& [f, angle] : d.prescription.fixed) refined->fixed_faces.push_back(f);
                 refined->sort_edges();
+                o.designer = refined;
               }
+              r->state = o.designer;
               r->prescription = d.prescription;
               r->design = std::move(d.design);
               r->verified = design_verified(r->design);
-            }
-            r->state = refined;
+              o.result = r;
+              return o;
+            });
             py::list round_list;
-            for (const RefineRound& k : rounds) {
+            for (const RefineRound& k : out.rounds) {
               py::dict d;
-              d["split_edges"] = k.split_edges, d["vertices"] = k.vertices, d["faces"] = k.faces;
+              d["split_edges"] = k.split_edges, d["vertices"] = k.vertices, d["faces"] = k.faces, d["reweighted"] = k.reweighted;
               round_list.append(d);
             }
-            return py::make_tuple(refined, py::cast(std::move(r)), int64_vector(parent), round_list, converged);
+            return py::make_tuple(out.designer, out.result, int64_vector(out.parent), round_list, out.converged);
           },
           py::arg("N"), py::arg("vertex"), py::arg("fixed"), py::arg("align_boundary"), py::arg("max_rounds"), py::arg("weights"),
           py::arg("solver"), py::arg("factorization"), py::arg("weight_floor"),
-          "Design, refined until no edge turns by pi/N or more (trivcon/refine.h): (designer of the final mesh, DesignResult, "
+          "Design, refined until no edge turns by pi/N or more (trivcon/split_large_turns.h): (designer of the final mesh, DesignResult, "
           "parent face of each face, rounds, converged).")
       .def(
           "auto_singularities",
-          [](const DesignerPtr& s, int N, int iterations, double cancel, bool cancel_absolute, const std::map<int, double>& fixed,
+          [](const DesignerPtr& s, int N, int iterations, double cancel, bool cancel_absolute, std::map<int, double> fixed,
              bool align_curvature, double curvature_t) {
             AutoOptions o;
-            o.N = N, o.iterations = iterations, o.cancel_distance = cancel, o.cancel_absolute = cancel_absolute, o.fixed = fixed;
+            o.N = N, o.iterations = iterations, o.cancel_distance = cancel, o.cancel_absolute = cancel_absolute, o.fixed = std::move(fixed);
             o.align_curvature = align_curvature, o.curvature_t = curvature_t;
-            auto out = std::make_unique<AutoOut>();
-            out->state = s;
-            {
-              py::gil_scoped_release release;
+            return interruptible(s->threads, [s, o] {
+              auto out = std::make_shared<AutoOut>();
+              out->state = s;
               std::lock_guard<std::mutex> lock(s->mutex);
-              for (const auto& [f, angle] : fixed) check_face(s->topology(), f, "fixed face");
+              check_cancelled();  // abandoned while it waited for the designer
+              for (const auto& [f, angle] : o.fixed) check_face(s->topology(), f, "fixed face");
               out->result = auto_singularities(*s->designer, o);
-            }
-            return out;
+              return out;
+            });
           },
           py::arg("N"), py::arg("iterations"), py::arg("cancel"), py::arg("cancel_absolute"), py::arg("fixed"), py::arg("align_curvature"),
           py::arg("curvature_t"), "Singularities of the smoothest field (trivcon/auto.h).")
       .def(
           "field_indices",
-          [](const DesignerState& s, const MatrixX3d& directions, int N) {
-            FieldIndices idx;
-            {
-              py::gil_scoped_release release;
-              check_rows(directions, s.topology().num_faces);
+          [](const DesignerPtr& s, MatrixX3d directions, int N) {
+            const FieldIndices idx = interruptible(s->threads, [s, directions = std::move(directions), N] {
+              check_rows(directions, s->topology().num_faces);
               if (N < 1) throw Error("the symmetry N must be at least 1 (got " + std::to_string(N) + ")");
-              idx = field_indices(s.topology(), s.geometry(), s.designer->cycles(), field_from_directions(s.geometry(), directions, N));
-            }
+              return field_indices(s->topology(), s->geometry(), s->designer->cycles(), field_from_directions(s->geometry(), directions, N));
+            });
             return indices_tuple(idx);
           },
           py::arg("directions"), py::arg("N"), "(vertex n, loop n, generator n) of a per-face field on this mesh.");
 
-  py::class_<DesignResult>(m, "DesignResult", "A trivcon::Design with its prescription.")
+  py::class_<DesignResult, DesignResultPtr>(m, "DesignResult", "A trivcon::Design with its prescription.")
+      .def("get_state", &design_state, "Everything the design holds (for pickling).")
+      .def_static("restore", &restore_design, py::arg("designer"), py::arg("state"), "A DesignResult of get_state()'s dict.")
       .def_property_readonly("N", [](const DesignResult& r) { return r.prescription.N; })
       .def_property_readonly("vertex", [](const DesignResult& r) { return r.prescription.vertex; })
       .def_property_readonly("fixed", [](const DesignResult& r) { return r.prescription.fixed; })
@@ -728,17 +1119,19 @@ PYBIND11_MODULE(_core, m) {
           py::arg("path"))
       .def(
           "render",
-          [](const DesignResult& r, const std::optional<std::vector<std::pair<int, int>>>& singular, const RenderArgs& args) {
+          [](const DesignResultPtr& r, const std::optional<std::vector<std::pair<int, int>>>& singular, const RenderArgs& args) {
             if (singular)
               for (auto [v, n] : *singular)
-                if (v < 0 || v >= r.state->topology().num_vertices)
+                if (v < 0 || v >= r->state->topology().num_vertices)
                   throw Error("singular vertex " + std::to_string(v) + " out of range (mesh has " +
-                              std::to_string(r.state->topology().num_vertices) + " vertices)");
-            return render_design(r, args, singular ? &*singular : nullptr);
+                              std::to_string(r->state->topology().num_vertices) + " vertices)");
+            return render_design(r, args, singular);
           },
           py::arg("singularities"), py::arg("options"));
 
-  py::class_<AutoOut>(m, "AutoResult", "A trivcon::AutoResult.")
+  py::class_<AutoOut, AutoOutPtr>(m, "AutoResult", "A trivcon::AutoResult.")
+      .def("get_state", &auto_state, "Everything the result holds (for pickling).")
+      .def_static("restore", &restore_auto, py::arg("designer"), py::arg("state"), "An AutoResult of get_state()'s dict.")
       .def_property_readonly("N", [](const AutoOut& a) { return a.result.field.N; })
       .def_property_readonly("found", [](const AutoOut& a) { return a.result.found; })
       .def_property_readonly("vertex", [](const AutoOut& a) { return a.result.vertex; })

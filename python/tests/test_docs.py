@@ -34,7 +34,7 @@ def test_every_public_name_has_a_docstring():
 
 def test_help_reads_well():
     text = pydoc.render_doc(trivcon, renderer=pydoc.plaintext)
-    for needle in ("trivcon: direction fields", "class FieldDesigner", "solve(self, N=1, singularities=None", "field_indices(V, F, directions, N=1)",
+    for needle in ("trivcon: direction fields", "class FieldDesigner", "solve(self, N=1, singularities=None", "field_indices(V, F, directions, N=1, arrays=False)",
                    "render(V, F, directions, N=1", "class Error", "Face frames", "batch"):
         assert needle in text, needle
     assert pydoc.render_doc(trivcon.FieldDesigner.solve, renderer=pydoc.plaintext).count("singularities") >= 3

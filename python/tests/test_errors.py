@@ -126,7 +126,8 @@ def test_index_errors(sphere):
     raises("singularities[2]: given twice", d.solve, N=1, singularities=[(2, 1), (2, 1)])
     raises("N must be an integer, got 4.0", d.solve, N=4.0)
     raises("the symmetry N must be at least 1 (got 0)", d.solve, N=0)
-    raises("singularities must be a dict {id: index} or a list of (id, index) pairs, not int", d.solve, N=1, singularities=5)
+    raises("singularities must be a dict {id: index}, a list of (id, index) pairs or a tuple (ids, numerators) of two integer arrays, "
+           "not int", d.solve, N=1, singularities=5)
 
 
 def test_prescription_errors_are_the_librarys(sphere, annulus):

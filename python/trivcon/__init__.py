@@ -9,6 +9,7 @@ same C++ library as the `trivcon` command line. Plain numpy arrays in, plain arr
     d = trivcon.FieldDesigner(V, F)              # validates and factors once
     r = d.solve(N=4, singularities={12: "1/4", 40: -0.25, ...})   # milliseconds per re-solve
     r.directions, r.angles, r.connection, r.edges, r.energy, r.residual, r.singularities
+    r.verified, r.field_exact                    # the connection checks; the per-face field reads exactly
     r2 = d.solve(N=4, singularities="auto")      # the singularities of the smoothest cross field
     trivcon.field_indices(V, F, r.directions, N=4)          # {vertex: Fraction}, of any tool's field
     trivcon.write_field("f.rawfield", V, F, r.directions, N=4)
@@ -17,31 +18,46 @@ same C++ library as the `trivcon` command line. Plain numpy arrays in, plain arr
 Conventions (the CLI's, see the README):
 - Ids are the file's own, 0-based; nothing is renumbered. Polygons are fan-triangulated in order.
 - Indices are exact multiples of 1/N. They are given as int, float (a multiple of 1/N),
-  fractions.Fraction or "p/q" strings, and returned as fractions.Fraction.
+  fractions.Fraction or "p/q" strings, and returned as fractions.Fraction; or as arrays: a tuple
+  (vertex ids, numerators) of two 1-D integer numpy arrays, index = numerator / N, in and out
+  (Result.singularity_arrays, field_indices(..., arrays=True)).
 - Orientation: FieldDesigner re-orients a component whose faces disagree (flipping the smaller class);
   FieldDesigner.F is the oriented copy, and face frames, normals and angles refer to it.
 - Face frames: face f's x axis runs along its first edge (corner 0 -> corner 1 of the oriented face), the
   y axis is normal x x_axis, angles increase counter-clockwise about the normal (p1 - p0) x (p2 - p0).
   A field's angle a at face f is the world direction cos(a) X[f] + sin(a) Y[f]; its N directions are
-  a + 2 pi k / N.
+  a + 2 pi k / N (all of them: Result.all_directions()).
 - Edges (i, j) have i < j, sorted by (i, j); face L holds the half-edge i -> j, R the half-edge j -> i.
   A direction at angle b in L is carried to b + rho - x in R (x: the connection, radians).
 - Arrays: V accepts any real dtype, F any integer dtype (both any layout, (n, 3) and (m, 3));
-  directions are (m, 3) world vectors. Outputs are float64 and int64 arrays.
+  directions are (m, 3) world vectors. Outputs are float64 and int64 arrays. The arrays of a
+  FieldDesigner, Result and AutoResult are computed once and read-only (copy one to change it); those
+  that functions return (read_mesh, make_*, render, ...) are new and yours.
 
 Every error -- a bad array, a bad index, and every error of the library (a bad file, a non-manifold mesh,
 a prescription violating Gauss-Bonnet, ...) -- raises trivcon.Error, a ValueError whose message is the
-one the CLI prints after "trivcon: error: ". Long calls release the GIL.
+one the CLI prints after "trivcon: error: ".
+
+Long calls release the GIL and stop on Ctrl-C: KeyboardInterrupt is raised within about 20 ms (the
+abandoned work stops at its next safe point, within a fraction of a second, and frees what it built).
+Threads: FieldDesigner(threads=k), trivcon.set_threads(k) or the environment variable TRIVCON_THREADS
+(see set_threads). FieldDesigner, Result and AutoResult pickle (a FieldDesigner is rebuilt from its mesh
+and options when unpickled, and factored again on its first solve), so they come back from
+multiprocessing and Dask workers.
 
 Batches of meshes on a Dask cluster: python3 -m trivcon.batch --help (trivcon/batch.py).
 """
 
-import math
-import numbers
-from collections.abc import Mapping
-from fractions import Fraction
+import atexit as _atexit
+import math as _math
+import numbers as _numbers
+import os as _os
+import re as _re
+import warnings as _warnings
+from collections.abc import Mapping as _Mapping
+from fractions import Fraction as _Fraction
 
-import numpy as np
+import numpy as _np
 
 from . import _core
 
@@ -70,6 +86,9 @@ __all__ = [
     "make_annulus",
     "make_holed_grid",
     "blas_kernels",
+    "set_threads",
+    "get_threads",
+    "batch",
 ]
 
 Error = _core.Error
@@ -82,21 +101,45 @@ indices on component 0 sum to 3/2, but Gauss-Bonnet needs its Euler characterist
 errors name the array and its shape or dtype (e.g. "V must have shape (n, 3), got shape (8, 2)")."""
 
 _INT32_MAX = 2**31 - 1
+_MAX_INDEX_PART = 10**9  # the library's bound on p and q of an index "p/q" (src/indices.cpp)
+_INDEX_TEXT = _re.compile(r"\s*([+-]?[0-9]+)(?:/([+-]?[0-9]+))?\s*\Z")
 
 
 # ---------------------------------------------------------------------------------------------------------
-# Arrays in
+# Arrays in and out
+
+
+def _frozen(a):
+    """`a` made read-only (the arrays an object hands out are views of what it keeps)."""
+    a.flags.writeable = False
+    return a
 
 
 def _array(value, name):
     try:
-        return np.asarray(value)
+        return _np.asarray(value)
     except (ValueError, TypeError) as e:
         raise Error(f"{name} must be an array: {e}") from None
 
 
 def _shape_text(shape):
     return "(" + ", ".join(str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
+
+
+def _short(value):
+    """The text of a number for a message: as written when short, else about 10 significant characters."""
+    if isinstance(value, str):
+        text = value.strip()
+        return text if len(text) <= 24 else text[:20] + "..."
+    text = repr(value) if isinstance(value, float) else str(value)
+    if len(text) <= 24:
+        return text
+    try:
+        return f"{float(value):.6g}"
+    except OverflowError:  # beyond a float: the power of ten
+        f = _Fraction(value)
+        exponent = len(str(abs(f.numerator))) - len(str(f.denominator))
+        return f"{'-' if f < 0 else ''}~1e+{exponent}"
 
 
 def _vectors(value, name, rows=None, rows_text="n"):
@@ -107,7 +150,7 @@ def _vectors(value, name, rows=None, rows_text="n"):
         raise Error(f"{name} must have shape {want}, got shape {_shape_text(a.shape)}")
     if a.dtype.kind not in "fiu":
         raise Error(f"{name} must hold real numbers, got dtype {a.dtype}")
-    return np.ascontiguousarray(a, dtype=np.float64)
+    return _np.ascontiguousarray(a, dtype=_np.float64)
 
 
 def _vertices(V):
@@ -130,7 +173,7 @@ def _faces(F, num_vertices):
                     raise Error(f"vertex index {i} out of range in face {f} (mesh has {num_vertices} vertices)")
             if len(set(row)) < 3:
                 raise Error(f"face {f} has a repeated vertex ({row[0]}, {row[1]}, {row[2]})")
-    return np.ascontiguousarray(a, dtype=np.int32)
+    return _np.ascontiguousarray(a, dtype=_np.int32)
 
 
 def _mesh(V, F):
@@ -143,82 +186,136 @@ def _directions(directions, num_faces):
 
 
 def _symmetry(N):
-    if isinstance(N, bool) or not isinstance(N, numbers.Integral):
-        raise Error(f"N must be an integer, got {N!r}")
+    if isinstance(N, bool) or not isinstance(N, _numbers.Integral):
+        raise Error(f"N must be an integer, got {_short(N) if isinstance(N, _numbers.Number) else repr(N)}")
     N = int(N)
     if N < 1:
-        raise Error(f"the symmetry N must be at least 1 (got {N})")
+        raise Error(f"the symmetry N must be at least 1 (got {_short(N)})")
     if N > _INT32_MAX:
-        raise Error(f"the symmetry N = {N} is too large")
+        raise Error(f"the symmetry N = {_short(N)} is too large (at most {_INT32_MAX})")
     return N
 
 
 def _id(key, what):
-    if isinstance(key, bool) or not isinstance(key, numbers.Integral):
-        raise Error(f"{what}: ids must be integers, got {key!r}")
+    if isinstance(key, bool) or not isinstance(key, _numbers.Integral):
+        raise Error(f"{what}: ids must be integers, got {_short(key) if isinstance(key, _numbers.Number) else repr(key)}")
     key = int(key)
     if abs(key) > _INT32_MAX:
-        raise Error(f"{what}: id {key} out of range")
+        raise Error(f"{what}: id {_short(key)} out of range")
     return key
 
 
-def _index_text(value, N, where):
-    """The library's text for an index given as int, float, Fraction or "p/q" (parsed by the library)."""
+def _too_large(value, N, where):
+    limit = min(_MAX_INDEX_PART, _INT32_MAX // N)
+    return Error(f"{where}: index {_short(value)} is too large (|index| at most {limit} with N = {N})")
+
+
+def _numerator(value, N, where):
+    """n (the index is n/N) of an index given as int, float, Fraction or "p/q"; errors start with `where`.
+
+    Strings go through the library's parser (the one behind --sing, with its messages) once their size is
+    known to fit; every form of a number too large for the library's int indices gets the same message."""
     if isinstance(value, bool):
         raise Error(f"{where}: an index must be an int, a float, a fractions.Fraction or a 'p/q' string, not a bool")
+    limit = _Fraction(min(_MAX_INDEX_PART, _INT32_MAX // N))
     if isinstance(value, str):
-        return value
-    if isinstance(value, numbers.Integral):
-        return str(int(value))
-    if isinstance(value, numbers.Rational):
-        return f"{int(value.numerator)}/{int(value.denominator)}"
-    if isinstance(value, numbers.Real):
+        m = _INDEX_TEXT.match(value)
+        if m:
+            p, q = int(m.group(1)), int(m.group(2) or 1)
+            if q > 0 and (abs(p) > _MAX_INDEX_PART or q > _MAX_INDEX_PART or abs(_Fraction(p, q)) > limit):
+                raise _too_large(value, N, where)
+        elif len(value.strip()) > 24:  # the library would quote all of it
+            raise Error(f"{where}: malformed index '{_short(value)}' (expected an integer or a fraction p/q, q > 0)")
+        return _core.parse_index(value, N, where)
+    if isinstance(value, _numbers.Rational):  # int, numpy integers, Fraction
+        f = _Fraction(int(value.numerator), int(value.denominator))
+        if abs(f) > limit:
+            raise _too_large(value, N, where)
+        n = f * N
+        if n.denominator != 1:
+            raise Error(f"{where}: index {_short(f)} is not a multiple of 1/{N} (use -N to change the symmetry)")
+        return int(n)
+    if isinstance(value, _numbers.Real):
         v = float(value)
-        if not math.isfinite(v):
+        if not _math.isfinite(v):
             raise Error(f"{where}: index {v!r} is not finite")
+        if abs(v) > limit:
+            raise _too_large(v, N, where)
         n = round(v * N)
         if abs(v * N - n) > 1e-9 * max(1.0, abs(v * N)):
             raise Error(f"{where}: index {v!r} is not a multiple of 1/{N}")
-        return f"{n}/{N}"
+        return n
     raise Error(f"{where}: an index must be an int, a float, a fractions.Fraction or a 'p/q' string, not {type(value).__name__}")
+
+
+def _is_arrays(value):
+    """Whether `value` is the arrays form of indices: a tuple (ids, numerators) of two numpy arrays."""
+    return isinstance(value, tuple) and len(value) == 2 and all(isinstance(a, _np.ndarray) for a in value)
 
 
 def _items(mapping, what):
     if mapping is None:
         return []
-    if isinstance(mapping, Mapping):
+    if isinstance(mapping, _Mapping):
         return list(mapping.items())
     try:
         items = [tuple(item) for item in mapping]
     except TypeError:
-        raise Error(f"{what} must be a dict {{id: index}} or a list of (id, index) pairs, not {type(mapping).__name__}") from None
+        raise Error(f"{what} must be a dict {{id: index}}, a list of (id, index) pairs or a tuple (ids, numerators) of "
+                    f"two integer arrays, not {type(mapping).__name__}") from None
     if any(len(item) != 2 for item in items):
         raise Error(f"{what} must be a dict {{id: index}} or a list of (id, index) pairs")
     return items
 
 
 def _indices(mapping, N, what):
-    """{id: n} (index n/N) of a user's {id: index}; errors name `what[id]`."""
+    """{id: n} (index n/N) of a user's {id: index}, (id, index) pairs or (ids, numerators) arrays."""
     out = {}
+    if _is_arrays(mapping):
+        ids, numerators = mapping
+        if ids.ndim != 1 or numerators.shape != ids.shape or ids.dtype.kind not in "iu" or numerators.dtype.kind not in "iu":
+            raise Error(f"{what}: (ids, numerators) must be two 1-D integer arrays of the same length, got shapes "
+                        f"{_shape_text(ids.shape)} and {_shape_text(numerators.shape)}, dtypes {ids.dtype} and {numerators.dtype}")
+        for key, n in zip(ids.tolist(), numerators.tolist()):
+            key = _id(key, what)
+            if key in out:
+                raise Error(f"{what}[{key}]: given twice")
+            if abs(n) > _INT32_MAX:
+                raise Error(f"{what}[{key}]: numerator {_short(n)} is too large (|numerator| at most {_INT32_MAX})")
+            out[key] = int(n)
+        return out
     for key, value in _items(mapping, what):
         key = _id(key, what)
         where = f"{what}[{key}]"
         if key in out:
             raise Error(f"{where}: given twice")
-        out[key] = _core.parse_index(_index_text(value, N, where), N, where)
+        out[key] = _numerator(value, N, where)
     return out
 
 
 def _fractions(ns, N):
     """{id: Fraction} of {id: n} or of a per-id sequence (zeros left out for vertices)."""
-    if isinstance(ns, Mapping):
-        return {int(k): Fraction(int(n), N) for k, n in sorted(ns.items())}
-    return {i: Fraction(int(n), N) for i, n in enumerate(ns)}
+    if isinstance(ns, _Mapping):
+        return {int(k): _Fraction(int(n), N) for k, n in sorted(ns.items())}
+    return {i: _Fraction(int(n), N) for i, n in enumerate(ns)}
 
 
 def _nonzero_fractions(per_vertex, N):
-    per_vertex = np.asarray(per_vertex)
-    return {int(v): Fraction(int(per_vertex[v]), N) for v in np.flatnonzero(per_vertex)}
+    per_vertex = _np.asarray(per_vertex)
+    return {int(v): _Fraction(int(per_vertex[v]), N) for v in _np.flatnonzero(per_vertex)}
+
+
+def _pair_arrays(ns):
+    """(ids, numerators), two int64 arrays sorted by id, of {id: n} (zeros kept out)."""
+    items = sorted((int(k), int(n)) for k, n in ns.items() if n != 0)
+    ids = _np.array([k for k, _ in items], dtype=_np.int64)
+    return ids, _np.array([n for _, n in items], dtype=_np.int64)
+
+
+def _nonzero_arrays(per_vertex):
+    per_vertex = _np.asarray(per_vertex, dtype=_np.int64)
+    ids = _np.flatnonzero(per_vertex).astype(_np.int64)
+    return ids, per_vertex[ids].copy()
 
 
 def _render_args(size, view, up, style, spacing, flat, legend, supersampling):
@@ -240,6 +337,70 @@ def _singular_pairs(singularities, N):
     if singularities is None:
         return None
     return sorted(_indices(singularities, N, "singularities").items())
+
+
+# ---------------------------------------------------------------------------------------------------------
+# Threads
+
+
+def _threads(threads, what="threads"):
+    """0 (the default) for None, else a whole number >= 1."""
+    if threads is None:
+        return 0
+    if isinstance(threads, bool) or not isinstance(threads, _numbers.Integral) or threads < 1 or threads > 4096:
+        raise Error(f"{what} must be None or a whole number from 1 to 4096, not {_short(threads) if isinstance(threads, _numbers.Number) else repr(threads)}")
+    return int(threads)
+
+
+def set_threads(threads):
+    """How many threads trivcon's calls use by default (None: OpenMP's default, OMP_NUM_THREADS or every core).
+
+    Applies to every call made afterwards by designers created without threads= (their set-up and
+    factorization, solves, automatic placement, refinement, reading indices) and by the module's
+    functions (read_mesh, field_indices, render). trivcon's own parallel loops (OpenMP) take the count per
+    call, on the thread that makes the call: calls in other Python threads with other counts do not
+    interfere. The BLAS (OpenBLAS, used by the factorization's dense blocks) has one setting per process:
+    set_threads also sets it to `threads` (to OpenMP's default for None), for every BLAS user in the
+    process, numpy included when it uses the same OpenBLAS (Debian's does). While a call with one thread
+    runs, OpenBLAS runs single-threaded in the whole process.
+
+    The environment variable TRIVCON_THREADS, read at import, gives the initial value. Two designers
+    used from two Python threads at once run fastest with threads=1 each (no oversubscription); one
+    designer alone runs fastest with every core (the default).
+    """
+    n = _threads(threads)
+    _core.set_default_threads(n)
+    _core.set_blas_threads(n if n > 0 else _core.omp_default_threads())
+
+
+def get_threads():
+    """The default thread count of trivcon's calls (set_threads; OpenMP's default when none was set)."""
+    return _core.default_threads() or _core.omp_default_threads()
+
+
+def _threads_from_environment():
+    value = _os.environ.get("TRIVCON_THREADS", "").strip()
+    if not value:
+        return
+    try:
+        set_threads(int(value))
+    except (ValueError, Error):
+        _warnings.warn(f"TRIVCON_THREADS={value!r} is not a whole number from 1 to 4096: ignored", RuntimeWarning, stacklevel=3)
+
+
+_threads_from_environment()
+
+
+def _wait_for_abandoned_work():
+    # Work abandoned by KeyboardInterrupt (and calls of daemon threads, the only Python threads left at exit,
+    # cancelled here) stops at its next safe point; the process must not unload the libraries under it.
+    try:
+        _core.wait_for_background(-1.0, True)
+    except KeyboardInterrupt:
+        pass
+
+
+_atexit.register(_wait_for_abandoned_work)
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -293,17 +454,20 @@ def write_field(path, V, F, directions, N=1):
     _core.write_field(str(path), V, F, _directions(directions, F.shape[0]), N)
 
 
-def read_singularities(path, N=1):
+def read_singularities(path, N=1, arrays=False):
     """Read a singularity file ("VERTEX INDEX" lines, INDEX an integer or p/q; or Directional's .sings).
 
-    Returns {vertex: Fraction}. Every index must be a multiple of 1/N.
+    Returns {vertex: Fraction}; with arrays=True (vertices, numerators), two int64 arrays sorted by vertex
+    (index = numerator / N, zeros left out). Every index must be a multiple of 1/N.
     """
     N = _symmetry(N)
-    return _fractions(_core.read_singularities(str(path), N), N)
+    ns = _core.read_singularities(str(path), N)
+    return _pair_arrays(ns) if arrays else _fractions(ns, N)
 
 
 def write_singularities(path, singularities, N=1):
-    """Write {vertex: index} in the plain format `trivcon solve -s` reads (indices as reduced fractions)."""
+    """Write {vertex: index} (or (vertices, numerators) arrays) in the plain format `trivcon solve -s` reads
+    (indices as reduced fractions)."""
     N = _symmetry(N)
     _core.write_singularities(str(path), _indices(singularities, N, "singularities"), N)
 
@@ -313,27 +477,28 @@ def write_png(path, image):
     a = _array(image, "image")
     if a.ndim != 3 or a.shape[2] != 3:
         raise Error(f"image must have shape (h, w, 3), got shape {_shape_text(a.shape)}")
-    if a.dtype != np.uint8:
+    if a.dtype != _np.uint8:
         raise Error(f"image must hold uint8 values, got dtype {a.dtype}")
-    _core.write_png(str(path), np.ascontiguousarray(a))
+    _core.write_png(str(path), _np.ascontiguousarray(a))
 
 
 # ---------------------------------------------------------------------------------------------------------
 # Fields on plain arrays
 
 
-def field_indices(V, F, directions, N=1):
+def field_indices(V, F, directions, N=1, arrays=False):
     """The singularities of any per-face field (trivcon's, Directional's, your own): {vertex: Fraction}.
 
     directions (m, 3): one world vector per face (the first of its N directions; projected onto the
     face). Across each interior edge the field's jump relative to parallel transport is reduced to
     (-pi/N, pi/N]; a vertex's index is (angle defect + the sum of the jumps around it) / 2 pi, exactly as
-    `trivcon check` reads it. Only vertices of nonzero index are listed.
+    `trivcon check` reads it. Only vertices of nonzero index are listed. With arrays=True: (vertices,
+    numerators), two int64 arrays sorted by vertex, index = numerator / N.
     """
     V, F = _mesh(V, F)
     N = _symmetry(N)
     vertex, _, _ = _core.field_indices(V, F, _directions(directions, F.shape[0]), N)
-    return _nonzero_fractions(vertex, N)
+    return _nonzero_arrays(vertex) if arrays else _nonzero_fractions(vertex, N)
 
 
 def render(V, F, directions, N=1, size=(1200, 900), view=(30, 20), up="y", style="hedgehog", spacing=11, flat=False,
@@ -343,7 +508,7 @@ def render(V, F, directions, N=1, size=(1200, 900), view=(30, 20), up="y", style
     size (width, height) in pixels; view (azimuth, elevation) in degrees; up "x", "y" or "z"; style
     "hedgehog" (N segments per face, or an even subset) or "streamlines"; spacing: pixels between glyphs
     or streamlines (at 900 pixels); flat: flat shading; legend: list N and the indices in a corner.
-    singularities {vertex: index} are drawn as discs (red positive, blue negative); None (default):
+    singularities {vertex: index} (or (vertices, numerators) arrays) are drawn as discs (red positive, blue negative); None (default):
     those of the field itself, as `trivcon render` does. Save with write_png. Deterministic.
     """
     V, F = _mesh(V, F)
@@ -416,7 +581,7 @@ def blas_kernels():
 class FieldDesigner:
     """A mesh prepared for fields: validated, its geometry and cycles computed, the system factored once.
 
-    FieldDesigner(V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0)
+    FieldDesigner(V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0, threads=None)
 
     V (n, 3) real, F (m, 3) integer, ids as in the file. Validation errors (non-finite coordinate,
     vertex id out of range, repeated vertex, non-manifold edge or vertex, non-orientable component)
@@ -425,15 +590,21 @@ class FieldDesigner:
     factorization: "own" (trivcon's, on several threads) or "cholmod". weight_floor: with cotan
     weights, every interior edge gets at least this fraction of the median weight (0 to 1; default 0,
     none): fewer large turns on meshes with many obtuse angles, at some cost in smoothness (README
-    "Weights and energy").
+    "Weights and energy"). threads: how many threads its calls use (None: trivcon.set_threads's default;
+    see set_threads for what is per call and what is per process); also the attribute `threads`.
 
     solve() then costs milliseconds per new set of singularities. Fixed faces change the matrix: a
     solve with a different set of fixed faces than the previous one refactors once; changing only
     their directions or the singularities does not. Safe to share between threads (solves on one
-    designer run one at a time); the GIL is released while it works.
+    designer run one at a time); the GIL is released while it works, and Ctrl-C stops it
+    (KeyboardInterrupt; the designer stays as it was).
+
+    Pickling stores the mesh as given and the options, not the factorization: an unpickled designer is
+    validated and prepared again (topology, geometry, cycles) when it is loaded, and factored again on its
+    first solve. Its arrays (V, F, edges, ...) are read-only and computed once.
     """
 
-    def __init__(self, V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0):
+    def __init__(self, V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0, threads=None):
         V, F = _mesh(V, F)
         for name, value, allowed in (("weights", weights, ("cotan", "unit")), ("solver", solver, ("cholesky", "qr")),
                                      ("factorization", factorization, ("own", "cholmod"))):
@@ -443,11 +614,13 @@ class FieldDesigner:
             weight_floor = float(weight_floor)
         except (TypeError, ValueError):
             raise Error(f"weight_floor must be a number in [0, 1], not {weight_floor!r}") from None
-        self._d = _core.Designer(V, F, weights, solver, factorization, weight_floor)
+        threads = _threads(threads)
+        self._d = _core.Designer(V, F, weights, solver, factorization, weight_floor, threads)
         self.weights = weights
         self.weight_floor = weight_floor
         self.solver = solver
         self.factorization = factorization
+        self._cache = {}
 
     @classmethod
     def _of_core(cls, core, like):
@@ -455,7 +628,37 @@ class FieldDesigner:
         self = cls.__new__(cls)
         self._d = core
         self.weights, self.weight_floor, self.solver, self.factorization = like.weights, like.weight_floor, like.solver, like.factorization
+        self._cache = {}
         return self
+
+    def __getstate__(self):
+        # The mesh as given and the options (the library's, including a refined mesh's per-edge weight
+        # scales), not the factorization: __setstate__ prepares the mesh again and factors on the first solve.
+        return {"core": self._d.get_state(), "weights": self.weights, "weight_floor": self.weight_floor, "solver": self.solver,
+                "factorization": self.factorization}
+
+    def __setstate__(self, state):
+        self._d = _core.Designer.restore(state["core"])
+        self.weights, self.weight_floor = state["weights"], state["weight_floor"]
+        self.solver, self.factorization = state["solver"], state["factorization"]
+        self._cache = {}
+
+    def _get(self, key, compute):
+        """The read-only array (or tuple of them) computed once for `key`."""
+        if key not in self._cache:
+            value = compute()
+            self._cache[key] = tuple(_frozen(a) for a in value) if isinstance(value, tuple) else _frozen(value)
+        return self._cache[key]
+
+    @property
+    def threads(self):
+        """How many threads this designer's calls use (None: the module's default, trivcon.set_threads).
+        Settable."""
+        return self._d.threads or None
+
+    @threads.setter
+    def threads(self, threads):
+        self._d.threads = _threads(threads)
 
     def __repr__(self):
         return (f"<trivcon.FieldDesigner: {self.num_vertices} vertices, {self.num_faces} faces, chi {self.euler_characteristic}, "
@@ -465,14 +668,19 @@ class FieldDesigner:
 
     @property
     def V(self):
-        """Vertex positions, float64 (n, 3), as given."""
-        return self._d.V
+        """Vertex positions, float64 (n, 3), as given (read-only)."""
+        return self._get("V", lambda: self._d.V)
 
     @property
     def F(self):
         """The consistently oriented faces, int64 (m, 3): equal to the input except for flipped_faces,
-        which are reversed (a, b, c) -> (a, c, b). Face frames and angles refer to these."""
-        return self._d.F
+        which are reversed (a, b, c) -> (a, c, b). Face frames and angles refer to these (read-only)."""
+        return self._get("F", lambda: self._d.F)
+
+    @property
+    def F_input(self):
+        """The faces as given, int64 (m, 3) (read-only): what write_mesh and the field files pair with V."""
+        return self._get("F_input", lambda: self._d.F_input)
 
     @property
     def num_vertices(self):
@@ -502,23 +710,23 @@ class FieldDesigner:
     @property
     def flipped_faces(self):
         """int64 array of the faces whose orientation was reversed to make their component consistent."""
-        return self._d.flipped_faces
+        return self._get("flipped_faces", lambda: self._d.flipped_faces)
 
     @property
     def unreferenced_vertices(self):
         """int64 array of the vertices no face uses (kept, never singular)."""
-        return self._d.unreferenced_vertices
+        return self._get("unreferenced_vertices", lambda: self._d.unreferenced_vertices)
 
     @property
     def boundary_loops(self):
         """List of int64 arrays: each boundary loop's vertices in order (surface on the left), loop ids
         (solve(boundary=)) by smallest vertex id, each loop starting at its smallest vertex."""
-        return self._d.boundary_loops
+        return list(self._get("boundary_loops", lambda: tuple(self._d.boundary_loops)))
 
     @property
     def boundary_vertices(self):
         """int64 array of the vertices on a boundary loop (they cannot be singular)."""
-        return self._d.boundary_vertices
+        return self._get("boundary_vertices", lambda: self._d.boundary_vertices)
 
     @property
     def components(self):
@@ -529,19 +737,19 @@ class FieldDesigner:
     @property
     def edges(self):
         """Every edge, int64 (E, 2), (i, j) with i < j, sorted by (i, j)."""
-        return self._d.edges
+        return self._get("edges", lambda: self._d.edges)
 
     @property
     def edge_faces(self):
         """(L, R) per edge of `edges`, int64 (E, 2): L holds the half-edge i -> j, R the half-edge j -> i;
         -1 where there is none (boundary edges)."""
-        return self._d.edge_faces
+        return self._get("edge_faces", lambda: self._d.edge_faces)
 
     def face_frames(self):
         """(X, Y, normal), each float64 (m, 3) unit vectors per face: X along the oriented face's first
         edge (corner 0 -> 1), Y = normal x X, normal along (p1 - p0) x (p2 - p0). The angle a in face f
         is the direction cos(a) X[f] + sin(a) Y[f]."""
-        return self._d.face_frames()
+        return self._get("face_frames", lambda: tuple(self._d.face_frames()))
 
     @property
     def timings(self):
@@ -559,14 +767,14 @@ class FieldDesigner:
             if face in explicit:
                 raise Error(f"fixed[{face}]: given twice")
             self._d.check_fixed_face(face)
-            if isinstance(value, numbers.Real) and not isinstance(value, bool):
+            if isinstance(value, _numbers.Real) and not isinstance(value, bool):
                 explicit[face] = float(value)
             else:
                 v = _array(value, f"fixed[{face}]")
                 if v.shape != (3,) or v.dtype.kind not in "fiu":
                     raise Error(f"fixed[{face}]: expected an angle (radians, in the face's frame) or a direction (x, y, z), "
                                 f"got {value!r}")
-                explicit[face] = self._d.fixed_angle(face, v.astype(np.float64))
+                explicit[face] = self._d.fixed_angle(face, v.astype(_np.float64))
         out.update(explicit)
         return out
 
@@ -575,14 +783,16 @@ class FieldDesigner:
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
-        singularities: {vertex: index} (or a list of (vertex, index) pairs); indices int, float (a
+        singularities: {vertex: index} (or a list of (vertex, index) pairs, or a tuple (vertices,
+          numerators) of two 1-D integer numpy arrays, index = numerator / N, as Result.singularity_arrays
+          gives them); indices int, float (a
           multiple of 1/N), fractions.Fraction or "p/q" strings; vertices not listed have index 0. On
           every closed component the indices must sum to chi (Gauss-Bonnet). Boundary vertices cannot
           be singular. Or "auto": those of the globally smoothest field (auto_singularities, with
           auto_cancel as its cancel distance, align_curvature as its curvature guidance and the same fixed
           faces), then the exact solve.
-        generators, boundary: {id: index} for generators and boundary loops (ids as num_generators and
-          boundary_loops); those not given are chosen to make the field smoothest.
+        generators, boundary: {id: index} (or the same other forms) for generators and boundary loops (ids
+          as num_generators and boundary_loops); those not given are chosen to make the field smoothest.
         fixed: {face: direction}, an angle in radians in the face's frame or a world vector (x, y, z)
           (projected onto the face): the field holds it exactly, modulo 2 pi / N.
         align_boundary: fix every face with a boundary edge to that edge's direction (fixed= wins).
@@ -592,7 +802,7 @@ class FieldDesigner:
         split_large_turns: refine the mesh where the connection turns by pi/N or more and solve again
           with the same vertex singularities, at most max_rounds times, until no edge does (trivcon
           solve --split-large-turns): then any tool's own (principal) matching reads exactly the
-          prescription. The Result then belongs to the refined mesh: Result.designer is a FieldDesigner
+          prescription (Result.field_exact). The Result then belongs to the refined mesh: Result.designer is a FieldDesigner
           of it (input vertices keep their ids, new ones appended; a split face keeps its id for its
           first child), Result.parent_face the input face of each face, Result.split_rounds one dict per
           round (split_edges, vertices, faces), Result.split_converged whether no large turn is left. The
@@ -601,7 +811,7 @@ class FieldDesigner:
           with roots.
 
         Errors in the prescription raise trivcon.Error with the library's message. The result is
-        verified (residuals, transport, indices read back): see Result.verified.
+        verified (residuals, transport, indices read back): see Result.verified and Result.field_exact.
         """
         N = _symmetry(N)
         fixed_angles = self._fixed(fixed, align_boundary)
@@ -619,7 +829,7 @@ class FieldDesigner:
         root_list = []
         for key, angle in _items(roots, "roots"):
             face = _id(key, "roots")
-            if isinstance(angle, bool) or not isinstance(angle, numbers.Real):
+            if isinstance(angle, bool) or not isinstance(angle, _numbers.Real):
                 raise Error(f"roots[{face}]: the angle must be a number, got {angle!r}")
             root_list.append((face, float(angle)))
         if split_large_turns:
@@ -627,7 +837,7 @@ class FieldDesigner:
                 raise Error("split_large_turns makes new generators and boundary loops: leave their indices to be chosen")
             if root_list:
                 raise Error("split_large_turns: roots are not supported (the refined mesh starts each component itself)")
-            if isinstance(max_rounds, bool) or not isinstance(max_rounds, numbers.Integral) or max_rounds < 0:
+            if isinstance(max_rounds, bool) or not isinstance(max_rounds, _numbers.Integral) or max_rounds < 0:
                 raise Error(f"max_rounds must be a whole number >= 0, not {max_rounds!r}")
             explicit = self._fixed(fixed, False)
             core, r, parent, rounds, converged = self._d.split_large_turns(
@@ -635,12 +845,15 @@ class FieldDesigner:
                 self.weight_floor)
             designer = self if core is self._d else FieldDesigner._of_core(core, self)
             result = Result(designer, r, auto)
-            result.parent_face = parent
+            result.parent_face = _frozen(parent)
             result.split_rounds = rounds
             result.split_converged = converged
             return result
+        # With "auto", the exact field takes each component's rotation from the smoothest field it came from
+        # (components with a root or a fixed face keep theirs), as solve --auto does.
+        guide = _np.asarray(auto.angles, dtype=_np.float64) if auto is not None else None
         r = self._d.design(N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), fixed_angles,
-                           root_list)
+                           root_list, guide)
         return Result(self, r, auto)
 
     def auto_singularities(self, N=1, cancel=0.0, cancel_absolute=False, iterations=8, fixed=None, align_boundary=False,
@@ -659,24 +872,25 @@ class FieldDesigner:
         N = _symmetry(N)
         curvature_t = 0.0
         if align_curvature is not None:
-            if isinstance(align_curvature, bool) or not isinstance(align_curvature, numbers.Real):
+            if isinstance(align_curvature, bool) or not isinstance(align_curvature, _numbers.Real):
                 raise Error(f"align_curvature must be None or a number t < 1, got {align_curvature!r}")
             curvature_t = float(align_curvature)
         try:
             cancel = float(cancel)
         except (TypeError, ValueError):
             raise Error(f"cancel must be a number, got {cancel!r}") from None
-        if not (math.isfinite(cancel) and cancel >= 0):
+        if not (_math.isfinite(cancel) and cancel >= 0):
             raise Error(f"singularity cancellation: invalid distance {cancel!r} (need a finite number >= 0)")
         fixed_angles = self._fixed(fixed, align_boundary)
         return AutoResult(self._d.auto_singularities(N, int(iterations), cancel, bool(cancel_absolute), fixed_angles,
-                                                     align_curvature is not None, curvature_t))
+                                                     align_curvature is not None, curvature_t), self)
 
-    def field_indices(self, directions, N=1):
-        """{vertex: Fraction} of a per-face field (m, 3) on this mesh (as trivcon.field_indices)."""
+    def field_indices(self, directions, N=1, arrays=False):
+        """{vertex: Fraction} of a per-face field (m, 3) on this mesh (as trivcon.field_indices); with
+        arrays=True (vertices, numerators), two int64 arrays sorted by vertex, index = numerator / N."""
         N = _symmetry(N)
         vertex, _, _ = self._d.field_indices(_directions(directions, self.num_faces), N)
-        return _nonzero_fractions(vertex, N)
+        return _nonzero_arrays(vertex) if arrays else _nonzero_fractions(vertex, N)
 
     def cycle_indices(self, directions, N=1):
         """(loops, generators) of a per-face field: {loop id: Fraction}, {generator id: Fraction}: the
@@ -686,12 +900,20 @@ class FieldDesigner:
         return _fractions(loops, N), _fractions(generators, N)
 
 
+
+def _all_directions(designer, angles, N):
+    """(m, N, 3): the N unit directions per face of angles (m,) in the designer's face frames."""
+    X, Y, _ = designer.face_frames()
+    a = angles[:, None] + (2 * _math.pi / N) * _np.arange(N)[None, :]
+    return _np.cos(a)[:, :, None] * X[:, None, :] + _np.sin(a)[:, :, None] * Y[:, None, :]
+
+
 class Result:
     """One solve of a FieldDesigner: the field, its connection, what was used and how well it holds.
 
-    Arrays (new numpy arrays, computed once):
+    Arrays (computed once, read-only):
       directions  float64 (m, 3): the first of the N unit directions per face, in world coordinates
-                  (the others are rotated by 2 pi k / N about the face normal)
+                  (the others are rotated by 2 pi k / N about the face normal: all_directions())
       angles      float64 (m,): the same as angles in the face frames (FieldDesigner.face_frames), in [0, 2 pi)
       edges       int64 (E, 2): the interior edges (i, j), i < j, sorted by (i, j), as --connection-out
       connection  float64 (E,): the adjustment angle x per edge of `edges` (radians): a direction at angle
@@ -700,12 +922,21 @@ class Result:
       generator cycles, radians), transport_mismatch, fixed_error, large_turn_edges.
     Indices (dicts of fractions.Fraction): singularities (the vertex indices used), generators and
       boundary (the indices used, given or chosen), generators_chosen / boundary_chosen (ids chosen by
-      the solver), field_singularities (read back from the field itself).
-    verified: the check `trivcon solve` applies (residuals, transport and fixed faces within 1e-9
-      relative, indices read back equal to the prescription except where the connection turns by pi/N
-      or more across an edge); auto: the AutoResult when solved with singularities="auto".
-    Files: write_field, write_connection, write_lines, write_singularities write what the CLI's
-      --field-out, --connection-out, --lines-out, --sing-out write for the same solve; render draws it.
+      the solver), field_singularities (read back from the field itself); singularity_arrays and
+      field_singularity_arrays give the same vertex indices as (vertices, numerators) arrays.
+    verified: the check `trivcon solve` applies to the connection (residuals, transport and fixed faces
+      within 1e-9 relative, indices read back equal to the prescription except where the connection turns
+      by pi/N or more across an edge).
+    field_exact: whether the per-face field read on its own (the principal matching, as field_indices and
+      any other tool read it) shows exactly the prescribed singularities; where the connection turns by
+      pi/N or more a field sampled once per face cannot show them, and then it is False even when
+      verified: solve again with split_large_turns=True. repr() says both.
+    auto: the AutoResult when solved with singularities="auto".
+    Files: write_field, write_connection, write_lines, write_singularities (and write_mesh, the mesh the
+      field belongs to) write what the CLI's --field-out, --connection-out, --lines-out, --sing-out
+      (--mesh-out) write for the same solve; render draws it.
+    Pickling stores the designer (see FieldDesigner), the prescription and every output, so an unpickled
+    Result gives the same values without solving again.
     """
 
     def __init__(self, designer, result, auto=None):
@@ -714,18 +945,52 @@ class Result:
         self.auto = auto
         self._cache = {}
 
+    def __getstate__(self):
+        state = {"designer": self._designer, "core": self._r.get_state(), "auto": self.auto}
+        for key in ("parent_face", "split_rounds", "split_converged"):
+            if key in self.__dict__:
+                state[key] = self.__dict__[key]
+        return state
+
+    def __setstate__(self, state):
+        self._designer = state["designer"]
+        self._r = _core.DesignResult.restore(self._designer._d, state["core"])
+        self.auto = state["auto"]
+        self._cache = {}
+        if "parent_face" in state:  # after split_large_turns
+            self.parent_face = _frozen(_np.array(state["parent_face"], dtype=_np.int64))
+            self.split_rounds, self.split_converged = state["split_rounds"], state["split_converged"]
+
     def _get(self, key, compute):
+        """The value computed once for `key` (arrays made read-only)."""
         if key not in self._cache:
-            self._cache[key] = compute()
+            value = compute()
+            if isinstance(value, _np.ndarray):
+                value = _frozen(value)
+            elif isinstance(value, tuple):
+                value = tuple(_frozen(a) if isinstance(a, _np.ndarray) else a for a in value)
+            self._cache[key] = value
         return self._cache[key]
+
+    def _exactness(self):
+        """'field exact', or what is not and what to do about it."""
+        k = len(self.index_mismatches)
+        if k == 0:
+            return "field exact"
+        text = f"field NOT exact: {k} {'vertex reads another index' if k == 1 else 'vertices read other indices'}"
+        if len(self.unexplained_mismatches) == 0:
+            text += " (large turns)"
+        if "split_rounds" in self.__dict__:
+            return text + "; split_large_turns left large turns"
+        return text + "; use split_large_turns=True"
 
     def __repr__(self):
         return (f"<trivcon.Result: N {self.N}, {len(self.singularities)} singular vertices, energy {self.energy:.6g}, "
-                f"residual {self.residual:.3g}, {'verified' if self.verified else 'NOT verified'}>")
+                f"residual {self.residual:.3g}, {'verified' if self.verified else 'NOT verified'}, {self._exactness()}>")
 
     @property
     def designer(self):
-        """The FieldDesigner this came from."""
+        """The FieldDesigner this came from (with split_large_turns, the refined mesh's)."""
         return self._designer
 
     @property
@@ -735,13 +1000,24 @@ class Result:
 
     @property
     def directions(self):
-        """float64 (m, 3) unit vectors: the first of the N directions per face, world coordinates."""
+        """float64 (m, 3) unit vectors: the first of the N directions per face, world coordinates (read-only)."""
         return self._get("directions", lambda: self._r.directions)
 
     @property
     def angles(self):
-        """float64 (m,): the field's first direction per face as an angle in the face's frame, [0, 2 pi)."""
+        """float64 (m,): the field's first direction per face as an angle in the face's frame, [0, 2 pi) (read-only)."""
         return self._get("angles", lambda: self._r.angles)
+
+    def all_directions(self):
+        """float64 (m, N, 3), read-only: all N unit directions per face, direction k at angle angles + 2 pi k / N
+        in the face frame; [:, 0] is `directions`."""
+
+        def compute():
+            out = _all_directions(self._designer, self.angles, self.N)
+            out[:, 0] = self.directions  # the library's own first direction, bit for bit
+            return out
+
+        return self._get("all_directions", compute)
 
     def _connection(self):
         return self._get("connection", self._r.connection)
@@ -794,7 +1070,13 @@ class Result:
     @property
     def singularities(self):
         """{vertex: Fraction}: the vertex indices prescribed (the ones found, with singularities="auto")."""
-        return self._get("singularities", lambda: _fractions(self._r.vertex, self.N))
+        return dict(self._get("singularities", lambda: _fractions(self._r.vertex, self.N)))
+
+    @property
+    def singularity_arrays(self):
+        """(vertices, numerators): the prescribed vertex indices as two int64 arrays sorted by vertex,
+        index = numerator / N (read-only); solve(singularities=...) takes them back."""
+        return self._get("singularity_arrays", lambda: _pair_arrays(self._r.vertex))
 
     @property
     def generators(self):
@@ -819,17 +1101,22 @@ class Result:
     @property
     def field_singularities(self):
         """{vertex: Fraction}: the indices read back from the field itself (as field_indices)."""
-        return self._get("field_singularities", lambda: _nonzero_fractions(self._r.indices[0], self.N))
+        return dict(self._get("field_singularities", lambda: _nonzero_fractions(self._r.indices[0], self.N)))
+
+    @property
+    def field_singularity_arrays(self):
+        """(vertices, numerators): field_singularities as two int64 arrays sorted by vertex (read-only)."""
+        return self._get("field_singularity_arrays", lambda: _nonzero_arrays(self._r.indices[0]))
 
     @property
     def index_mismatches(self):
-        """int64 array: interior vertices whose index read back differs from the prescription."""
-        return self._r.index_mismatch_vertices
+        """int64 array: interior vertices whose index read back differs from the prescription (read-only)."""
+        return self._get("index_mismatches", lambda: self._r.index_mismatch_vertices)
 
     @property
     def unexplained_mismatches(self):
-        """int64 array: those of index_mismatches next to no edge turning by pi/N or more (real errors)."""
-        return self._r.unexplained_mismatch_vertices
+        """int64 array: those of index_mismatches next to no edge turning by pi/N or more (real errors; read-only)."""
+        return self._get("unexplained_mismatches", lambda: self._r.unexplained_mismatch_vertices)
 
     @property
     def large_turn_edges(self):
@@ -838,8 +1125,18 @@ class Result:
 
     @property
     def verified(self):
-        """True when every check `trivcon solve` makes passed (its exit status 3 otherwise)."""
+        """True when every check `trivcon solve` makes passed (its exit status 3 otherwise): the connection has
+        the prescribed holonomy and the field follows it. About the field read on its own: field_exact."""
         return self._r.verified
+
+    @property
+    def field_exact(self):
+        """True exactly when the per-face field, read on its own with the principal (closest) matching -- as
+        field_indices, `trivcon check` and other tools read a field -- shows exactly the prescribed
+        singularities: no index_mismatches. False where the connection turns by pi/N or more across edges
+        (large_turn_edges) around a vertex that then reads another index, even when `verified`; solve with
+        split_large_turns=True to refine those edges away (or hand other tools `matching`)."""
+        return len(self.index_mismatches) == 0
 
     @property
     def seconds(self):
@@ -850,6 +1147,11 @@ class Result:
         """Write the field exactly as --field-out does (.txt, .rawfield or .ply by extension)."""
         self._r.write_field(str(path))
 
+    def write_mesh(self, path):
+        """Write the mesh the field belongs to, as --mesh-out does (.ply binary, else OBJ by extension): the
+        refined mesh after split_large_turns, else the input (faces as given)."""
+        write_mesh(path, self._designer.V, self._designer.F_input)
+
     def write_connection(self, path):
         """Write the connection as --connection-out does ("i j x" per interior edge, sorted)."""
         self._r.write_connection(str(path))
@@ -858,8 +1160,8 @@ class Result:
     def matching(self):
         """int64 (E,): per edge of `edges`, the whole number m in [0, N) of 2 pi / N turns our connection uses
         between the two faces' first directions (trivcon/matching.h; what --matching-out writes): a tool
-        given this matching instead of computing the closest one reads exactly our singularities."""
-        return self._r.matching()
+        given this matching instead of computing the closest one reads exactly our singularities (read-only)."""
+        return self._get("matching", self._r.matching)
 
     def write_matching(self, path):
         """Write the matching as --matching-out does (Directional's .matching format)."""
@@ -884,18 +1186,37 @@ class Result:
 class AutoResult:
     """Singularities found automatically (FieldDesigner.auto_singularities).
 
-      singularities  {vertex: Fraction} to prescribe (after cancellation)
+      singularities  {vertex: Fraction} to prescribe (after cancellation); singularity_arrays the same as
+                     (vertices, numerators) arrays
       found          {vertex: Fraction} of the smoothest field, before cancellation
       pairs          [(vertex of +n, vertex of -n)] cancelled, in order
       coincident_removed  singularities removed by summing over coincident vertices (auto.h)
-      directions     float64 (m, 3), angles float64 (m,): the smoothest field itself (not the exact solve)
+      directions     float64 (m, 3), angles float64 (m,): the smoothest field itself (not the exact solve;
+                     read-only); all_directions() its N directions per face
       energy         its Rayleigh quotient E(u) / |u|^2_M; vanishing_faces: faces where it vanished
       seconds        per stage (assemble, factor, iterate, align, indices, cancel)
       ordering       the smoothest field's factor order: "AMD" or "coordinate dissection" (auto.h)
+    Pickles with its designer.
     """
 
-    def __init__(self, a):
+    def __init__(self, a, designer=None):
         self._a = a
+        self._designer = designer
+        self._cache = {}
+
+    def __getstate__(self):
+        return {"designer": self._designer, "core": self._a.get_state()}
+
+    def __setstate__(self, state):
+        self._designer = state["designer"]
+        self._a = _core.AutoResult.restore(self._designer._d, state["core"])
+        self._cache = {}
+
+    def _get(self, key, compute):
+        if key not in self._cache:
+            value = compute()
+            self._cache[key] = tuple(_frozen(a) for a in value) if isinstance(value, tuple) else _frozen(value)
+        return self._cache[key]
 
     def __repr__(self):
         return (f"<trivcon.AutoResult: N {self.N}, found {len(self.found)} singularities, cancelled {len(self.pairs)} pairs, "
@@ -910,6 +1231,11 @@ class AutoResult:
     def singularities(self):
         """{vertex: Fraction}: the singularities to prescribe (after cancellation)."""
         return _fractions(self._a.vertex, self.N)
+
+    @property
+    def singularity_arrays(self):
+        """(vertices, numerators): `singularities` as two int64 arrays sorted by vertex, index = numerator / N."""
+        return self._get("singularity_arrays", lambda: _pair_arrays(self._a.vertex))
 
     @property
     def found(self):
@@ -933,13 +1259,23 @@ class AutoResult:
 
     @property
     def directions(self):
-        """float64 (m, 3): the smoothest field's first direction per face (world coordinates)."""
-        return self._a.directions
+        """float64 (m, 3): the smoothest field's first direction per face (world coordinates; read-only)."""
+        return self._get("directions", lambda: self._a.directions)
 
     @property
     def angles(self):
-        """float64 (m,): the smoothest field's angles in the face frames."""
-        return self._a.angles
+        """float64 (m,): the smoothest field's angles in the face frames (read-only)."""
+        return self._get("angles", lambda: self._a.angles)
+
+    def all_directions(self):
+        """float64 (m, N, 3), read-only: the smoothest field's N directions per face ([:, 0] is `directions`)."""
+
+        def compute():
+            out = _all_directions(self._designer, self.angles, self.N)
+            out[:, 0] = self.directions
+            return out
+
+        return self._get("all_directions", compute)
 
     @property
     def energy(self):
@@ -955,3 +1291,14 @@ class AutoResult:
     def seconds(self):
         """Seconds per stage: assemble, factor, iterate, indices, cancel."""
         return self._a.seconds
+
+
+
+def __getattr__(name):
+    # trivcon.batch on first use (PEP 562): imported with the package, `python3 -m trivcon.batch` would find
+    # it in sys.modules before running it as __main__ (runpy warns).
+    if name == "batch":
+        import importlib
+
+        return importlib.import_module(".batch", __name__)
+    raise AttributeError(f"module 'trivcon' has no attribute {name!r}")

@@ -7,7 +7,11 @@
 Each mesh (a file, or every .obj/.off/.ply[.gz] file of a folder) is one task: read, FieldDesigner, solve
 (its singularities from --sing-dir, else those of the smoothest field as with `trivcon solve --auto`), write
 DIR/NAME.field.txt (--field-format), DIR/NAME.sing (the singularities used) and, when asked, the connection
-and a picture. NAME is the file name without its extensions. By default the tasks run on a local cluster of
+and a picture. NAME is the file name without its extensions. With --split-large-turns each mesh is refined
+where the connection turns by pi/N or more and solved again (as `trivcon solve --split-large-turns`), so that
+the field read on its own shows exactly the singularities; the field then belongs to the refined mesh, which
+is written beside it (DIR/NAME.mesh.obj, input vertices and faces keeping their ids) with DIR/NAME.parent_face.txt
+(the input face of each of its faces, one per line). By default the tasks run on a local cluster of
 worker processes (--workers, default one per core, each on one thread); --scheduler sends them to a running
 Dask scheduler instead (`dask scheduler` on one machine, `dask worker tcp://host:8786` on each of the
 others, trivcon installed on every worker), which then must see the meshes and DIR at the same paths (a
@@ -16,7 +20,11 @@ shared file system): paths are made absolute before they are sent.
 A failing mesh (an unreadable file, a non-manifold mesh, a prescription that violates Gauss-Bonnet, a worker
 that died) is reported and never stops the others. While it runs, a progress bar goes to stderr; at the end a
 summary table goes to stdout and to DIR/summary.txt, and every row (with the full error messages) to
-DIR/summary.json. Exit status: 0 when every mesh solved and verified, 1 otherwise, 2 for a usage error.
+DIR/summary.json. A mesh's status is "ok" when it solved, verified and its field is exact (field_exact: the
+per-face field read on its own shows exactly the prescribed singularities), "inexact" when it verified but
+its field reads other indices at some vertices (large turns, large_turn_edges > 0: use --split-large-turns),
+"unverified" when the verification failed, "failed" when it did not solve. Exit status: 0 when every mesh is
+ok, 1 otherwise, 2 for a usage error.
 
 From Python: trivcon.batch.run(meshes, out, ...) returns the rows (a list of dicts, in the order of the
 meshes); trivcon.batch.solve_mesh(job) is the task itself.
@@ -32,7 +40,9 @@ __all__ = ["run", "solve_mesh", "find_meshes", "format_table", "main"]
 
 MESH_SUFFIXES = (".obj", ".off", ".ply")
 FIELD_FORMATS = ("txt", "rawfield", "ply")
-COLUMNS = ("mesh", "status", "vertices", "faces", "chi", "N", "singularities", "energy", "residual", "seconds", "message")
+COLUMNS = ("mesh", "status", "vertices", "faces", "chi", "N", "singularities", "field_exact", "large_turn_edges", "energy", "residual",
+           "seconds", "message")
+STATUSES = ("ok", "inexact", "unverified", "failed")
 
 
 class UsageError(Exception):
@@ -69,7 +79,8 @@ def find_meshes(paths):
     return [os.path.abspath(m) for m in meshes]
 
 
-def _jobs(meshes, out, N, sing_dir, auto_cancel, align_boundary, weights, field_format, connection, png):
+def _jobs(meshes, out, N, sing_dir, auto_cancel, align_boundary, weights, field_format, connection, png, split_large_turns=False,
+          threads=None):
     jobs, names = [], {}
     for mesh in meshes:
         name = mesh_name(mesh)
@@ -93,6 +104,8 @@ def _jobs(meshes, out, N, sing_dir, auto_cancel, align_boundary, weights, field_
             "field_format": field_format,
             "connection": connection,
             "png": png,
+            "split_large_turns": split_large_turns,
+            "threads": threads,
         })
     return jobs
 
@@ -111,7 +124,9 @@ def solve_mesh(job):
 
     Never raises for a problem of the mesh or its singularities: the row's status is then "failed" and
     its message the library's error message. Keys of job: mesh, name, out, N, sing_file (None: automatic),
-    auto_cancel, align_boundary, weights, field_format, connection, png.
+    auto_cancel, align_boundary, weights, field_format, connection, png, and optionally split_large_turns
+    (refine where the connection turns by pi/N or more; writes the refined mesh and its parent faces too)
+    and threads (the designer's, None: trivcon's default).
     """
     import trivcon
 
@@ -120,22 +135,31 @@ def solve_mesh(job):
     try:
         V, F = trivcon.read_mesh(job["mesh"])
         row["vertices"], row["faces"] = int(V.shape[0]), int(F.shape[0])
-        d = trivcon.FieldDesigner(V, F, weights=job["weights"])
+        d = trivcon.FieldDesigner(V, F, weights=job["weights"], threads=job.get("threads"))
         row["chi"] = d.euler_characteristic
+        split = bool(job.get("split_large_turns"))
         if job["sing_file"] is not None:
             if not os.path.exists(job["sing_file"]):
                 raise trivcon.Error(f"no singularity file {job['sing_file']}")
             sings = trivcon.read_singularities(job["sing_file"], job["N"])
-            r = d.solve(N=job["N"], singularities=sings, align_boundary=job["align_boundary"])
+            r = d.solve(N=job["N"], singularities=sings, align_boundary=job["align_boundary"], split_large_turns=split)
             row["source"] = job["sing_file"]
         else:
-            r = d.solve(N=job["N"], singularities="auto", auto_cancel=job["auto_cancel"], align_boundary=job["align_boundary"])
+            r = d.solve(N=job["N"], singularities="auto", auto_cancel=job["auto_cancel"], align_boundary=job["align_boundary"],
+                        split_large_turns=split)
             row["source"] = "auto"
             row["auto_found"], row["auto_cancelled_pairs"] = len(r.auto.found), len(r.auto.pairs)
         base = os.path.join(job["out"], job["name"])
         outputs = [f"{base}.field.{job['field_format']}", base + ".sing"]
         r.write_field(outputs[0])
         r.write_singularities(outputs[1])
+        if split:
+            # The field is per face of the refined mesh: that mesh, and the input face of each of its faces.
+            outputs += [base + ".mesh.obj", base + ".parent_face.txt"]
+            r.write_mesh(outputs[-2])
+            _write_parent_faces(outputs[-1], r.parent_face, job["mesh"])
+            row["split_large_turns"] = {"rounds": len(r.split_rounds), "converged": bool(r.split_converged),
+                                        "vertices": r.designer.num_vertices, "faces": r.designer.num_faces}
         if job["connection"]:
             outputs.append(base + ".connection.txt")
             r.write_connection(outputs[-1])
@@ -143,8 +167,11 @@ def solve_mesh(job):
             outputs.append(base + ".png")
             trivcon.write_png(outputs[-1], r.render(size=(800, 600)))
         row.update({
-            "status": "ok" if r.verified else "unverified",
+            "status": "ok" if r.verified and r.field_exact else "inexact" if r.verified else "unverified",
             "singularities": len(r.singularities),
+            "field_exact": bool(r.field_exact),
+            "large_turn_edges": int(r.large_turn_edges),
+            "index_mismatches": int(len(r.index_mismatches)),
             "energy": r.energy,
             "residual": r.residual,
             "transport_mismatch": r.transport_mismatch,
@@ -153,6 +180,11 @@ def solve_mesh(job):
         if not r.verified:
             row["message"] = (f"verification failed: residual {r.residual:.3g}, transport mismatch {r.transport_mismatch:.3g}, "
                               f"{len(r.unexplained_mismatches)} unexplained index mismatches")
+        elif not r.field_exact:
+            k = len(r.index_mismatches)
+            row["message"] = (f"field not exact: {k} {'vertex reads another index' if k == 1 else 'vertices read other indices'} "
+                              f"({r.large_turn_edges} edges turn by pi/N or more); "
+                              + ("--split-large-turns left large turns" if split else "use --split-large-turns"))
     except trivcon.Error as e:
         row["message"] = str(e)
     except MemoryError:
@@ -163,11 +195,22 @@ def solve_mesh(job):
     return row
 
 
+def _write_parent_faces(path, parent_face, mesh):
+    """The input face of each face of the refined mesh, one per line after a comment, atomically."""
+    temporary = os.path.join(os.path.dirname(path), ".trivcon-partial." + os.path.basename(path))
+    with open(temporary, "w") as f:
+        f.write(f"# trivcon parent faces: the face of {os.path.basename(mesh)} each face of the refined mesh comes from\n")
+        f.write(f"# {len(parent_face)} faces\n")
+        f.write("\n".join(str(int(p)) for p in parent_face))
+        f.write("\n")
+    os.replace(temporary, path)
+
+
 class Progress:
     """A progress bar on a stream: redrawn in place on a terminal, one line per finished mesh otherwise."""
 
     def __init__(self, total, stream=None, width=30):
-        self.total, self.done, self.failed = total, 0, 0
+        self.total, self.done, self.failed, self.not_ok = total, 0, 0, 0
         self.stream = stream if stream is not None else sys.stderr
         self.width = width
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
@@ -176,12 +219,14 @@ class Progress:
     def line(self, last=""):
         filled = self.width * self.done // max(self.total, 1)
         bar = "#" * filled + "-" * (self.width - filled)
-        text = f"[{bar}] {self.done}/{self.total} meshes, {self.failed} failed, {time.perf_counter() - self.start:.1f} s"
+        other = f", {self.not_ok - self.failed} not ok" if self.not_ok > self.failed else ""
+        text = f"[{bar}] {self.done}/{self.total} meshes, {self.failed} failed{other}, {time.perf_counter() - self.start:.1f} s"
         return text + (f"  {last}" if last else "")
 
     def update(self, row):
         self.done += 1
-        self.failed += row["status"] != "ok"
+        self.failed += row["status"] == "failed"
+        self.not_ok += row["status"] != "ok"
         last = f"{row['mesh']}: {row['status']}"
         if self.tty:
             self.stream.write("\r\033[K" + self.line(last))
@@ -196,6 +241,8 @@ def _cell(row, key):
     v = row.get(key)
     if v is None:
         return ""
+    if key == "field_exact":
+        return "yes" if v else "NO"
     if key in ("energy",):
         return f"{v:.6g}"
     if key == "residual":
@@ -208,22 +255,21 @@ def _cell(row, key):
 
 
 def format_table(rows):
-    """The summary table: one line per mesh (mesh, status, sizes, chi, N, singularities, energy, residual,
-    seconds, message), then a total line."""
+    """The summary table: one line per mesh (mesh, status, sizes, chi, N, singularities, field_exact,
+    large_turn_edges, energy, residual, seconds, message), then a total line."""
     cells = [list(COLUMNS)] + [[_cell(r, k) for k in COLUMNS] for r in rows]
     widths = [max(len(c[i]) for c in cells) for i in range(len(COLUMNS))]
-    numeric = {"vertices", "faces", "chi", "N", "singularities", "energy", "residual", "seconds"}
+    numeric = {"vertices", "faces", "chi", "N", "singularities", "large_turn_edges", "energy", "residual", "seconds"}
     lines = []
     for n, c in enumerate(cells):
         parts = [(s.rjust(w) if COLUMNS[i] in numeric else s.ljust(w)) for i, (s, w) in enumerate(zip(c, widths))]
         lines.append("  ".join(parts).rstrip())
         if n == 0:
             lines.append("  ".join("-" * w for w in widths))
-    ok = sum(r["status"] == "ok" for r in rows)
-    failed = sum(r["status"] == "failed" for r in rows)
-    unverified = len(rows) - ok - failed
+    count = {s: sum(r["status"] == s for r in rows) for s in STATUSES}
     total = sum(r.get("seconds") or 0 for r in rows)
-    lines.append(f"{len(rows)} meshes: {ok} ok, {failed} failed, {unverified} unverified; {total:.1f} s of work")
+    lines.append(f"{len(rows)} meshes: {count['ok']} ok, {count['failed']} failed, {count['unverified']} unverified, "
+                 f"{count['inexact']} inexact (field not exact); {total:.1f} s of work")
     return "\n".join(lines)
 
 
@@ -232,11 +278,17 @@ def _failed_row(job, message):
 
 
 def run(meshes, out, N=4, sing_dir=None, auto_cancel=0.0, align_boundary=False, weights="cotan", field_format="txt",
-        connection=False, png=False, scheduler=None, workers=None, threads_per_worker=1, progress=True, stream=None, timeout=30):
+        connection=False, png=False, scheduler=None, workers=None, threads_per_worker=1, progress=True, stream=None, timeout=30,
+        split_large_turns=False, threads=None):
     """Solve every mesh on a Dask cluster and write the outputs into `out`; returns the rows, in mesh order.
 
     meshes: mesh files and folders (all their mesh files). sing_dir: a folder with NAME.sing (or NAME.sings)
     per mesh; None: automatic singularities (auto_cancel: their cancel distance in mean edge lengths).
+    split_large_turns: refine each mesh where the connection turns by pi/N or more (FieldDesigner.solve's
+    split_large_turns) and write NAME.mesh.obj and NAME.parent_face.txt beside the field.
+    threads: threads per mesh (None: with a local cluster the cores shared out among its workers, one at
+    least; with a scheduler each worker's trivcon default).
+    Rows have the keys of COLUMNS (field_exact, large_turn_edges, ...), status one of STATUSES.
     scheduler: the address of a running Dask scheduler (e.g. "tcp://host:8786"); None: a local cluster of
     `workers` processes (default: one per core, at most one per mesh) with `threads_per_worker` threads.
     timeout: seconds to wait for the scheduler. progress: draw a progress bar on `stream` (default stderr).
@@ -255,8 +307,10 @@ def run(meshes, out, N=4, sing_dir=None, auto_cancel=0.0, align_boundary=False, 
         raise UsageError(f"--sing-dir {sing_dir} is not a folder")
     out = os.path.abspath(out)
     os.makedirs(out, exist_ok=True)
+    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
+        raise UsageError(f"--threads must be an integer >= 1, not {threads!r}")
     jobs = _jobs(find_meshes(meshes), out, N, None if sing_dir is None else os.path.abspath(sing_dir), float(auto_cancel),
-                 bool(align_boundary), weights, field_format, bool(connection), bool(png))
+                 bool(align_boundary), weights, field_format, bool(connection), bool(png), bool(split_large_turns), threads)
     if not jobs:
         raise UsageError("no meshes given")
 
@@ -268,6 +322,9 @@ def run(meshes, out, N=4, sing_dir=None, auto_cancel=0.0, align_boundary=False, 
             raise UsageError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
     else:
         n = workers or min(len(jobs), os.cpu_count() or 1)
+        if threads is None:  # the cores shared out: workers on all cores each would fight over them
+            for job in jobs:
+                job["threads"] = max(1, (os.cpu_count() or 1) // (n * max(1, threads_per_worker)))
         cluster = LocalCluster(n_workers=n, threads_per_worker=threads_per_worker, processes=True, dashboard_address=None)
         client = Client(cluster)
     rows = [None] * len(jobs)
@@ -305,9 +362,11 @@ def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="python3 -m trivcon.batch",
         description="Solve many meshes with trivcon on a Dask cluster (a local one by default): automatic singularities, "
-        "or one singularity file per mesh. Prints a summary table; exit status 0 when every mesh solved and verified.")
+        "or one singularity file per mesh. Prints a summary table; exit status 0 when every mesh solved, verified and "
+        "its field is exact (status ok).")
     parser.add_argument("meshes", nargs="+", help="mesh files (.obj .off .ply, optionally .gz) or folders of them")
-    parser.add_argument("--out", required=True, help="output folder: NAME.field.txt, NAME.sing, summary.txt, summary.json")
+    parser.add_argument("--out", required=True, help="output folder: NAME.field.txt, NAME.sing, summary.txt, summary.json "
+                        "(and NAME.mesh.obj, NAME.parent_face.txt with --split-large-turns)")
     parser.add_argument("-N", "--symmetry", type=int, default=4, help="symmetry N (default 4: cross fields)")
     parser.add_argument("--sing-dir", help="folder with NAME.sing (or Directional's NAME.sings) per mesh; default: automatic")
     parser.add_argument("--auto-cancel", type=float, default=0.0,
@@ -317,6 +376,10 @@ def main(argv=None):
     parser.add_argument("--field-format", choices=FIELD_FORMATS, default="txt", help="field file format (default txt)")
     parser.add_argument("--connection", action="store_true", help="also write NAME.connection.txt")
     parser.add_argument("--png", action="store_true", help="also write NAME.png (800x600)")
+    parser.add_argument("--split-large-turns", action="store_true",
+                        help="refine each mesh where the connection turns by pi/N or more, so that the field read on its own shows "
+                        "exactly the singularities; writes the refined mesh NAME.mesh.obj and NAME.parent_face.txt beside the field")
+    parser.add_argument("--threads", type=int, help="threads per mesh (default: the cores shared out among local workers)")
     parser.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786 (default: a local cluster)")
     parser.add_argument("--timeout", type=float, default=30, help="seconds to wait for the scheduler (default 30)")
     parser.add_argument("--workers", type=int, help="local cluster: worker processes (default: one per core)")
@@ -329,10 +392,13 @@ def main(argv=None):
         parser.error("--workers must be at least 1")
     if a.scheduler and a.workers:
         parser.error("--workers is for the local cluster, not with --scheduler")
+    if a.threads is not None and a.threads < 1:
+        parser.error("--threads must be at least 1")
     try:
         rows = run(a.meshes, a.out, N=a.symmetry, sing_dir=a.sing_dir, auto_cancel=a.auto_cancel, align_boundary=a.align_boundary,
                    weights=a.weights, field_format=a.field_format, connection=a.connection, png=a.png, scheduler=a.scheduler,
-                   workers=a.workers, threads_per_worker=a.threads_per_worker, progress=not a.no_progress, timeout=a.timeout)
+                   workers=a.workers, threads_per_worker=a.threads_per_worker, progress=not a.no_progress, timeout=a.timeout,
+                   split_large_turns=a.split_large_turns, threads=a.threads)
     except UsageError as e:
         parser.error(str(e))
     print(format_table(rows))

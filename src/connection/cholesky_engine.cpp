@@ -11,6 +11,7 @@
 #include "linalg/substitution.h"
 #include "linalg/supernodal.h"
 #include "linalg/timing.h"
+#include "trivcon/cancel.h"
 #include "trivcon/error.h"
 
 namespace trivcon::detail {
@@ -68,7 +69,10 @@ cholmod_factor* symbolic(const Csc& M, std::vector<int> order, int nD, int nC, c
 }  // namespace
 
 void analyse(const Csc& M, int nD, int nC, AnalysisState& state) {
-  if (nD + nC > 0) state.factor = symbolic(M, vertex_order(M, nD, nC, *state.cc), nD, nC, *state.cc);
+  if (nD + nC == 0) return;
+  std::vector<int> order = vertex_order(M, nD, nC, *state.cc);
+  check_cancelled();  // trivcon/cancel.h
+  state.factor = symbolic(M, std::move(order), nD, nC, *state.cc);
 }
 
 namespace {
@@ -117,16 +121,19 @@ class CholeskyEngine : public SolverEngine {
       Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct, w, edge_rows_);
       timings.assemble += seconds_since(t0);
       if (n == 0) return;
+      check_cancelled();
       if (analysis) {
         t0 = Clock::now();
         adopt(M, analysis());
         timings.analysis_wait += seconds_since(t0);
         timings.analysis_adopted = analysis_adopted;
+        check_cancelled();
       }
       t0 = Clock::now();
       factorize(M);
       timings.factor += seconds_since(t0);
       timings.numeric_factorization = numeric_by_;
+      check_cancelled();
       t0 = Clock::now();
       prepare_schur();
       timings.schur += seconds_since(t0);

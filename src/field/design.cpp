@@ -11,6 +11,7 @@
 
 #include "linalg/parallel.h"
 #include "linalg/timing.h"
+#include "trivcon/cancel.h"
 #include "trivcon/error.h"
 
 namespace trivcon {
@@ -30,13 +31,15 @@ FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptio
     topology_ = build_topology(F, static_cast<int>(V_.rows()));
     check_coordinate_range(V_, topology_);
   });
+  const CancelFlag cancel = cancel_flag();  // trivcon/cancel.h: polled between the stages, shared with the analysis
+  check_cancelled(cancel.get());
   // The cycles and the solver's symbolic analysis depend on the connectivity only: on the Cholesky
   // route a second thread computes them while this one computes the geometry and the plan (design.h).
   const bool concurrent = options_.solver == SolverKind::Cholesky;
   std::promise<void> cycles_done;
   std::future<void> cycles_ready = cycles_done.get_future();
   if (concurrent)
-    analysis_ = std::async(std::launch::async, [this, timed, done = std::move(cycles_done)]() mutable {
+    analysis_ = std::async(std::launch::async, [this, timed, cancel, done = std::move(cycles_done)]() mutable {
       try {
         timed(timings_.cycles, [&] { cycles_ = compute_cycles(topology_); });
       } catch (...) {
@@ -44,14 +47,18 @@ FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptio
         throw;
       }
       done.set_value();
+      const CancelScope scope(cancel);  // the caller's flag, polled in the analysis too
+      check_cancelled();
       return SolverAnalysis(topology_, cycles_);
     });
   // With the analysis running, the geometry leaves it a core: on two cores, OpenMP's two threads and the
   // analysis would share them, and the analysis, the longer of the two, would finish later (dragon: 0.15 s).
   const int threads = concurrent ? std::max(1, detail::max_threads() - 1) : 0;
   timed(timings_.geometry, [&] { geometry_ = compute_geometry(V_, topology_, threads); });
+  check_cancelled(cancel.get());
   if (!concurrent) timed(timings_.cycles, [&] { cycles_ = compute_cycles(topology_); });
   timed(timings_.plan, [&] { plan_ = plan_propagation(topology_); });
+  check_cancelled(cancel.get());
   if (concurrent) cycles_ready.get();  // rethrows the thread's error
   construct_seconds_ = seconds_since(start);
   timings_.prepare = construct_seconds_;

@@ -1,5 +1,6 @@
 // Automatic singularities from the globally smoothest field (trivcon/auto.h).
 #include "trivcon/auto.h"
+#include "trivcon/cancel.h"
 
 #include <algorithm>
 #include <array>
@@ -190,9 +191,11 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
     }
   }
   time.assemble = seconds_since(t0);
+  check_cancelled();  // trivcon/cancel.h: here, after the analysis, per iteration
 
   t0 = Clock::now();
   const SymbolicFactor symbolic = analyse_smoothest_matrix(V, t, face_of, outer, inner);
+  check_cancelled();
   cholmod_common& c = **symbolic.context;
   cholmod_factor* const L = symbolic.factor.get();
   ordering_used = symbolic.ordering;
@@ -240,6 +243,7 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
       cf[q] = comp, mf[q] = dirichlet_component[comp] ? 0.0 : k.mass[face_of[j]];
     }
     for (int it = 0; it < std::max(1, o.iterations); ++it) {
+      check_cancelled();
       for (int q = 0; q < n; ++q) bf[q] = (mf[q] * scale[cf[q]]) * xf[q] + df[q];
       substitution.solve_in_factor_order(bf.data());
       xf.swap(bf);
@@ -420,7 +424,9 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
   const Weights k = face_weights(V, t, g);
   std::vector<Complex> guidance;
   if (o.align_curvature) guidance = curvature_tensors(V, t, g);
+  check_cancelled();
   std::vector<Complex> u = smoothest_values(V, t, g, k, o, o.align_curvature ? &guidance : nullptr, r.seconds, r.ordering);
+  check_cancelled();
 
   auto t0 = Clock::now();
   // Energy (the Rayleigh quotient), then faces where the field vanishes (trivcon/auto.h).

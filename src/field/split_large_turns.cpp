@@ -2,6 +2,7 @@
 
 #include <numeric>
 
+#include "trivcon/cancel.h"
 #include "trivcon/error.h"
 #include "trivcon/generate.h"
 #include "trivcon/matching.h"
@@ -30,6 +31,7 @@ RefinedDesign split_large_turns(const FieldDesigner& designer, const MatrixX3i& 
   int splits = 0, reweights = 0;
   bool reweighting = false;  // once splitting stalls, only the weights change
   for (int round = 0;; ++round) {
+    check_cancelled();  // trivcon/cancel.h
     out.design = current->design(out.prescription, round == 0 ? roots : std::vector<std::pair<int, double>>{});
     const std::vector<int> large = large_turn_edges(current->topology(), out.design.connection.x, out.prescription.N);
     if (large.empty()) {

@@ -3,6 +3,7 @@
 #include <dlfcn.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
@@ -53,6 +54,23 @@ SingleThreadedBlas::~SingleThreadedBlas() {
   if (!set || !dlsym(RTLD_DEFAULT, "openblas_get_num_threads")) return;
   std::lock_guard<std::mutex> lock(blas_threads_mutex);
   if (--single_threaded_users == 0 && saved_blas_threads > 1) set(saved_blas_threads);
+}
+
+int blas_threads() {
+  const auto get = reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  if (!get) return 0;
+  std::lock_guard<std::mutex> lock(blas_threads_mutex);
+  return single_threaded_users > 0 ? std::max(1, saved_blas_threads) : get();
+}
+
+void set_blas_threads(int threads) {
+  const auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  if (!set || !dlsym(RTLD_DEFAULT, "openblas_get_num_threads") || threads < 1) return;
+  std::lock_guard<std::mutex> lock(blas_threads_mutex);
+  if (single_threaded_users > 0)
+    saved_blas_threads = threads;  // restored by the last SingleThreadedBlas
+  else
+    set(threads);
 }
 
 }  // namespace trivcon

@@ -14,6 +14,7 @@
 
 #include "linalg/parallel.h"
 #include "trivcon/blas.h"
+#include "trivcon/cancel.h"
 #include "trivcon/error.h"
 
 // Fortran BLAS and LAPACK, the same OpenBLAS CHOLMOD calls (libblas.so.3 / liblapack.so.3).
@@ -385,6 +386,7 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
   std::vector<std::vector<int>> head(parts);
   std::vector<int> failed(parts, -1);
   std::vector<std::exception_ptr> error(parts);
+  const std::atomic<bool>* cancel = cancel_flag().get();  // trivcon/cancel.h: polled per supernode, on every thread
   {
     std::optional<SingleThreadedBlas> one_thread_per_call;
     if (several) one_thread_per_call.emplace();
@@ -393,8 +395,10 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
       try {
         head[k].assign(L.nsuper, -1);
         Workspace<T> w = numeric.workspace();
-        for (int s : split.part[k])
+        for (int s : split.part[k]) {
+          check_cancelled(cancel);
           if ((failed[k] = numeric.compute(s, w, head[k])) >= 0) break;
+        }
       } catch (...) {  // an exception must not leave an OpenMP region
         error[k] = std::current_exception();
       }
@@ -410,11 +414,13 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
     for (int t : split.top)
       for (auto& h : head) numeric.move_list(t, h, top_head);
     Workspace<T> w = numeric.workspace();
-    for (int t : split.top)
+    for (int t : split.top) {
+      check_cancelled(cancel);
       if (const int f = numeric.compute(t, w, top_head); f >= 0) {
         minor = f;
         break;
       }
+    }
   }
   L.minor = static_cast<size_t>(minor);
   return minor;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include "linalg/parallel.h"
+#include "trivcon/cancel.h"
 
 namespace trivcon {
 
@@ -122,6 +123,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
     }
   }
   g.degenerate_faces = degenerate_faces, g.zero_area_faces = zero_area_faces;
+  check_cancelled();  // trivcon/cancel.h: between the passes
   // Frames. A degenerate face borrows the summed normal of its edge neighbours (any unit vector
   // perpendicular to its first edge as a last resort), so every output stays finite.
 #pragma omp parallel for schedule(static) num_threads(team) if (nF > kParallelMinElements)
@@ -176,6 +178,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   // holonomies and frames above stay those of the mesh as given. Components whose faces all have the
   // margin keep their cotangents unchanged (ε = 0).
   std::vector<double> length(nE);
+  check_cancelled();
 #pragma omp parallel for schedule(static) num_threads(team) if (nE > kParallelMinElements)
   for (int e = 0; e < nE; ++e) length[e] = (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).norm();
   const size_t nC = t.components.size();
@@ -221,6 +224,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   g.rho.setZero(nE);
   g.cotan_weight.setZero(nE);
   int negative_cotan_edges = 0, clamped_cotangents = 0, zero_weight_edges = 0;
+  check_cancelled();
 #pragma omp parallel for schedule(static) reduction(+ : negative_cotan_edges, clamped_cotangents, zero_weight_edges) num_threads(team) \
     if (nE > kParallelMinElements)
   for (int e = 0; e < nE; ++e) {
