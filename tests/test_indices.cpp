@@ -73,6 +73,20 @@ TEST(Indices, ParseIndexEdgeCases) {
   EXPECT_EQ(error_of([] { parse_index("1.5", 4, "here"); }), "here: malformed index '1.5'" + malformed);
   EXPECT_EQ(error_of([] { parse_index("99999999999", 4, "here"); }), "here: index '99999999999' is too large");
   EXPECT_EQ(error_of([] { parse_index("1/2", 1, "here"); }), "here: index 1/2 is not a multiple of 1/1 (use -N to change the symmetry)");
+  // Within the parts' range but not in int once multiplied by N (it used to wrap around to a negative sum).
+  EXPECT_EQ(error_of([] { parse_index("1000000000", 4, "here"); }), "here: index 1000000000 is too large (|index| at most 250000000 with N = 4)");
+  EXPECT_EQ(parse_index("250000000", 4, "x"), 1000000000);
+}
+
+// Indices that each fit but whose sum on a component would not: refused before any sum is formed in int.
+TEST(Indices, IndicesWhoseSumWouldOverflowAreRefused) {
+  const Mesh m = make_disk(4, 6);
+  const Topology t = test::topo(m);
+  IndexPrescription p;
+  p.N = 4;
+  p.vertex = {{0, 1000000000}, {1, 1000000000}, {2, 1000000000}};
+  EXPECT_EQ(error_of([&] { validate_prescription(t, 0, p); }),
+            "the indices on component 0 are too large: their magnitudes add up to more than 1000000000/4");
 }
 
 TEST(Indices, FormatIndexGivesReducedFractionsThatParseBack) {

@@ -57,7 +57,11 @@ int parse_index(const std::string& text_in, int N, const std::string& where) {
   // n = p N / q must be an integer.
   if ((p * N) % q != 0)
     throw Error(where + ": index " + text + " is not a multiple of 1/" + std::to_string(N) + " (use -N to change the symmetry)");
-  return static_cast<int>(p * N / q);
+  const long long n = p * N / q;
+  if (n > kMaxIndexPart || n < -kMaxIndexPart)
+    throw Error(where + ": index " + text + " is too large (|index| at most " + std::to_string(kMaxIndexPart / N) + " with N = " +
+                std::to_string(N) + ")");
+  return static_cast<int>(n);
 }
 
 std::string format_index(int n, int N) {
@@ -152,9 +156,15 @@ void validate_prescription(const Topology& t, int num_generators, const IndexPre
     if (l < 0 || l >= static_cast<int>(t.boundary_loops.size()))
       throw Error("boundary loop " + std::to_string(l) + " out of range (the mesh has " + std::to_string(t.boundary_loops.size()) +
                   " boundary loops)");
-  std::vector<long long> sum(t.components.size(), 0);
+  std::vector<long long> sum(t.components.size(), 0), magnitude(t.components.size(), 0);
   std::vector<int> prescribed_loops(t.components.size(), 0);
-  for (auto [v, n] : p.vertex) sum[t.vertex_component[v]] += n;
+  for (auto [v, n] : p.vertex) sum[t.vertex_component[v]] += n, magnitude[t.vertex_component[v]] += std::abs(static_cast<long long>(n));
+  for (auto [l, n] : p.loop) magnitude[t.vertex_component[t.boundary_loops[l][0]]] += std::abs(static_cast<long long>(n));
+  // Indices are whole numbers of 1/N in int: their sums on a component must stay far from its range.
+  for (size_t c = 0; c < t.components.size(); ++c)
+    if (magnitude[c] > kMaxIndexPart)
+      throw Error("the indices on component " + std::to_string(c) + " are too large: their magnitudes add up to more than " +
+                  std::to_string(kMaxIndexPart) + "/" + std::to_string(p.N));
   for (auto [l, n] : p.loop) {
     const int c = t.vertex_component[t.boundary_loops[l][0]];
     sum[c] += n;
