@@ -502,6 +502,9 @@ struct EditorServer::Impl {
     std::vector<int> fixed_faces;          // sorted: every face of prescription.fixed
     double auto_cancel = 0;                // /api/auto's "cancel"
   };
+  // The smoothest field of the last /api/auto: later solves of its N take their rotation from it.
+  std::mutex auto_guide_mutex;
+  std::optional<Field> auto_guide;
 
   Impl(MeshData m, std::unique_ptr<FieldDesigner> d, EditorOptions o) : mesh(std::move(m)), options(std::move(o)) {
     token = options.token.empty() ? random_token() : options.token;
@@ -656,7 +659,11 @@ struct EditorServer::Impl {
     Solved s;
     try {
       with_designer(r.fixed_faces, [&](const FieldDesigner& d) {
-        const Design design = d.design(r.prescription);
+        Design design = d.design(r.prescription);
+        {  // after Auto: the field takes each component's rotation from the smoothest field (trivcon/auto.h)
+          std::lock_guard guide_lock(auto_guide_mutex);
+          if (auto_guide && auto_guide->N == r.prescription.N) turn_toward(d, design.field, *auto_guide, r.prescription.fixed);
+        }
         const bool ok = design_verified(design);
         const cli::ReportRun run{options.mesh_path, "", "cotan", "cholesky", r.align_boundary, options.read_seconds, 0, ok};
         s.report = cli::solve_report(run, mesh, d, r.prescription, design);
@@ -1122,6 +1129,10 @@ struct EditorServer::Impl {
                 std::shared_lock lock(designer_mutex);  // auto_singularities reads the designer; no refactoring meanwhile
                 const AutoResult a = auto_singularities(*designer, ao);
                 lock.unlock();
+                {
+                  std::lock_guard guide_lock(auto_guide_mutex);
+                  auto_guide = a.field;
+                }
                 ojson sing = ojson::array();
                 for (auto [v, n] : a.vertex) sing.push_back({v, format_index(n, ao.N)});
                 ojson out = {{"N", ao.N}, {"singularities", sing}, {"found", a.found.size()}, {"cancelled_pairs", a.pairs.size()}};

@@ -150,5 +150,9 @@ double mean_edge_length(const MatrixX3d& V, const Topology& topology);
 std::vector<std::pair<int, double>> roots_toward(const FieldDesigner& designer, const Field& field, const Field& guide,
                                                  const std::vector<std::pair<int, double>>& roots = {},
                                                  const std::map<int, double>& fixed = {});
+// The same rotation applied to `field` in place (each component's angles + θ, wrapped to [0, 2π)), without
+// designing again: what an interactive front end does after every edit (a rotation by a constant per
+// component changes none of the design's checks). Components with a fixed face keep their rotation.
+void turn_toward(const FieldDesigner& designer, Field& field, const Field& guide, const std::map<int, double>& fixed = {});
 
 }  // namespace trivcon

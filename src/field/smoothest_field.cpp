@@ -524,4 +524,15 @@ std::vector<std::pair<int, double>> roots_toward(const FieldDesigner& designer, 
   return out;
 }
 
+void turn_toward(const FieldDesigner& designer, Field& field, const Field& guide, const std::map<int, double>& fixed) {
+  const Topology& t = designer.topology();
+  std::vector<double> turn(t.components.size(), 0.0);
+  for (auto [f, angle] : roots_toward(designer, field, guide, {}, fixed)) turn[t.face_component[f]] = angle - field.angle(f);
+  for (int f = 0; f < t.num_faces; ++f) {
+    const double a = field.angle(f) + turn[t.face_component[f]];
+    field.angle(f) = a - kTwoPi * std::floor(a / kTwoPi);
+    if (field.angle(f) >= kTwoPi) field.angle(f) = 0;
+  }
+}
+
 }  // namespace trivcon
