@@ -9,7 +9,7 @@
 TRIVCON_FUZZ_TARGET(fixed) {
   const trivcon::fuzz::FixedMesh& m = trivcon::fuzz::fixed_mesh();
   std::map<int, double> fixed;
-  trivcon::detail::read_fixed_directions_from(bytes, "fuzz.txt", m.topology, m.geometry, fixed);
+  trivcon::io::read_fixed_directions_from(bytes, "fuzz.txt", m.topology, m.geometry, fixed);
   for (const auto& [face, angle] : fixed) TRIVCON_FUZZ_CHECK(face >= 0 && face < m.topology.num_faces && std::isfinite(angle));
   trivcon::fixed_conflicts(m.topology, m.geometry, fixed, 4);
 }

@@ -14,7 +14,7 @@
 #include "fuzz_target.h"
 
 TRIVCON_FUZZ_TARGET(gz) {
-  const std::string data = trivcon::detail::gunzip(bytes, "fuzz.gz");
+  const std::string data = trivcon::io::gunzip(bytes, "fuzz.gz");
   using Reader = trivcon::MeshData (*)(const std::string&, const std::string&);
   for (const Reader read : {Reader{trivcon::read_obj}, Reader{trivcon::read_off}, Reader{trivcon::read_ply}}) {
     try {
@@ -52,7 +52,7 @@ extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t s
   constexpr std::size_t kMaxPlain = 16384;
   std::string plain;
   try {
-    plain = trivcon::detail::gunzip(std::string(reinterpret_cast<const char*>(data), size), "seed.gz");
+    plain = trivcon::io::gunzip(std::string(reinterpret_cast<const char*>(data), size), "seed.gz");
   } catch (const trivcon::Error&) {
     return LLVMFuzzerMutate(data, size, max_size);
   }

@@ -7,7 +7,7 @@
 TRIVCON_FUZZ_TARGET(rawfield) {
   const trivcon::fuzz::FixedMesh& m = trivcon::fuzz::fixed_mesh();
   int N = 0;
-  const trivcon::MatrixX3d directions = trivcon::detail::read_field_from(bytes, "fuzz.rawfield", m.topology.num_faces, &N);
+  const trivcon::MatrixX3d directions = trivcon::io::read_field_from(bytes, "fuzz.rawfield", m.topology.num_faces, &N);
   TRIVCON_FUZZ_CHECK(directions.rows() == m.topology.num_faces && directions.allFinite());
   TRIVCON_FUZZ_CHECK(N >= 0 && N <= 1000);
   const trivcon::Field field = trivcon::field_from_directions(m.geometry, directions, N > 0 ? N : 4);

@@ -7,7 +7,7 @@ TRIVCON_FUZZ_TARGET(sings) {
   const trivcon::fuzz::FixedMesh& m = trivcon::fuzz::fixed_mesh();
   trivcon::IndexPrescription p;
   p.N = 4;
-  trivcon::detail::read_singularities_from(bytes, "fuzz.sings", p);
+  trivcon::io::read_singularities_from(bytes, "fuzz.sings", p);
   for (const auto& [v, n] : p.vertex) TRIVCON_FUZZ_CHECK(v >= 0);
   trivcon::validate_prescription(m.topology, static_cast<int>(m.cycles.generators.size()), p);
 }

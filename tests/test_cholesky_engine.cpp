@@ -130,7 +130,7 @@ TEST(CholeskyEngine, BothFactorizationsSolveABadlyScaledSystemAlike) {
 }
 
 TEST(CholeskyEngine, NumericLibrariesPassTheStartUpCheck) {
-  EXPECT_NO_THROW(detail::check_numeric_libraries());
+  EXPECT_NO_THROW(linalg::check_numeric_libraries());
   int version[3] = {0, 0, 0};
   cholmod_version(version);
   EXPECT_EQ(version[0], CHOLMOD_MAIN_VERSION);

@@ -60,12 +60,12 @@ struct Fill {
 
 // CHOLMOD's count of the factor's nonzeros and flops for an order (empty: CHOLMOD's AMD).
 Fill analyse(const Graph& g, std::vector<int> order) {
-  detail::CholmodContext context;
+  linalg::CholmodContext context;
   cholmod_common& c = *context;
   c.nmethods = 1;
   c.method[0].ordering = order.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
   c.postorder = 1;
-  cholmod_sparse A = detail::upper_view(g.outer, g.inner, g.values, g.n);
+  cholmod_sparse A = linalg::upper_view(g.outer, g.inner, g.values, g.n);
   cholmod_factor* L = order.empty() ? cholmod_analyze(&A, &c) : cholmod_analyze_p(&A, order.data(), nullptr, 0, &c);
   EXPECT_NE(L, nullptr);
   Fill f{c.lnz, c.fl};
@@ -74,7 +74,7 @@ Fill analyse(const Graph& g, std::vector<int> order) {
 }
 
 std::vector<int> dissection(const Graph& g, int leaf = 16) {
-  return ordering::coordinate_dissection(ordering::leading_block_pattern(g.outer, g.inner, g.n), g.point, leaf);
+  return linalg::coordinate_dissection(linalg::leading_block_pattern(g.outer, g.inner, g.n), g.point, leaf);
 }
 
 void expect_permutation(const std::vector<int>& order, int n) {

@@ -56,15 +56,15 @@ Upper shifted_laplacian(const Mesh& mesh, double shift, unsigned seed) {
   return M;
 }
 
-cholmod_sparse view(const Upper& M) { return detail::upper_view(M.outer, M.inner, M.values, M.n); }
+cholmod_sparse view(const Upper& M) { return linalg::upper_view(M.outer, M.inner, M.values, M.n); }
 
 // The library's CHOLMOD workspace (src/linalg/cholmod.h), as the solver sets it up.
 struct Cholmod {
-  detail::CholmodContext context;
+  linalg::CholmodContext context;
   cholmod_common& c = *context;
 };
 
-// Factors M with CHOLMOD and with supernodal::factorize from one symbolic analysis; returns the largest
+// Factors M with CHOLMOD and with linalg::factorize from one symbolic analysis; returns the largest
 // difference of the factors' values relative to the largest value, and each one's `minor`.
 struct Comparison {
   double difference = 0;
@@ -79,7 +79,7 @@ Comparison compare(Upper& M) {
   cholmod_factor* ours = cholmod_copy_factor(theirs, &cm.c);
   cholmod_factorize(&A, theirs, &cm.c);
   Comparison r;
-  r.ours_minor = static_cast<size_t>(supernodal::factorize(*ours, M.outer, M.inner, M.values, cm.c));
+  r.ours_minor = static_cast<size_t>(linalg::factorize(*ours, M.outer, M.inner, M.values, cm.c));
   EXPECT_EQ(r.ours_minor, ours->minor);
   r.cholmod_minor = theirs->minor;
   r.supernodes = ours->nsuper;
@@ -125,12 +125,12 @@ TEST(Supernodal, SameComplexFactorAsCholmod) {
     Upper M = hermitian_laplacian(mesh, 1e-3, 7);
     Cholmod cm;
     cm.c.supernodal = CHOLMOD_SUPERNODAL;
-    cholmod_sparse A = detail::upper_view_complex(M.outer, M.inner, M.values, M.n);
+    cholmod_sparse A = linalg::upper_view_complex(M.outer, M.inner, M.values, M.n);
     cholmod_factor* theirs = cholmod_analyze(&A, &cm.c);
     ASSERT_NE(theirs, nullptr);
     cholmod_factor* ours = cholmod_copy_factor(theirs, &cm.c);
     ASSERT_TRUE(cholmod_factorize(&A, theirs, &cm.c));
-    ASSERT_EQ(supernodal::factorize_complex(*ours, M.outer, M.inner, M.values, cm.c), M.n);
+    ASSERT_EQ(linalg::factorize_complex(*ours, M.outer, M.inner, M.values, cm.c), M.n);
     EXPECT_TRUE(ours->is_super && ours->is_ll && ours->xtype == CHOLMOD_COMPLEX);
     ASSERT_EQ(ours->xsize, theirs->xsize);
     const double* a = static_cast<const double*>(ours->x);
@@ -143,7 +143,7 @@ TEST(Supernodal, SameComplexFactorAsCholmod) {
     std::vector<double> rhs(2 * M.n);
     for (int i = 0; i < 2 * M.n; ++i) rhs[i] = std::sin(0.37 * i + 1);
     Eigen::VectorXd bv = Eigen::Map<Eigen::VectorXd>(rhs.data(), 2 * M.n);
-    cholmod_dense B = detail::dense_view_complex(bv);
+    cholmod_dense B = linalg::dense_view_complex(bv);
     cholmod_dense* X = cholmod_solve(CHOLMOD_A, ours, &B, &cm.c);
     ASSERT_NE(X, nullptr);
     const std::complex<double>* x = static_cast<const std::complex<double>*>(X->x);
@@ -226,7 +226,7 @@ TEST(Supernodal, SameBitsEveryTime) {
   std::vector<double> first;
   for (int run = 0; run < 4; ++run) {
     cholmod_factor* L = cholmod_copy_factor(symbolic, &cm.c);
-    ASSERT_EQ(supernodal::factorize(*L, M.outer, M.inner, M.values, cm.c), M.n);
+    ASSERT_EQ(linalg::factorize(*L, M.outer, M.inner, M.values, cm.c), M.n);
     const double* x = static_cast<const double*>(L->x);
     if (run == 0)
       first.assign(x, x + L->xsize);
@@ -263,11 +263,11 @@ void check_substitution(const Upper& M, const std::string& name) {
   constexpr bool complex = !std::is_same<T, double>::value;
   Cholmod cm;
   cm.c.supernodal = CHOLMOD_SUPERNODAL;
-  cholmod_sparse A = complex ? detail::upper_view_complex(M.outer, M.inner, M.values, M.n) : view(M);
+  cholmod_sparse A = complex ? linalg::upper_view_complex(M.outer, M.inner, M.values, M.n) : view(M);
   cholmod_factor* L = cholmod_analyze(&A, &cm.c);
   ASSERT_NE(L, nullptr);
-  ASSERT_EQ(complex ? supernodal::factorize_complex(*L, M.outer, M.inner, M.values, cm.c)
-                    : supernodal::factorize(*L, M.outer, M.inner, M.values, cm.c),
+  ASSERT_EQ(complex ? linalg::factorize_complex(*L, M.outer, M.inner, M.values, cm.c)
+                    : linalg::factorize(*L, M.outer, M.inner, M.values, cm.c),
             M.n);
   std::vector<T> b(M.n);
   for (int i = 0; i < M.n; ++i) {
@@ -277,7 +277,7 @@ void check_substitution(const Upper& M, const std::string& name) {
       b[i] = std::sin(0.37 * i + 1);
   }
   Eigen::VectorXd flat = Eigen::Map<const Eigen::VectorXd>(reinterpret_cast<const double*>(b.data()), (complex ? 2 : 1) * M.n);
-  cholmod_dense B = complex ? detail::dense_view_complex(flat) : detail::dense_view(flat);
+  cholmod_dense B = complex ? linalg::dense_view_complex(flat) : linalg::dense_view(flat);
   cholmod_dense* X = cholmod_solve(CHOLMOD_A, L, &B, &cm.c);
   ASSERT_NE(X, nullptr);
   const T* theirs = static_cast<const T*>(X->x);
@@ -288,7 +288,7 @@ void check_substitution(const Upper& M, const std::string& name) {
   for (int n : {1, 2, 3, 4}) {
     SCOPED_TRACE(name + ", " + std::to_string(n) + " threads");
     omp_set_num_threads(n);
-    const supernodal::Substitution<T> solver(*L);
+    const linalg::Substitution<T> solver(*L);
     EXPECT_EQ(solver.size(), M.n);
     for (int run = 0; run < 2; ++run) {
       std::vector<T> x = b;
@@ -324,8 +324,8 @@ TEST(Substitution, RefusesAFactorOfTheOtherType) {
   cm.c.supernodal = CHOLMOD_SUPERNODAL;
   cholmod_sparse A = view(M);
   cholmod_factor* L = cholmod_analyze(&A, &cm.c);
-  ASSERT_EQ(supernodal::factorize(*L, M.outer, M.inner, M.values, cm.c), M.n);
-  EXPECT_THROW(supernodal::Substitution<std::complex<double>>{*L}, Error);
+  ASSERT_EQ(linalg::factorize(*L, M.outer, M.inner, M.values, cm.c), M.n);
+  EXPECT_THROW(linalg::Substitution<std::complex<double>>{*L}, Error);
   cholmod_free_factor(&L, &cm.c);
 }
 
@@ -341,7 +341,7 @@ TEST(Supernodal, ReportsTheColumnThatIsNotPositiveDefinite) {
     cholmod_factor* L = cholmod_analyze(&A, &cm.c);
     const int* perm = static_cast<const int*>(L->Perm);
     const int column = static_cast<int>(std::find(perm, perm + M.n, bad) - perm);
-    EXPECT_EQ(supernodal::factorize(*L, M.outer, M.inner, M.values, cm.c), column) << "row " << bad;
+    EXPECT_EQ(linalg::factorize(*L, M.outer, M.inner, M.values, cm.c), column) << "row " << bad;
     cholmod_free_factor(&L, &cm.c);
     const Comparison r = compare(M);
     EXPECT_EQ(r.ours_minor, r.cholmod_minor) << "row " << bad;
@@ -356,7 +356,7 @@ struct BelowTop {
   double heaviest = 0;  // the largest subtree below the top
 };
 BelowTop expect_valid_split(const std::vector<int>& parent, const std::vector<double>& work, double min_split,
-                            const supernodal::TreeSplit& split, int parts = 2) {
+                            const linalg::TreeSplit& split, int parts = 2) {
   const int count = static_cast<int>(parent.size());
   EXPECT_EQ(static_cast<int>(split.part.size()), parts);
   std::vector<int> where(count, -2);  // −1: top, k ≥ 0: part k
@@ -428,23 +428,23 @@ void random_forest(std::mt19937& rng, std::vector<int>& parent, std::vector<doub
 }
 
 TEST(Supernodal, TreeSplitIsIndependentAndBalanced) {
-  using supernodal::split_tree;
+  using linalg::split_tree;
   {  // Two equal leaves under a heavy root: the root is the top, one leaf per part.
-    const supernodal::TreeSplit s = split_tree({2, 2, -1}, {10, 10, 1}, 5);
+    const linalg::TreeSplit s = split_tree({2, 2, -1}, {10, 10, 1}, 5);
     expect_valid_split({2, 2, -1}, {10, 10, 1}, 5, s);
     EXPECT_EQ(s.top, std::vector<int>{2});
     EXPECT_EQ(s.part[0].size() + s.part[1].size(), 2u);
     EXPECT_FALSE(s.part[0].empty() || s.part[1].empty());
   }
   {  // Two trees of equal work: nothing to split, one each.
-    const supernodal::TreeSplit s = split_tree({1, -1, 3, -1}, {5, 5, 5, 5}, 1);
+    const linalg::TreeSplit s = split_tree({1, -1, 3, -1}, {5, 5, 5, 5}, 1);
     expect_valid_split({1, -1, 3, -1}, {5, 5, 5, 5}, 1, s);
     EXPECT_TRUE(s.top.empty());
     EXPECT_EQ(s.part[0].size(), 2u);
     EXPECT_EQ(s.part[1].size(), 2u);
   }
   {  // A chain allows no two independent parts: below min_split it stays whole, above it all goes to the top.
-    const supernodal::TreeSplit small = split_tree({1, 2, -1}, {10, 10, 10}, 100), large = split_tree({1, 2, -1}, {10, 10, 10}, 1);
+    const linalg::TreeSplit small = split_tree({1, 2, -1}, {10, 10, 10}, 100), large = split_tree({1, 2, -1}, {10, 10, 10}, 1);
     expect_valid_split({1, 2, -1}, {10, 10, 10}, 100, small);
     expect_valid_split({1, 2, -1}, {10, 10, 10}, 1, large);
     EXPECT_TRUE(small.top.empty());
@@ -458,7 +458,7 @@ TEST(Supernodal, TreeSplitIsIndependentAndBalanced) {
     std::vector<int> parent;
     std::vector<double> work;
     random_forest(rng, parent, work);
-    const supernodal::TreeSplit split = split_tree(parent, work, 100);
+    const linalg::TreeSplit split = split_tree(parent, work, 100);
     split_in_two += expect_valid_split(parent, work, 100, split).roots.size() >= 2;
   }
   EXPECT_GE(split_in_two, 40) << "most random forests leave several subtrees below the top";
@@ -466,11 +466,11 @@ TEST(Supernodal, TreeSplitIsIndependentAndBalanced) {
 
 // The same contract for 1, 3 and 4 parts (threads): split_tree takes OpenMP's thread count.
 TEST(Supernodal, TreeSplitIntoAnyNumberOfParts) {
-  using supernodal::split_tree;
+  using linalg::split_tree;
   {  // Four equal leaves under a root: with 4 parts one leaf each, with 1 part nothing split.
     const std::vector<int> parent{4, 4, 4, 4, -1};
     const std::vector<double> work{10, 10, 10, 10, 1};
-    const supernodal::TreeSplit four = split_tree(parent, work, 5, 4), one = split_tree(parent, work, 5, 1);
+    const linalg::TreeSplit four = split_tree(parent, work, 5, 4), one = split_tree(parent, work, 5, 1);
     expect_valid_split(parent, work, 5, four, 4);
     expect_valid_split(parent, work, 5, one, 1);
     EXPECT_EQ(four.top, std::vector<int>{4});
@@ -485,7 +485,7 @@ TEST(Supernodal, TreeSplitIntoAnyNumberOfParts) {
       std::vector<int> parent;
       std::vector<double> work;
       random_forest(rng, parent, work);
-      const supernodal::TreeSplit split = split_tree(parent, work, 100, parts);
+      const linalg::TreeSplit split = split_tree(parent, work, 100, parts);
       all_used += static_cast<int>(expect_valid_split(parent, work, 100, split, parts).roots.size()) >= parts;
     }
     EXPECT_GE(all_used, 30) << "most random forests leave a subtree for every part";
@@ -495,8 +495,8 @@ TEST(Supernodal, TreeSplitIntoAnyNumberOfParts) {
 // With `refine` (the parallel substitution's split): the same contract of independent, balanced parts, and a
 // critical path (the top's work, done on one thread, plus the heaviest part's) never longer than without.
 TEST(Supernodal, RefinedTreeSplitShortensTheCriticalPath) {
-  using supernodal::split_tree;
-  auto critical_path = [](const std::vector<double>& work, const supernodal::TreeSplit& s, const BelowTop& below) {
+  using linalg::split_tree;
+  auto critical_path = [](const std::vector<double>& work, const linalg::TreeSplit& s, const BelowTop& below) {
     double top = 0;
     for (int t : s.top) top += work[t];
     return top + *std::max_element(below.load.begin(), below.load.end());
@@ -509,7 +509,7 @@ TEST(Supernodal, RefinedTreeSplitShortensTheCriticalPath) {
     std::vector<double> work;
     random_forest(rng, parent, work);
     for (int parts : {2, 3}) {
-      const supernodal::TreeSplit plain = split_tree(parent, work, 100, parts), refined = split_tree(parent, work, 100, parts, true);
+      const linalg::TreeSplit plain = split_tree(parent, work, 100, parts), refined = split_tree(parent, work, 100, parts, true);
       const BelowTop below_plain = expect_valid_split(parent, work, 100, plain, parts);
       const BelowTop below_refined = expect_valid_split(parent, work, 100, refined, parts);
       const double a = critical_path(work, plain, below_plain), b = critical_path(work, refined, below_refined);
@@ -522,7 +522,7 @@ TEST(Supernodal, RefinedTreeSplitShortensTheCriticalPath) {
   // two of them share a thread (critical path 1 + 60); going down the 40 (2 over two 19s) gives 3 + 54.
   const std::vector<int> parent{2, 2, 5, 5, 5, -1};
   const std::vector<double> work{19, 19, 2, 35, 25, 1};
-  const supernodal::TreeSplit plain = split_tree(parent, work, 1, 2), refined = split_tree(parent, work, 1, 2, true);
+  const linalg::TreeSplit plain = split_tree(parent, work, 1, 2), refined = split_tree(parent, work, 1, 2, true);
   const BelowTop a = expect_valid_split(parent, work, 1, plain), b = expect_valid_split(parent, work, 1, refined);
   EXPECT_EQ(plain.top, (std::vector<int>{5}));
   EXPECT_DOUBLE_EQ(critical_path(work, plain, a), 61);
@@ -530,7 +530,7 @@ TEST(Supernodal, RefinedTreeSplitShortensTheCriticalPath) {
   EXPECT_DOUBLE_EQ(critical_path(work, refined, b), 57);
 }
 
-// The elimination trees of mesh Laplacians, with the work measure and threshold supernodal::factorize
+// The elimination trees of mesh Laplacians, with the work measure and threshold linalg::factorize
 // uses (per supernode cols · height² + 64 · height, split above 1e5): two non-empty parts, balanced.
 TEST(Supernodal, TreeSplitOfMeshFactorsWithTheFactorizationsWorkMeasure) {
   for (const auto& [name, mesh] : std::vector<std::pair<std::string, Mesh>>{{"cube sphere 40", make_cube_sphere(40, true)},
@@ -543,14 +543,14 @@ TEST(Supernodal, TreeSplitOfMeshFactorsWithTheFactorizationsWorkMeasure) {
     cholmod_factor* L = cholmod_analyze(&A, &cm.c);
     ASSERT_NE(L, nullptr);
     ASSERT_TRUE(L->is_super);
-    const supernodal::Supernodes S(L);
-    const std::vector<int> parent = supernodal::supernode_parents(S, S.owners());
+    const linalg::Supernodes S(L);
+    const std::vector<int> parent = linalg::supernode_parents(S, S.owners());
     std::vector<double> work(S.count);
     for (int s = 0; s < S.count; ++s) {
       const double ncol = S.cols(s), nrow = S.height(s);
       work[s] = ncol * nrow * nrow + 64 * nrow;
     }
-    const supernodal::TreeSplit split = supernodal::split_tree(parent, work, 1e5);
+    const linalg::TreeSplit split = linalg::split_tree(parent, work, 1e5);
     const BelowTop below = expect_valid_split(parent, work, 1e5, split);
     EXPECT_FALSE(split.part[0].empty() || split.part[1].empty());
     EXPECT_GE(below.roots.size(), 2u);

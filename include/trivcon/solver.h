@@ -111,7 +111,7 @@ struct SetupTimings {
   std::string numeric_factorization;
 };
 
-namespace detail {
+namespace connection {
 struct AnalysisState;
 }
 
@@ -130,7 +130,7 @@ class SolverAnalysis {
   double seconds() const;  // how long the analysis took (on whichever thread ran it)
 
  private:
-  std::unique_ptr<detail::AnalysisState> state_;
+  std::unique_ptr<connection::AnalysisState> state_;
   friend class ConnectionSolver;
 };
 

@@ -5,7 +5,7 @@
 #include <numeric>
 #include <utility>
 
-namespace trivcon::detail {
+namespace trivcon::connection {
 
 using Triplet = Eigen::Triplet<double>;
 
@@ -133,4 +133,4 @@ SparseMatrix cycle_columns(int m, const std::vector<int>& column, int count, con
   return S;
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::connection

@@ -15,7 +15,7 @@
 #include "trivcon/cycles.h"
 #include "trivcon/topology.h"
 
-namespace trivcon::detail {
+namespace trivcon::connection {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using EdgeEnds = std::vector<std::array<int, 2>>;  // per system edge, the vertex rows of its ends (−1: none)
@@ -59,4 +59,4 @@ EdgeEnds edge_ends(const Topology& t, const std::vector<int>& edges, const std::
 // Cycles (or paths) as the sparse columns of Aᵀ (m × count); repeated edges of a cycle are summed.
 SparseMatrix cycle_columns(int m, const std::vector<int>& column, int count, const std::function<const DualCycle&(int)>& cycle);
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::connection

@@ -14,7 +14,7 @@
 #include "trivcon/cancel.h"
 #include "trivcon/error.h"
 
-namespace trivcon::detail {
+namespace trivcon::connection {
 
 AnalysisState::~AnalysisState() {
   if (factor) cholmod_free_factor(&factor, cc.get());
@@ -35,19 +35,19 @@ std::vector<int> vertex_order(const Csc& M, int nD, int nC, cholmod_common& cc) 
   std::vector<int> order(nD);
   if (nD == 0) return order;
   if (nC > 0) {
-    cholmod_sparse A = upper_view(M.outer, M.inner, M.values, nD + nC);
+    cholmod_sparse A = linalg::upper_view(M.outer, M.inner, M.values, nD + nC);
     std::vector<int> last(nD + nC, 0), full(nD + nC);
     std::fill(last.begin() + nD, last.end(), 1);
-    require(cholmod_camd(&A, nullptr, 0, last.data(), full.data(), &cc) != 0, "CHOLMOD could not order the constraint system", cc);
+    linalg::require(cholmod_camd(&A, nullptr, 0, last.data(), full.data(), &cc) != 0, "CHOLMOD could not order the constraint system", cc);
     std::copy(full.begin(), full.begin() + nD, order.begin());
-    for (int k = 0; k < nD; ++k) require(order[k] < nD, "CHOLMOD did not order the cycle rows last", cc);
+    for (int k = 0; k < nD; ++k) linalg::require(order[k] < nD, "CHOLMOD did not order the cycle rows last", cc);
   } else {
-    cholmod_sparse A = upper_view(M.outer, M.inner, M.values, nD);
-    require(cholmod_amd(&A, nullptr, 0, order.data(), &cc) != 0, "CHOLMOD could not order the vertex Laplacian", cc);
+    cholmod_sparse A = linalg::upper_view(M.outer, M.inner, M.values, nD);
+    linalg::require(cholmod_amd(&A, nullptr, 0, order.data(), &cc) != 0, "CHOLMOD could not order the vertex Laplacian", cc);
   }
-  const ordering::Pattern pattern = ordering::leading_block_pattern(M.outer, M.inner, nD);
-  std::vector<int> parent = ordering::elimination_tree(pattern, order), post(nD);
-  require(cholmod_postorder(parent.data(), nD, nullptr, post.data(), &cc) == nD, "CHOLMOD could not postorder the elimination tree", cc);
+  const linalg::Pattern pattern = linalg::leading_block_pattern(M.outer, M.inner, nD);
+  std::vector<int> parent = linalg::elimination_tree(pattern, order), post(nD);
+  linalg::require(cholmod_postorder(parent.data(), nD, nullptr, post.data(), &cc) == nD, "CHOLMOD could not postorder the elimination tree", cc);
   std::vector<int> postordered(nD);
   for (int k = 0; k < nD; ++k) postordered[k] = order[post[k]];
   return postordered;
@@ -57,12 +57,12 @@ std::vector<int> vertex_order(const Csc& M, int nD, int nC, cholmod_common& cc) 
 cholmod_factor* symbolic(const Csc& M, std::vector<int> order, int nD, int nC, cholmod_common& c) {
   const int n = nD + nC;
   for (int r = nD; r < n; ++r) order.push_back(r);
-  cholmod_sparse A = upper_view(M.outer, M.inner, M.values, n);
+  cholmod_sparse A = linalg::upper_view(M.outer, M.inner, M.values, n);
   c.nmethods = 1;
   c.method[0].ordering = CHOLMOD_GIVEN;
   c.postorder = 0;  // keep the cycle rows last (the vertex order is postordered already)
   cholmod_factor* L = cholmod_analyze_p(&A, order.data(), nullptr, 0, &c);
-  require(L != nullptr, "CHOLMOD could not analyse the constraint system", c);
+  linalg::require(L != nullptr, "CHOLMOD could not analyse the constraint system", c);
   return L;
 }
 
@@ -77,7 +77,7 @@ void analyse(const Csc& M, int nD, int nC, AnalysisState& state) {
 
 namespace {
 
-using supernodal::Supernodes;
+using linalg::Supernodes;
 
 // See src/connection/cholesky_engine.h.
 class CholeskyEngine : public SolverEngine {
@@ -104,7 +104,7 @@ class CholeskyEngine : public SolverEngine {
   mutable Eigen::VectorXd forward_work_;
   mutable int stamp_ = 0;
   // Backward substitution on OpenMP's threads (src/linalg/substitution.h), planned once the factor has its values.
-  std::unique_ptr<supernodal::Substitution<double>> substitution_;
+  std::unique_ptr<linalg::Substitution<double>> substitution_;
 
   // The rows of A (see normal_matrix): vertex rows given per system edge by the rows of its two ends (a
   // boundary or dropped vertex has none), then the extra rows Et (fixed-face paths that are ordered with
@@ -113,30 +113,30 @@ class CholeskyEngine : public SolverEngine {
   CholeskyEngine(const EdgeEnds& ends, int num_vertex_rows, const SparseMatrix& Et, const SparseMatrix& Ct, const Eigen::VectorXd& w_,
                  Factorization factorization, SetupTimings& timings, const std::function<std::unique_ptr<AnalysisState>()>& analysis)
       : factorization_(factorization), w(w_) {
-    check_numeric_libraries();
+    linalg::check_numeric_libraries();
     m = static_cast<int>(ends.size()), nD = num_vertex_rows + static_cast<int>(Et.cols()), nC = static_cast<int>(Ct.cols());
     const int n = nD + nC;
     try {
-      auto t0 = Clock::now();
+      auto t0 = linalg::Clock::now();
       Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct, w, edge_rows_);
-      timings.assemble += seconds_since(t0);
+      timings.assemble += linalg::seconds_since(t0);
       if (n == 0) return;
       check_cancelled();
       if (analysis) {
-        t0 = Clock::now();
+        t0 = linalg::Clock::now();
         adopt(M, analysis());
-        timings.analysis_wait += seconds_since(t0);
+        timings.analysis_wait += linalg::seconds_since(t0);
         timings.analysis_adopted = analysis_adopted;
         check_cancelled();
       }
-      t0 = Clock::now();
+      t0 = linalg::Clock::now();
       factorize(M);
-      timings.factor += seconds_since(t0);
+      timings.factor += linalg::seconds_since(t0);
       timings.numeric_factorization = numeric_by_;
       check_cancelled();
-      t0 = Clock::now();
+      t0 = linalg::Clock::now();
       prepare_schur();
-      timings.schur += seconds_since(t0);
+      timings.schur += linalg::seconds_since(t0);
     } catch (...) {  // the destructor does not run for an object whose constructor throws
       release();
       throw;
@@ -163,10 +163,10 @@ class CholeskyEngine : public SolverEngine {
     const int n = nD + nC;
     if (factorization_ == Factorization::Parallel) {
       numeric_by_ = "trivcon";
-      return supernodal::factorize(*factor, M.outer, M.inner, M.values, cc());
+      return linalg::factorize(*factor, M.outer, M.inner, M.values, cc());
     }
     numeric_by_ = "cholmod";
-    cholmod_sparse A = upper_view(M.outer, M.inner, M.values, n);
+    cholmod_sparse A = linalg::upper_view(M.outer, M.inner, M.values, n);
     const int ok = cholmod_factorize(&A, factor, &cc());
     check(ok && (cc().status == CHOLMOD_OK || cc().status == CHOLMOD_NOT_POSDEF), "CHOLMOD factorization failed");
     return cc().status == CHOLMOD_NOT_POSDEF ? static_cast<int>(factor->minor) : n;
@@ -204,7 +204,7 @@ class CholeskyEngine : public SolverEngine {
 
   std::string ordering() const override { return nC > 0 ? "CAMD" : "AMD"; }
 
-  void check(bool ok, const char* what) const { require(ok, what, cc()); }
+  void check(bool ok, const char* what) const { linalg::require(ok, what, cc()); }
 
   // Supernodal elimination tree and the factor position of each row, for forward_update.
   void prepare_sparse_forward() {
@@ -214,10 +214,10 @@ class CholeskyEngine : public SolverEngine {
     for (int k = 0; k < n; ++k) position_[perm[k]] = k;
     const Supernodes L(factor);
     super_of_col_ = L.owners();
-    super_parent_ = supernodal::supernode_parents(L, super_of_col_);
+    super_parent_ = linalg::supernode_parents(L, super_of_col_);
     super_stamp_.assign(L.count, -1);
     for (int& r : edge_rows_.row) r = position_[r];
-    substitution_ = std::make_unique<supernodal::Substitution<double>>(*factor);
+    substitution_ = std::make_unique<linalg::Substitution<double>>(*factor);
   }
 
   // z ← L⁻ᵀ z (in factor order), on OpenMP's threads: the top of the tree, then one set of disjoint subtrees
@@ -273,7 +273,7 @@ class CholeskyEngine : public SolverEngine {
 
   // L⁻¹ b by CHOLMOD (in factor order), for a right-hand side that is not an update of the base one.
   Eigen::VectorXd lower_solve(const Eigen::VectorXd& b) const {
-    cholmod_dense B = dense_view(b);
+    cholmod_dense B = linalg::dense_view(b);
     cholmod_dense* X = cholmod_solve(CHOLMOD_L, factor, &B, &cc());
     check(X != nullptr && cc().status == CHOLMOD_OK, "CHOLMOD solve failed");
     Eigen::VectorXd out = Eigen::Map<Eigen::VectorXd>(static_cast<double*>(X->x), b.size());
@@ -354,7 +354,7 @@ class CholeskyEngine : public SolverEngine {
   // x = W Aᵀ y for y in factor order.
   Eigen::VectorXd edge_values(const Eigen::VectorXd& y) const {
     Eigen::VectorXd x(m);
-#pragma omp parallel for schedule(static) if (m > kParallelMinEditElements)
+#pragma omp parallel for schedule(static) if (m > linalg::kParallelMinEditElements)
     for (int a = 0; a < m; ++a) {
       double sum = 0;
       for (int k = edge_rows_.start[a]; k < edge_rows_.start[a + 1]; ++k) sum += edge_rows_.coefficient[k] * y(edge_rows_.row[k]);
@@ -372,4 +372,4 @@ std::unique_ptr<SolverEngine> make_cholesky_engine(const EdgeEnds& ends, int num
   return std::make_unique<CholeskyEngine>(ends, num_vertex_rows, Et, Ct, w, factorization, timings, analysis);
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::connection

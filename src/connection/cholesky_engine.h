@@ -25,12 +25,12 @@
 #include "connection/solver_engine.h"
 #include "trivcon/solver.h"
 
-namespace trivcon::detail {
+namespace trivcon::connection {
 
 // A symbolic factorization and the pattern it was computed for (behind trivcon::SolverAnalysis), or just
 // the CHOLMOD workspace of an engine that analyses its own.
 struct AnalysisState {
-  CholmodContext cc;
+  linalg::CholmodContext cc;
   cholmod_factor* factor = nullptr;
   int nD = 0, nC = 0;
   std::vector<int> outer, inner;
@@ -55,4 +55,4 @@ std::unique_ptr<SolverEngine> make_cholesky_engine(const EdgeEnds& ends, int num
                                                    SetupTimings& timings,
                                                    const std::function<std::unique_ptr<AnalysisState>()>& analysis = {});
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::connection

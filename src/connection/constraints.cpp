@@ -137,10 +137,10 @@ void insert_fixed(std::map<int, double>& fixed, int face, double angle, const st
 }  // namespace
 
 void read_fixed_directions(const std::string& path, const Topology& t, const Geometry& g, std::map<int, double>& fixed) {
-  detail::read_fixed_directions_from(read_file_bytes(path), path, t, g, fixed);
+  io::read_fixed_directions_from(read_file_bytes(path), path, t, g, fixed);
 }
 
-void detail::read_fixed_directions_from(const std::string& bytes, const std::string& path, const Topology& t, const Geometry& g,
+void io::read_fixed_directions_from(const std::string& bytes, const std::string& path, const Topology& t, const Geometry& g,
                                         std::map<int, double>& fixed) {
   std::istringstream in(bytes);
   std::string line;

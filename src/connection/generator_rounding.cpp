@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace trivcon::detail {
+namespace trivcon::connection {
 
 Eigen::VectorXi babai_round(const Eigen::MatrixXd& T, bool lower, const Eigen::VectorXd& u) {
   const int k = static_cast<int>(u.size());
@@ -62,4 +62,4 @@ Eigen::VectorXi nearest_lattice_point(const SolverEngine& engine, const Eigen::V
   return t;
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::connection

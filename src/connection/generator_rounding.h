@@ -11,7 +11,7 @@
 
 #include "connection/solver_engine.h"
 
-namespace trivcon::detail {
+namespace trivcon::connection {
 
 // Rounds the real minimiser u of ‖T (u − n)‖² to integers one coordinate at a time (see above): with T
 // lower triangular from the first coordinate on, with T upper triangular from the last one back. Exact
@@ -24,4 +24,4 @@ Eigen::VectorXi babai_round(const Eigen::MatrixXd& T, bool lower, const Eigen::V
 Eigen::VectorXi nearest_lattice_point(const SolverEngine& engine, const Eigen::VectorXd& u, const Eigen::VectorXd& n0,
                                       const Eigen::MatrixXd& M, bool identity);
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::connection

@@ -96,9 +96,9 @@ void add_loop_index(const std::string& spec, IndexPrescription& p) {
   insert_once(p.loop, parse_id(id, "boundary loop", where), parse_index(index, p.N, where), "boundary loop", where);
 }
 
-void read_singularities(const std::string& path, IndexPrescription& p) { detail::read_singularities_from(read_file_bytes(path), path, p); }
+void read_singularities(const std::string& path, IndexPrescription& p) { io::read_singularities_from(read_file_bytes(path), path, p); }
 
-namespace detail {
+namespace io {
 
 void read_singularities_from(const std::string& bytes, const std::string& path, IndexPrescription& p) {
   std::istringstream in(bytes);
@@ -137,7 +137,7 @@ void read_singularities_from(const std::string& bytes, const std::string& path, 
     throw Error(path + ": the header announces " + std::to_string(announced) + " singularities but the file lists " + std::to_string(seen));
 }
 
-}  // namespace detail
+}  // namespace io
 
 void validate_prescription(const Topology& t, int num_generators, const IndexPrescription& p) {
   if (p.N < 1) throw Error("the symmetry N must be at least 1 (got " + std::to_string(p.N) + ")");

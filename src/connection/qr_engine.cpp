@@ -10,13 +10,13 @@
 #include "linalg/timing.h"
 #include "trivcon/error.h"
 
-namespace trivcon::detail {
+namespace trivcon::connection {
 
 namespace {
 
 class QREngine : public SolverEngine {
  public:
-  mutable CholmodLongContext cc_;
+  mutable linalg::CholmodLongContext cc_;
   cholmod_common& cc() const { return *cc_; }
   SuiteSparseQR_factorization<double>* qr = nullptr;
   Eigen::VectorXd sqrt_w;
@@ -47,7 +47,7 @@ class QREngine : public SolverEngine {
     if (qr) SuiteSparseQR_free<double>(&qr, &cc());
   }
   void set_up(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w, SetupTimings& timings) {
-    auto t0 = Clock::now();
+    auto t0 = linalg::Clock::now();
     sqrt_w = w.cwiseSqrt();
     nD = static_cast<int>(Dt.cols()), nC = static_cast<int>(Ct.cols()), m = static_cast<int>(Dt.rows());
     Eigen::SparseMatrix<double, Eigen::ColMajor, SuiteSparse_long> At(m, nD + nC);  // (A W^½)ᵀ
@@ -60,16 +60,16 @@ class QREngine : public SolverEngine {
       At.setFromTriplets(trip.begin(), trip.end());
       At.makeCompressed();
     }
-    timings.assemble += seconds_since(t0);
-    t0 = Clock::now();
-    cholmod_sparse A = sparse_view(At);
+    timings.assemble += linalg::seconds_since(t0);
+    t0 = linalg::Clock::now();
+    cholmod_sparse A = linalg::sparse_view(At);
     qr = SuiteSparseQR_factorize<double>(SPQR_ORDERING_DEFAULT, SPQR_DEFAULT_TOL, &A, &cc());
     if (!qr || cc().status != CHOLMOD_OK) throw Error("SuiteSparseQR could not factor the constraint matrix");
     if (cc().SPQR_istat[4] < nD + nC)
       throw Error("the constraint matrix is rank deficient (rank " + std::to_string(cc().SPQR_istat[4]) + " of " + std::to_string(nD + nC) +
                   "); try --weights unit");
-    timings.factor += seconds_since(t0);
-    t0 = Clock::now();
+    timings.factor += linalg::seconds_since(t0);
+    t0 = linalg::Clock::now();
     responses.resize(m, nC);
     for (int c = 0; c < nC; ++c) {
       Eigen::VectorXd b = Eigen::VectorXd::Zero(nD + nC);
@@ -86,7 +86,7 @@ class QREngine : public SolverEngine {
       if (llt.info() != Eigen::Success) throw Error("the cycle rows of the constraint system are dependent; try --weights unit");
       P_lower = Eigen::MatrixXd(llt.matrixU()).reverse();
     }
-    timings.schur += seconds_since(t0);
+    timings.schur += linalg::seconds_since(t0);
   }
   Eigen::VectorXd min_norm_y(const Eigen::VectorXd& b) const {
     cholmod_dense* B = cholmod_l_allocate_dense(b.size(), 1, b.size(), CHOLMOD_REAL, &cc());
@@ -117,4 +117,4 @@ std::unique_ptr<SolverEngine> make_qr_engine(const SparseMatrix& Dt, const Spars
   return std::make_unique<QREngine>(Dt, Ct, w, timings);
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::connection

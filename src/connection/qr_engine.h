@@ -8,11 +8,11 @@
 #include "connection/solver_engine.h"
 #include "trivcon/solver.h"
 
-namespace trivcon::detail {
+namespace trivcon::connection {
 
 // Dt (m × nD) and Ct (m × nC): the transposed vertex and cycle rows over the system edges, w their weights.
 // Throws trivcon::Error when the system is rank deficient.
 std::unique_ptr<SolverEngine> make_qr_engine(const SparseMatrix& Dt, const SparseMatrix& Ct, const Eigen::VectorXd& w,
                                              SetupTimings& timings);
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::connection

@@ -29,30 +29,30 @@ constexpr int kMaxDensePaths = 256;
 // instead of 21).
 constexpr double kRefineAbove = 2.5e-10;
 constexpr int kMaxRefinements = 3;
-using detail::Clock;
-using detail::kParallelMinEditElements;
-using detail::seconds_since;
-using detail::SparseMatrix;
+using linalg::Clock;
+using linalg::kParallelMinEditElements;
+using linalg::seconds_since;
+using connection::SparseMatrix;
 using Triplet = Eigen::Triplet<double>;
 }  // namespace
 
-SolverAnalysis::SolverAnalysis(const Topology& t, const Cycles& cycles) : state_(std::make_unique<detail::AnalysisState>()) {
+SolverAnalysis::SolverAnalysis(const Topology& t, const Cycles& cycles) : state_(std::make_unique<connection::AnalysisState>()) {
   const auto t0 = Clock::now();
-  const detail::RowLayout layout = detail::row_layout(t);
+  const connection::RowLayout layout = connection::row_layout(t);
   std::vector<int> edges, column;
-  detail::system_edges(t, nullptr, edges, column);
+  connection::system_edges(t, nullptr, edges, column);
   std::vector<const DualCycle*> rows;
-  for (int l : detail::loop_rows(t, layout.dropped_loop)) rows.push_back(&cycles.loops[l]);
+  for (int l : connection::loop_rows(t, layout.dropped_loop)) rows.push_back(&cycles.loops[l]);
   for (const DualCycle& g : cycles.generators) rows.push_back(&g);
   const int m = static_cast<int>(edges.size());
   const SparseMatrix Ct =
-      detail::cycle_columns(m, column, static_cast<int>(rows.size()), [&](int r) -> const DualCycle& { return *rows[r]; });
-  detail::EdgeRows edge_rows;
-  detail::Csc M = detail::normal_matrix(detail::edge_ends(t, edges, layout.vertex_row), layout.num_vertex_rows, SparseMatrix(m, 0), Ct,
+      connection::cycle_columns(m, column, static_cast<int>(rows.size()), [&](int r) -> const DualCycle& { return *rows[r]; });
+  connection::EdgeRows edge_rows;
+  connection::Csc M = connection::normal_matrix(connection::edge_ends(t, edges, layout.vertex_row), layout.num_vertex_rows, SparseMatrix(m, 0), Ct,
                                         Eigen::VectorXd::Ones(m), edge_rows);
-  detail::AnalysisState& a = *state_;
+  connection::AnalysisState& a = *state_;
   a.nD = layout.num_vertex_rows, a.nC = static_cast<int>(rows.size());
-  detail::analyse(M, a.nD, a.nC, a);
+  connection::analyse(M, a.nD, a.nC, a);
   a.outer = std::move(M.outer), a.inner = std::move(M.inner);
   a.seconds = seconds_since(t0);
 }
@@ -70,7 +70,7 @@ struct ConnectionSolver::Impl {
   // Levi-Civita holonomy per loop / generator / fixed-face path.
   std::vector<double> loop_curvature, generator_holonomy, path_holonomy;
   SetupTimings timings;
-  std::unique_ptr<detail::SolverEngine> engine;
+  std::unique_ptr<connection::SolverEngine> engine;
   bool sparse_paths = false;
 
   // Rows of the reduced system: interior vertices (minus one per closed component), then the cycle
@@ -220,7 +220,7 @@ double ConnectionSolver::Impl::regularize_rigid_cycles() {
 // generator rows; the system edges.
 void ConnectionSolver::Impl::lay_out_rows(double epsilon) {
   const Topology& t = topology;
-  detail::RowLayout layout = detail::row_layout(t);
+  connection::RowLayout layout = connection::row_layout(t);
   vertex_row = std::move(layout.vertex_row), dropped_vertex = std::move(layout.dropped_vertex);
   dropped_loop = std::move(layout.dropped_loop), num_vertex_rows = layout.num_vertex_rows;
   // Cycle rows, fixed-face paths first: free indices are rounded in this order (see src/connection/generator_rounding.h),
@@ -232,10 +232,10 @@ void ConnectionSolver::Impl::lay_out_rows(double epsilon) {
   sparse_paths = options.solver == SolverKind::Cholesky && static_cast<int>(paths.size()) > kMaxDensePaths;
   if (!sparse_paths)
     for (int k = 0; k < static_cast<int>(paths.size()); ++k) rows.push_back({RowKind::Path, k});
-  for (int l : detail::loop_rows(t, dropped_loop)) rows.push_back({RowKind::Loop, l});
+  for (int l : connection::loop_rows(t, dropped_loop)) rows.push_back({RowKind::Loop, l});
   for (int g = 0; g < num_generators(); ++g) rows.push_back({RowKind::Generator, g});
   connect_isolated_vertices(epsilon);
-  detail::system_edges(t, options.solver == SolverKind::QR ? &weights : nullptr, active_edges, edge_column);
+  connection::system_edges(t, options.solver == SolverKind::QR ? &weights : nullptr, active_edges, edge_column);
 }
 
 // The factorization of the chosen route, and the stored forward substitution of the base right-hand side.
@@ -245,8 +245,8 @@ void ConnectionSolver::Impl::factor(const std::function<SolverAnalysis()>& analy
   const int m = static_cast<int>(active_edges.size());
   const int nC = static_cast<int>(rows.size());
   // The vertex rows of A as the rows of each edge's ends; the cycle and path rows as sparse columns.
-  const detail::EdgeEnds ends = detail::edge_ends(t, active_edges, vertex_row);
-  const SparseMatrix Ct = detail::cycle_columns(m, edge_column, nC, [&](int r) -> const DualCycle& { return cycle_of_row(r); });
+  const connection::EdgeEnds ends = connection::edge_ends(t, active_edges, vertex_row);
+  const SparseMatrix Ct = connection::cycle_columns(m, edge_column, nC, [&](int r) -> const DualCycle& { return cycle_of_row(r); });
   Eigen::VectorXd w(m);
   for (int a = 0; a < m; ++a) w(a) = weights(active_edges[a]);
   timings.assemble += seconds_since(t0);
@@ -257,19 +257,19 @@ void ConnectionSolver::Impl::factor(const std::function<SolverAnalysis()>& analy
       for (int end = 0; end < 2; ++end)
         if (ends[a][end] >= 0) trip.emplace_back(a, ends[a][end], end == 0 ? -1.0 : 1.0);
     Dt.setFromTriplets(trip.begin(), trip.end());
-    engine = detail::make_qr_engine(Dt, Ct, w, timings);
+    engine = connection::make_qr_engine(Dt, Ct, w, timings);
   } else if (!sparse_paths) {
     // A symbolic factorization made beforehand fits the system without fixed faces only.
-    std::function<std::unique_ptr<detail::AnalysisState>()> given;
+    std::function<std::unique_ptr<connection::AnalysisState>()> given;
     if (analysis && paths.empty()) given = [&analysis] { return std::move(analysis().state_); };
-    engine = detail::make_cholesky_engine(ends, num_vertex_rows, SparseMatrix(m, 0), Ct, w, options.factorization, timings, given);
+    engine = connection::make_cholesky_engine(ends, num_vertex_rows, SparseMatrix(m, 0), Ct, w, options.factorization, timings, given);
   } else {
     // The vertex and path rows together, ordered anew (CAMD). (Ordering the path rows first, or each
     // before the first of its vertices, with the vertex order of the system without them, made the
     // factorization 60–80 times slower on a cube's feature lines: 4,367 paths, many sharing edges.)
     const SparseMatrix Et =
-        detail::cycle_columns(m, edge_column, static_cast<int>(paths.size()), [&](int k) -> const DualCycle& { return paths[k].path; });
-    engine = detail::make_cholesky_engine(ends, num_vertex_rows, Et, Ct, w, options.factorization, timings);
+        connection::cycle_columns(m, edge_column, static_cast<int>(paths.size()), [&](int k) -> const DualCycle& { return paths[k].path; });
+    engine = connection::make_cholesky_engine(ends, num_vertex_rows, Et, Ct, w, options.factorization, timings);
   }
   t0 = Clock::now();
   Eigen::VectorXd base(num_vertex_rows);
@@ -479,7 +479,7 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
   Eigen::VectorXd b_C;
   Eigen::VectorXd x_active = s.engine->solve(b, [&](const Eigen::VectorXd& r0) {
     const Eigen::VectorXd u = (cycle.H - r0) / step;
-    n_C += cycle.M * detail::nearest_lattice_point(*s.engine, u, cycle.n0, cycle.M, cycle.identity).cast<double>();
+    n_C += cycle.M * connection::nearest_lattice_point(*s.engine, u, cycle.n0, cycle.M, cycle.identity).cast<double>();
     b_C = cycle.H - step * n_C;
     return b_C;
   });

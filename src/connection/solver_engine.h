@@ -9,7 +9,7 @@
 #include <functional>
 #include <string>
 
-namespace trivcon::detail {
+namespace trivcon::connection {
 
 class SolverEngine {
  public:
@@ -41,4 +41,4 @@ class SolverEngine {
   Eigen::VectorXd P_diagonal_;
 };
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::connection

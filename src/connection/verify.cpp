@@ -7,7 +7,7 @@
 
 namespace trivcon {
 
-using detail::kParallelMinEditElements;
+using linalg::kParallelMinEditElements;
 
 void verify_connection(const Topology& t, const Geometry& geometry, const Cycles& cycles, const IndexPrescription& prescription,
                        Connection& connection, const std::vector<double>* loop_curvatures,

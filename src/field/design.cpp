@@ -16,8 +16,8 @@
 
 namespace trivcon {
 
-using detail::Clock;
-using detail::seconds_since;
+using linalg::Clock;
+using linalg::seconds_since;
 
 FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptions options) : V_(V), options_(options) {
   const auto start = Clock::now();
@@ -53,7 +53,7 @@ FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptio
     });
   // With the analysis running, the geometry leaves it a core: on two cores, OpenMP's two threads and the
   // analysis would share them, and the analysis, the longer of the two, would finish later (dragon: 0.15 s).
-  const int threads = concurrent ? std::max(1, detail::max_threads() - 1) : 0;
+  const int threads = concurrent ? std::max(1, linalg::max_threads() - 1) : 0;
   timed(timings_.geometry, [&] { geometry_ = compute_geometry(V_, topology_, threads); });
   check_cancelled(cancel.get());
   if (!concurrent) timed(timings_.cycles, [&] { cycles_ = compute_cycles(topology_); });

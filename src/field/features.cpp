@@ -32,7 +32,7 @@ int corner_of(const Topology& t, int f, int e) {
   return -1;
 }
 
-using Lines = detail::TextLines;
+using Lines = io::TextLines;
 
 
 std::vector<std::string> split(const std::string& line, char separator) {
@@ -89,8 +89,8 @@ std::vector<int> read_feature_edges(const std::string& path, const Topology& t) 
     const std::vector<std::string> tokens = split(lines.line, ' ');
     if (tokens.size() != 2)
       throw Error(lines.where() + ": expected two vertex ids 'i j', got " + std::to_string(tokens.size()) + " fields");
-    const int i = static_cast<int>(detail::whole_number(tokens[0], lines, 0, t.num_vertices - 1, "vertex id"));
-    const int j = static_cast<int>(detail::whole_number(tokens[1], lines, 0, t.num_vertices - 1, "vertex id"));
+    const int i = static_cast<int>(io::whole_number(tokens[0], lines, 0, t.num_vertices - 1, "vertex id"));
+    const int j = static_cast<int>(io::whole_number(tokens[1], lines, 0, t.num_vertices - 1, "vertex id"));
     const std::string pair = "(" + std::to_string(i) + ", " + std::to_string(j) + ")";
     const int e = i == j ? -1 : edge_of(t, i, j);
     if (e < 0) throw Error(lines.where() + ": " + pair + " is not an edge of the mesh");
@@ -168,7 +168,7 @@ std::vector<SharpFaceEdge> read_sharp(const std::string& path, int num_faces) {
   if (!lines.next()) throw Error(path + ": empty .sharp file (expected the count on the first line)");
   const std::vector<std::string> head = split(lines.line, ' ');
   if (head.size() != 1) throw Error(lines.where() + ": expected the number of sharp face-edges alone on the first line");
-  const long long count = detail::whole_number(head[0], lines, 0, 3LL * num_faces, "the count");
+  const long long count = io::whole_number(head[0], lines, 0, 3LL * num_faces, "the count");
   std::vector<SharpFaceEdge> out;
   out.reserve(static_cast<size_t>(count));
   for (long long n = 0; n < count; ++n) {
@@ -177,9 +177,9 @@ std::vector<SharpFaceEdge> read_sharp(const std::string& path, int num_faces) {
     if (fields.size() != 3)
       throw Error(lines.where() + ": expected 'convexity,face,edge', got " + std::to_string(fields.size()) + " comma-separated fields");
     SharpFaceEdge r;
-    r.convex = static_cast<int>(detail::whole_number(fields[0], lines, 0, 1, "convexity"));
-    r.face = static_cast<int>(detail::whole_number(fields[1], lines, 0, num_faces - 1, "face"));
-    r.edge = static_cast<int>(detail::whole_number(fields[2], lines, 0, 2, "edge"));
+    r.convex = static_cast<int>(io::whole_number(fields[0], lines, 0, 1, "convexity"));
+    r.face = static_cast<int>(io::whole_number(fields[1], lines, 0, num_faces - 1, "face"));
+    r.edge = static_cast<int>(io::whole_number(fields[2], lines, 0, 2, "edge"));
     out.push_back(r);
   }
   if (lines.next()) throw Error(lines.where() + ": text after the " + std::to_string(count) + " lines the first line announced");

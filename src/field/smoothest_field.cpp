@@ -28,8 +28,8 @@ namespace trivcon {
 
 namespace {
 
-using detail::Clock;
-using detail::seconds_since;
+using linalg::Clock;
+using linalg::seconds_since;
 using Complex = std::complex<double>;
 
 double edge_length(const MatrixX3d& V, const Topology& t, int e) {
@@ -84,7 +84,7 @@ struct FactorDeleter {
 // (the sphere's factor: 1.90e7 entries for 1.39e7 nonzeros, 2.22e7 with the default); the factorization
 // itself did not get measurably slower.
 struct SymbolicFactor {
-  std::unique_ptr<detail::CholmodContext> context;
+  std::unique_ptr<linalg::CholmodContext> context;
   std::unique_ptr<cholmod_factor, FactorDeleter> factor{nullptr, FactorDeleter{nullptr}};
   std::string ordering;
 };
@@ -94,7 +94,7 @@ SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, c
   const int n = static_cast<int>(face_of.size());
   SymbolicFactor candidate[2];  // by AMD, by the dissection
   for (SymbolicFactor& s : candidate) {
-    s.context = std::make_unique<detail::CholmodContext>();
+    s.context = std::make_unique<linalg::CholmodContext>();
     cholmod_common* c = s.context->get();
     c->nmethods = 1;
     c->postorder = 1;
@@ -105,8 +105,8 @@ SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, c
   candidate[0].context->get()->method[0].ordering = CHOLMOD_AMD, candidate[0].ordering = "AMD";
   candidate[1].context->get()->method[0].ordering = CHOLMOD_GIVEN, candidate[1].ordering = "coordinate dissection";
   // The pattern alone (with the complex values the analyses copied them too: 0.04 s at 400k).
-  cholmod_sparse A = detail::upper_pattern_view(outer, inner, n);
-  const bool compare = n >= detail::kParallelMinElements && detail::max_threads() > 1;
+  cholmod_sparse A = linalg::upper_pattern_view(outer, inner, n);
+  const bool compare = n >= linalg::kParallelMinElements && linalg::max_threads() > 1;
   std::exception_ptr error;
 #pragma omp parallel num_threads(2) if (compare)
   {
@@ -118,7 +118,7 @@ SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, c
         for (int j = 0; j < n; ++j)
           for (int a = 0; a < 3; ++a)
             centroid[j][a] = (V(t.F(face_of[j], 0), a) + V(t.F(face_of[j], 1), a) + V(t.F(face_of[j], 2), a)) / 3;
-        std::vector<int> order = ordering::coordinate_dissection(ordering::leading_block_pattern(outer, inner, n), centroid);
+        std::vector<int> order = linalg::coordinate_dissection(linalg::leading_block_pattern(outer, inner, n), centroid);
         candidate[1].factor.reset(cholmod_analyze_p(&A, order.data(), nullptr, 0, candidate[1].context->get()));
       }
     } catch (...) {  // an exception must not leave an OpenMP region
@@ -127,7 +127,7 @@ SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, c
     }
   }
   if (error) std::rethrow_exception(error);
-  detail::require(candidate[0].factor != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix",
+  linalg::require(candidate[0].factor != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix",
                   candidate[0].context->common());
   const bool dissect = candidate[1].factor && candidate[1].context->common().fl < candidate[0].context->common().fl;
   return std::move(candidate[dissect ? 1 : 0]);
@@ -202,11 +202,11 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   // The numeric factor by trivcon's own supernodal code (src/linalg/supernodal.h, the same that factors the
   // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another,
   // and took 3-4 times as long on the 400k-face sphere (2.8-3.1 s against 0.73-1.06 s after METIS).
-  if (const int minor = supernodal::factorize_complex(*L, outer, inner, values, c); minor < n)
+  if (const int minor = linalg::factorize_complex(*L, outer, inner, values, c); minor < n)
     throw Error("automatic singularities: the smoothest-field matrix is not positive definite (column " + std::to_string(minor) +
                 " of " + std::to_string(n) + "): a non-finite or degenerate weight");
   // The solves below on both cores (src/linalg/substitution.h): CHOLMOD's own took 0.1 s each at 400k faces.
-  const supernodal::Substitution<Complex> substitution(*L);
+  const linalg::Substitution<Complex> substitution(*L);
   time.factor = seconds_since(t0);
 
   t0 = Clock::now();
@@ -293,7 +293,7 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
         const double lambda = norm[comp] > 0 ? energy[comp] / norm[comp] : 0.0;
         values[2 * (outer[j + 1] - 1)] = diag[f] + (eps - o.curvature_t * lambda) * k.mass[f];
       }
-      if (supernodal::factorize_complex(*L, outer, inner, values, c) < n)
+      if (linalg::factorize_complex(*L, outer, inner, values, c) < n)
         throw Error("automatic singularities: curvature alignment with t = " + std::to_string(o.curvature_t) +
                     " makes the system indefinite (t must be below 1, and a little below 1 can already exceed the smallest "
                     "eigenvalue's estimate): use a smaller t");

@@ -42,7 +42,7 @@ int edge_between(const Topology& t, int i, int j) {
 
 void put_double(std::ostream& out, double v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); }
 
-using detail::TextLines;
+using io::TextLines;
 
 std::vector<double> parse_numbers(const TextLines& lines, size_t expected) {
   std::istringstream fields(lines.line);
@@ -91,7 +91,7 @@ MatrixX3d read_field_ply(const std::string& bytes, const std::string& path, int 
       continue;
     }
     long long& count = counts[count_index++];
-    if (line.substr(0, hash) != want.substr(0, hash) || !detail::parse_integer(line.substr(hash), count) || count < 0)
+    if (line.substr(0, hash) != want.substr(0, hash) || !io::parse_integer(line.substr(hash), count) || count < 0)
       throw Error(not_ours);
   }
   const long long nv = counts[0], nf = counts[1];
@@ -130,10 +130,10 @@ int field_text_N(const std::string& bytes, const std::string& path) {
     pos = newline + 1;
     if (line.substr(0, 4) != "# N ") continue;
     line.remove_prefix(4);
-    while (!line.empty() && detail::is_space(line.back())) line.remove_suffix(1);
-    while (!line.empty() && detail::is_space(line.front())) line.remove_prefix(1);
+    while (!line.empty() && io::is_space(line.back())) line.remove_suffix(1);
+    while (!line.empty() && io::is_space(line.front())) line.remove_prefix(1);
     long long n;
-    if (!detail::parse_integer(line, n)) continue;
+    if (!io::parse_integer(line, n)) continue;
     if (n < 1 || n > kMaxFieldN)
       throw Error(path + ":" + std::to_string(line_no) + ": N " + std::to_string(n) + " out of range (1 to " + std::to_string(kMaxFieldN) +
                   ")");
@@ -196,10 +196,10 @@ void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F
 }
 
 MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file) {
-  return detail::read_field_from(read_file_bytes(path), path, num_faces, N_in_file);
+  return io::read_field_from(read_file_bytes(path), path, num_faces, N_in_file);
 }
 
-MatrixX3d detail::read_field_from(const std::string& bytes, const std::string& path, int num_faces, int* N_in_file) {
+MatrixX3d io::read_field_from(const std::string& bytes, const std::string& path, int num_faces, int* N_in_file) {
   if (N_in_file) *N_in_file = 0;
   if (ends_with(path, ".ply")) return read_field_ply(bytes, path, num_faces);
   MatrixX3d d(num_faces, 3);
@@ -318,7 +318,7 @@ std::vector<int> edges_by_vertices(const Topology& t) {
   return order;
 }
 
-using detail::whole_number;
+using io::whole_number;
 }  // namespace
 
 void write_matching(const std::string& path, const Topology& t, const Eigen::VectorXi& matching, int N) {

@@ -6,7 +6,7 @@
 
 #include "trivcon/error.h"
 
-namespace trivcon::detail {
+namespace trivcon::io {
 
 [[noreturn]] inline void fail(const std::string& name, const std::string& message) { throw Error(name + ": " + message); }
 
@@ -14,4 +14,4 @@ namespace trivcon::detail {
   throw Error(name + ":" + std::to_string(line) + ": " + message);
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::io

@@ -10,7 +10,7 @@
 
 #include "io/file_error.h"
 
-namespace trivcon::detail {
+namespace trivcon::io {
 
 std::string gunzip(const std::string& compressed, const std::string& path) {
   if (compressed.empty()) return {};
@@ -51,4 +51,4 @@ std::string gunzip(const std::string& compressed, const std::string& path) {
   return out;
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::io

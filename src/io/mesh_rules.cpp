@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace trivcon::detail {
+namespace trivcon::io {
 
 std::string out_of_range_message(long long index, long long vertex_count) {
   return "face index " + std::to_string(index) + " out of range (file has " + std::to_string(vertex_count) + " vertices)";
@@ -41,4 +41,4 @@ std::string polygon_problem(const std::vector<int>& corners, long long face) {
   return "face " + std::to_string(face) + " has a repeated vertex (" + list + ")";
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::io

@@ -13,7 +13,7 @@
 
 #include "trivcon/io.h"
 
-namespace trivcon::detail {
+namespace trivcon::io {
 
 inline constexpr long long kMaxCount = std::numeric_limits<int>::max();  // ids are int (MatrixX3i)
 
@@ -58,4 +58,4 @@ class FaceCollector {
   int polygon_count_ = 0;
 };
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::io

@@ -45,7 +45,7 @@ std::string read_file_bytes(const std::string& path) {
   }
   if (std::ferror(file)) throw Error("cannot read '" + path + "': " + std::strerror(errno));
   bytes.resize(used);
-  if (ends_with_ignoring_case(path, ".gz")) return detail::gunzip(bytes, path);
+  if (ends_with_ignoring_case(path, ".gz")) return io::gunzip(bytes, path);
   return bytes;
 }
 

@@ -12,7 +12,7 @@
 
 namespace trivcon {
 
-using namespace detail;
+using namespace io;
 
 MeshData read_obj(const std::string& buffer, const std::string& name) {
   if (buffer.empty()) fail(name, "empty file");

@@ -16,7 +16,7 @@
 
 namespace trivcon {
 
-using namespace detail;
+using namespace io;
 
 namespace {
 
@@ -199,7 +199,7 @@ class PlyBinarySource {
     const std::size_t item = ply_type_size(property.type);
     const std::size_t left = size_ - pos_;
     if (static_cast<unsigned long long>(count) > left / item) {
-      detail::fail(name_, "truncated binary data at byte " + std::to_string(pos_ + left / item * item) + " (" + element_->name + " " +
+      io::fail(name_, "truncated binary data at byte " + std::to_string(pos_ + left / item * item) + " (" + element_->name + " " +
                               std::to_string(index_) + " of " + std::to_string(element_->count) + "; its '" + property.name +
                               "' list claims " + std::to_string(count) + " items of " + std::to_string(item) + " bytes, but only " +
                               std::to_string(left) + " bytes follow the count)");
@@ -211,7 +211,7 @@ class PlyBinarySource {
     pos_ += static_cast<std::size_t>(count) * ply_type_size(property.type);
   }
 
-  [[noreturn]] void fail(const std::string& message) const { detail::fail(name_, message + " (at byte " + std::to_string(start_) + ")"); }
+  [[noreturn]] void fail(const std::string& message) const { io::fail(name_, message + " (at byte " + std::to_string(start_) + ")"); }
   std::string where() const { return element_->name + " " + std::to_string(index_); }
 
  private:
@@ -250,7 +250,7 @@ class PlyBinarySource {
   }
 
   [[noreturn]] void truncated() const {
-    detail::fail(name_, "truncated binary data at byte " + std::to_string(pos_) + " (" + element_->name + " " + std::to_string(index_) +
+    io::fail(name_, "truncated binary data at byte " + std::to_string(pos_) + " (" + element_->name + " " + std::to_string(index_) +
                             " of " + std::to_string(element_->count) + ")");
   }
 

@@ -12,7 +12,7 @@
 #include "trivcon/indices.h"
 #include "trivcon/topology.h"
 
-namespace trivcon::detail {
+namespace trivcon::io {
 
 void read_singularities_from(const std::string& bytes, const std::string& path, IndexPrescription& prescription);
 
@@ -21,4 +21,4 @@ void read_fixed_directions_from(const std::string& bytes, const std::string& pat
 
 MatrixX3d read_field_from(const std::string& bytes, const std::string& path, int num_faces, int* N_in_file);
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::io

@@ -8,7 +8,7 @@
 
 #include "trivcon/error.h"
 
-namespace trivcon::detail {
+namespace trivcon::io {
 
 // Lines of a text file with their 1-based numbers, comments ('#') and blank lines skipped, '\r' dropped.
 struct TextLines {
@@ -40,4 +40,4 @@ inline long long whole_number(const std::string& token, const TextLines& lines, 
   return v;
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::io

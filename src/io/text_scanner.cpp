@@ -8,7 +8,7 @@
 #include <limits>
 #include <system_error>
 
-namespace trivcon::detail {
+namespace trivcon::io {
 
 std::string quoted(std::string_view text) {
   constexpr std::size_t kMaxShown = 40;
@@ -66,4 +66,4 @@ bool parse_integer(std::string_view token, long long& value) {
   return end == last && error == std::errc();
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::io

@@ -17,7 +17,7 @@
 
 #include "io/file_error.h"
 
-namespace trivcon::detail {
+namespace trivcon::io {
 
 // Quotes a token for a message; binary garbage is escaped and long tokens are cut.
 std::string quoted(std::string_view text);
@@ -138,4 +138,4 @@ class TextScanner {
   std::string joined_;           // storage for a line joined from backslash continuations
 };
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::io

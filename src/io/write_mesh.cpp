@@ -18,9 +18,9 @@
 namespace trivcon {
 namespace {
 
-using detail::kMaxCount;
-using detail::non_finite_message;
-using detail::polygon_problem;
+using io::kMaxCount;
+using io::non_finite_message;
+using io::polygon_problem;
 
 // Refuses what the readers would reject, so that everything written reads back identically.
 void check_writable(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {

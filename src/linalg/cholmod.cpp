@@ -10,7 +10,7 @@
 // Fortran BLAS, as CHOLMOD and src/linalg/supernodal.cpp call it: 32-bit integers (LP64) assumed, checked below.
 extern "C" int idamax_(const int* n, const double* x, const int* incx);
 
-namespace trivcon::detail {
+namespace trivcon::linalg {
 
 void require(bool ok, const std::string& what, const cholmod_common& c) {
   if (!ok) throw Error(what + " (CHOLMOD status " + std::to_string(c.status) + ")");
@@ -100,4 +100,4 @@ void check_numeric_libraries() {
   if (!problem.empty()) throw Error(problem);
 }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::linalg

@@ -23,7 +23,7 @@
 // s, x as int / double arrays, cholmod_change_factor to allocate values) was written and tested against.
 static_assert(CHOLMOD_MAIN_VERSION == 3, "trivcon's numeric factorization was written for CHOLMOD 3 (SuiteSparse 5)");
 
-namespace trivcon::detail {
+namespace trivcon::linalg {
 
 // Throws trivcon::Error naming `what` and CHOLMOD's status unless `ok`.
 void require(bool ok, const std::string& what, const cholmod_common& c);
@@ -86,4 +86,4 @@ cholmod_dense dense_view_complex(const Eigen::VectorXd& b);
 // See the top of this file. Cheap after the first call (the result is remembered).
 void check_numeric_libraries();
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::linalg

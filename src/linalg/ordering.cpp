@@ -4,7 +4,7 @@
 #include <functional>
 #include <numeric>
 
-namespace trivcon::ordering {
+namespace trivcon::linalg {
 
 Pattern leading_block_pattern(const std::vector<int>& outer, const std::vector<int>& inner, int n) {
   Pattern p;
@@ -100,4 +100,4 @@ std::vector<int> coordinate_dissection(const Pattern& pattern, const std::vector
   return order;
 }
 
-}  // namespace trivcon::ordering
+}  // namespace trivcon::linalg

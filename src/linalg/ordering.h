@@ -7,7 +7,7 @@
 #include <array>
 #include <vector>
 
-namespace trivcon::ordering {
+namespace trivcon::linalg {
 
 // The symmetric sparsity pattern of the leading n × n block of a matrix given as its upper triangle in
 // compressed columns (outer, inner): per row, its off-diagonal neighbours.
@@ -32,4 +32,4 @@ std::vector<int> elimination_tree(const Pattern& pattern, const std::vector<int>
 // compare, not a replacement (trivcon/auto.h takes the one with fewer flops). Deterministic.
 std::vector<int> coordinate_dissection(const Pattern& pattern, const std::vector<std::array<double, 3>>& point, int leaf = 16);
 
-}  // namespace trivcon::ordering
+}  // namespace trivcon::linalg

@@ -8,7 +8,7 @@
 
 #include <algorithm>
 
-namespace trivcon::detail {
+namespace trivcon::linalg {
 
 // Meshes with more faces (or edges, for per-edge loops) than this run their per-element loops and
 // independent passes on several threads.
@@ -23,4 +23,4 @@ inline int max_threads() { return std::max(1, omp_get_max_threads()); }
 // Threads for a region with at most `tasks` independent tasks (e.g. 2 passes, or 2 subtrees).
 inline int threads_for(int tasks) { return std::max(1, std::min(tasks, max_threads())); }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::linalg

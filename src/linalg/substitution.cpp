@@ -7,7 +7,7 @@
 #include "linalg/parallel.h"
 #include "trivcon/error.h"
 
-namespace trivcon::supernodal {
+namespace trivcon::linalg {
 
 template <class T>
 Substitution<T>::Substitution(const cholmod_factor& L) : L_(L) {
@@ -22,7 +22,7 @@ Substitution<T>::Substitution(const cholmod_factor& L) : L_(L) {
   // Balanced by the entries each supernode holds: a solve reads each once.
   std::vector<double> entries(S.count);
   for (int s = 0; s < S.count; ++s) entries[s] = static_cast<double>(S.height(s)) * S.cols(s);
-  TreeSplit split = split_tree(supernode_parents(S, owner), entries, 1e4, detail::max_threads(), true);
+  TreeSplit split = split_tree(supernode_parents(S, owner), entries, 1e4, linalg::max_threads(), true);
   top_ = std::move(split.top), part_ = std::move(split.part);
   top_slot_.assign(n_, -1);
   for (int s : top_)
@@ -177,4 +177,4 @@ void Substitution<T>::backward_in_factor_order(T* z) const {
 template class Substitution<double>;
 template class Substitution<std::complex<double>>;
 
-}  // namespace trivcon::supernodal
+}  // namespace trivcon::linalg

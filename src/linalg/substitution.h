@@ -26,10 +26,10 @@
 
 #include "linalg/supernodal.h"
 
-namespace trivcon::supernodal {
+namespace trivcon::linalg {
 
 // T is double for a real (LLᵀ) factor, std::complex<double> for a complex (LLᴴ) one; the factor must be
-// supernodal and numeric with that type (supernodal::factorize / factorize_complex). The plan (tree split,
+// supernodal and numeric with that type (linalg::factorize / factorize_complex). The plan (tree split,
 // permutation) is made once; the factor's values are read at each solve, so a refactorization with the same
 // symbolic factor (the curvature alignment of trivcon/auto.h) needs no new plan.
 template <class T>
@@ -61,4 +61,4 @@ class Substitution {
 extern template class Substitution<double>;
 extern template class Substitution<std::complex<double>>;
 
-}  // namespace trivcon::supernodal
+}  // namespace trivcon::linalg

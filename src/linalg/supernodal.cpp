@@ -38,7 +38,7 @@ void ztrsm_(const char* side, const char* uplo, const char* transa, const char* 
 void zpotrf_(const char* uplo, const int* n, std::complex<double>* a, const int* lda, int* info);
 }
 
-namespace trivcon::supernodal {
+namespace trivcon::linalg {
 
 namespace {
 
@@ -372,7 +372,7 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
     const double ncol = S.cols(s), nrow = S.height(s);
     work[s] = ncol * nrow * nrow + 64 * nrow;
   }
-  const TreeSplit split = split_tree(supernode_parents(S, owner), work, 1e5, detail::max_threads());
+  const TreeSplit split = split_tree(supernode_parents(S, owner), work, 1e5, linalg::max_threads());
   const int parts = static_cast<int>(split.part.size());
   Numeric<T> numeric(S, owner, static_cast<T*>(L.x), A);
   // Below the top, one thread per part (OpenMP's thread count): a subtree needs only its own descendants. Each thread keeps its own
@@ -438,4 +438,4 @@ int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const st
   return factorize_as<Complex>(L, outer, inner, reinterpret_cast<const Complex*>(values.data()), c);
 }
 
-}  // namespace trivcon::supernodal
+}  // namespace trivcon::linalg

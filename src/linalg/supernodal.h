@@ -16,7 +16,7 @@
 #include <array>
 #include <vector>
 
-namespace trivcon::supernodal {
+namespace trivcon::linalg {
 
 // The supernodal elimination tree of a factor, split for `parts` threads: `top` (the supernodes above
 // the split, done one at a time) and `parts` sets of whole subtrees below it that do not depend on each
@@ -73,4 +73,4 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
 int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
                       cholmod_common& c);
 
-}  // namespace trivcon::supernodal
+}  // namespace trivcon::linalg

@@ -2,10 +2,10 @@
 #pragma once
 #include <chrono>
 
-namespace trivcon::detail {
+namespace trivcon::linalg {
 
 using Clock = std::chrono::steady_clock;
 
 inline double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-}  // namespace trivcon::detail
+}  // namespace trivcon::linalg

@@ -12,7 +12,7 @@ namespace {
 constexpr double kDegenerateArea = 1e-14;  // relative to the longest edge squared
 constexpr double kMollifyFactor = 1e-5;    // δ of the mollification, relative to the component's mean edge length
 constexpr double kMollifyReach = 1e3;      // faces with a margin below this many δ take the mollified cotangents
-using detail::kParallelMinElements;
+using linalg::kParallelMinElements;
 
 // Cotangents of the three corner angles of a triangle with edge lengths l[k] (edge k: corner k → k+1,
 // opposite corner k+2), all positive and satisfying the triangle inequality strictly: cot at corner j is
@@ -84,7 +84,7 @@ Eigen::Vector3d Geometry::direction_in_face(int f, double beta) const {
 
 Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   const int nF = t.num_faces, nE = t.num_edges, nV = t.num_vertices;
-  const int team = threads > 0 ? threads : detail::max_threads();
+  const int team = threads > 0 ? threads : linalg::max_threads();
   Geometry g;
   g.corner_angles.resize(nF, 3);
   g.half_edge_angle.resize(nF, 3);

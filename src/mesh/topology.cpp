@@ -17,8 +17,8 @@
 namespace trivcon {
 namespace {
 
-using detail::kParallelMinElements;
-using detail::threads_for;
+using linalg::kParallelMinElements;
+using linalg::threads_for;
 
 // Union-find with path halving; used for face fans around vertices.
 struct DisjointSets {
