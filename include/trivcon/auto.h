@@ -137,8 +137,6 @@ std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& 
 // The summing over coincident vertices above on its own.
 std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topology& topology, const std::map<int, int>& vertex);
 
-// Mean length of the mesh's edges (the unit of AutoOptions::cancel_distance).
-double mean_edge_length(const MatrixX3d& V, const Topology& topology);
 
 // The roots (face, angle) that turn each component's field to agree best with `guide`, an N-field (e.g. the
 // smoothest field AutoResult::field that --auto read its singularities from: the trivial connection then

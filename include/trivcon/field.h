@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "trivcon/angles.h"  // reduce_angle, declared here before
 #include "trivcon/cycles.h"
 #include "trivcon/geometry.h"
 #include "trivcon/topology.h"
@@ -69,7 +70,5 @@ FieldIndices indices_from_jumps(const Topology& topology, const Geometry& geomet
 // exactly the one the connection x transports.
 double max_transport_mismatch(const Topology& topology, const Geometry& geometry, const Eigen::VectorXd& x, const Field& field);
 
-// Reduces an angle into (−π/N, π/N] modulo 2π/N.
-double reduce_angle(double a, int N);
 
 }  // namespace trivcon

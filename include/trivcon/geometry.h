@@ -36,6 +36,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "trivcon/angles.h"  // wrap_angle, declared here before
 #include "trivcon/topology.h"
 
 namespace trivcon {
@@ -73,7 +74,9 @@ struct Geometry {
 // more than 50k faces.
 Geometry compute_geometry(const MatrixX3d& V, const Topology& topology, int threads = 0);
 
-// Wraps an angle into (−π, π].
-double wrap_angle(double a);
+// Mean Euclidean length of the mesh's edges (0 without edges): the unit of --auto-cancel, of the renderer's
+// glyph size, and of anything else measured "in mean edge lengths".
+double mean_edge_length(const MatrixX3d& V, const Topology& topology);
+
 
 }  // namespace trivcon

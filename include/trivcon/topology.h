@@ -66,6 +66,9 @@ struct Topology {
   int euler_characteristic() const;
 };
 
+// The edge joining vertices i and j (either order), or −1 (also for ids out of range): one scan of i's edges.
+int edge_between(const Topology& topology, int i, int j);
+
 // Builds connectivity in O(V + F) (expected) and validates; throws trivcon::Error on the first
 // problem found. `num_vertices` is V (vertex ids must be in [0, V)).
 Topology build_topology(const MatrixX3i& F, int num_vertices);

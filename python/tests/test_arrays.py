@@ -139,9 +139,13 @@ def test_huge_indices_have_one_short_message(ball, value):
 
 def test_largest_index_and_other_huge_numbers(ball):
     V, F, d = ball
-    # The largest index that fits passes the parser (and fails Gauss-Bonnet, as it must).
-    for value in (536870911, "536870911", 536870911.0, Fraction(536870911)):
+    # The largest index that fits (|index| N at most 1e9) passes the checks of size (and fails Gauss-Bonnet,
+    # as it must); one quarter turn more is too large, whatever its form.
+    for value in (250000000, "250000000", 250000000.0, Fraction(250000000)):
         with pytest.raises(trivcon.Error, match="Gauss-Bonnet"):
+            d.solve(N=4, singularities={3: value})
+    for value in (Fraction(1000000001, 4), "1000000001/4", 536870911):
+        with pytest.raises(trivcon.Error, match="too large"):
             d.solve(N=4, singularities={3: value})
     with pytest.raises(trivcon.Error, match=r"^singularities: id 1e\+30 out of range$"):
         d.solve(N=4, singularities={10**30: 1})

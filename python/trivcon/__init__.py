@@ -115,6 +115,20 @@ def _frozen(a):
     return a
 
 
+class _Cached:
+    """The values an object hands out, computed once per key and kept in self._cache (arrays made read-only)."""
+
+    def _get(self, key, compute):
+        if key not in self._cache:
+            value = compute()
+            if isinstance(value, _np.ndarray):
+                value = _frozen(value)
+            elif isinstance(value, tuple):
+                value = tuple(_frozen(a) if isinstance(a, _np.ndarray) else a for a in value)
+            self._cache[key] = value
+        return self._cache[key]
+
+
 def _array(value, name):
     try:
         return _np.asarray(value)
@@ -578,7 +592,7 @@ def blas_kernels():
 # The designer
 
 
-class FieldDesigner:
+class FieldDesigner(_Cached):
     """A mesh prepared for fields: validated, its geometry and cycles computed, the system factored once.
 
     FieldDesigner(V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0, threads=None)
@@ -642,13 +656,6 @@ class FieldDesigner:
         self.weights, self.weight_floor = state["weights"], state["weight_floor"]
         self.solver, self.factorization = state["solver"], state["factorization"]
         self._cache = {}
-
-    def _get(self, key, compute):
-        """The read-only array (or tuple of them) computed once for `key`."""
-        if key not in self._cache:
-            value = compute()
-            self._cache[key] = tuple(_frozen(a) for a in value) if isinstance(value, tuple) else _frozen(value)
-        return self._cache[key]
 
     @property
     def threads(self):
@@ -908,7 +915,7 @@ def _all_directions(designer, angles, N):
     return _np.cos(a)[:, :, None] * X[:, None, :] + _np.sin(a)[:, :, None] * Y[:, None, :]
 
 
-class Result:
+class Result(_Cached):
     """One solve of a FieldDesigner: the field, its connection, what was used and how well it holds.
 
     Arrays (computed once, read-only):
@@ -960,17 +967,6 @@ class Result:
         if "parent_face" in state:  # after split_large_turns
             self.parent_face = _frozen(_np.array(state["parent_face"], dtype=_np.int64))
             self.split_rounds, self.split_converged = state["split_rounds"], state["split_converged"]
-
-    def _get(self, key, compute):
-        """The value computed once for `key` (arrays made read-only)."""
-        if key not in self._cache:
-            value = compute()
-            if isinstance(value, _np.ndarray):
-                value = _frozen(value)
-            elif isinstance(value, tuple):
-                value = tuple(_frozen(a) if isinstance(a, _np.ndarray) else a for a in value)
-            self._cache[key] = value
-        return self._cache[key]
 
     def _exactness(self):
         """'field exact', or what is not and what to do about it."""
@@ -1183,7 +1179,7 @@ class Result:
         return self._r.render(_singular_pairs(singularities, self.N), args)
 
 
-class AutoResult:
+class AutoResult(_Cached):
     """Singularities found automatically (FieldDesigner.auto_singularities).
 
       singularities  {vertex: Fraction} to prescribe (after cancellation); singularity_arrays the same as
@@ -1211,12 +1207,6 @@ class AutoResult:
         self._designer = state["designer"]
         self._a = _core.AutoResult.restore(self._designer._d, state["core"])
         self._cache = {}
-
-    def _get(self, key, compute):
-        if key not in self._cache:
-            value = compute()
-            self._cache[key] = tuple(_frozen(a) for a in value) if isinstance(value, tuple) else _frozen(value)
-        return self._cache[key]
 
     def __repr__(self):
         return (f"<trivcon.AutoResult: N {self.N}, found {len(self.found)} singularities, cancelled {len(self.pairs)} pairs, "

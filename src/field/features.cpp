@@ -16,15 +16,6 @@ namespace trivcon {
 
 namespace {
 
-// The edge joining vertices i and j (either order), or −1.
-int edge_of(const Topology& t, int i, int j) {
-  for (int a = t.vertex_edge_offsets[i]; a < t.vertex_edge_offsets[i + 1]; ++a) {
-    const int e = t.vertex_edges[a];
-    if (t.edge_vertices(e, 0) == std::min(i, j) && t.edge_vertices(e, 1) == std::max(i, j)) return e;
-  }
-  return -1;
-}
-
 // Corner k of face f such that the face's half-edge k → k+1 is edge e (in the oriented Topology::F).
 int corner_of(const Topology& t, int f, int e) {
   for (int k = 0; k < 3; ++k)
@@ -92,7 +83,7 @@ std::vector<int> read_feature_edges(const std::string& path, const Topology& t) 
     const int i = static_cast<int>(io::whole_number(tokens[0], lines, 0, t.num_vertices - 1, "vertex id"));
     const int j = static_cast<int>(io::whole_number(tokens[1], lines, 0, t.num_vertices - 1, "vertex id"));
     const std::string pair = "(" + std::to_string(i) + ", " + std::to_string(j) + ")";
-    const int e = i == j ? -1 : edge_of(t, i, j);
+    const int e = i == j ? -1 : edge_between(t, i, j);
     if (e < 0) throw Error(lines.where() + ": " + pair + " is not an edge of the mesh");
     if (t.is_boundary_edge(e))
       throw Error(lines.where() + ": " + pair + " is a boundary edge; features are interior edges (use --align-boundary for the boundary)");

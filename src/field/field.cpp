@@ -8,21 +8,8 @@ namespace trivcon {
 
 namespace {
 constexpr int kParallelFaces = 100000;  // propagate_field's per-face loops run on all cores (OpenMP) above this
-// Into [0, 2π), through wrap_angle's (−π, π].
-double wrap_positive(double a) {
-  a = wrap_angle(a);
-  if (a < 0) a += 2 * kPi;
-  return a < 2 * kPi ? a : 0.0;  // a tiny negative angle plus 2π can round to 2π
-}
 }  // namespace
 
-double reduce_angle(double a, int N) {
-  const double period = 2 * kPi / N;
-  a -= period * std::round(a / period);
-  if (a <= -period / 2) a += period;
-  if (a > period / 2) a -= period;
-  return a;
-}
 
 PropagationPlan plan_propagation(const Topology& t) {
   PropagationPlan plan;
@@ -92,7 +79,7 @@ Field propagate_field(const Topology& t, const Geometry& g, const PropagationPla
   for (int c = 0; c < nC; ++c) {
     const int begin = plan.component_begin[c], end = plan.component_begin[c + 1];
 #pragma omp parallel for schedule(static) if (end - begin > kParallelFaces)
-    for (int q = begin; q < end; ++q) field.angle(plan.order[q]) = wrap_positive(along[q] + shift[c]);
+    for (int q = begin; q < end; ++q) field.angle(plan.order[q]) = wrap_two_pi(along[q] + shift[c]);
   }
   return field;
 }
@@ -117,7 +104,7 @@ Field field_from_directions(const Geometry& g, const MatrixX3d& directions, int 
     if (!d.allFinite()) throw Error("the direction of face " + std::to_string(f) + " is not finite");
     const double along = std::hypot(d.dot(g.frame_x.row(f)), d.dot(g.frame_y.row(f)));
     if (!(along > 1e-12 * d.norm())) throw Error("the direction of face " + std::to_string(f) + " has no component in the face's plane");
-    field.angle(f) = wrap_positive(g.angle_in_face(f, d));
+    field.angle(f) = wrap_two_pi(g.angle_in_face(f, d));
   }
   return field;
 }

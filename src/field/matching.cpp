@@ -8,8 +8,6 @@
 namespace trivcon {
 
 namespace {
-// a in (−π, π].
-double wrap_pi(double a) { return wrap_angle(a); }
 int modulo(long long a, int N) { return static_cast<int>(((a % N) + N) % N); }
 // The whole number of 2π/N steps nearest to `angle`, modulo N.
 int steps_of(double angle, int N) { return modulo(std::llround(angle * N / (2 * kPi)), N); }
@@ -45,7 +43,7 @@ FieldIndices indices_with_matching(const Topology& t, const Geometry& g, const C
   Eigen::VectorXd d = Eigen::VectorXd::Zero(t.num_edges);
   for (int e = 0; e < t.num_edges; ++e) {
     if (t.is_boundary_edge(e)) continue;
-    d(e) = wrap_pi(field.angle(t.edge_faces(e, 1)) + 2 * kPi * modulo(matching(e), N) / N - field.angle(t.edge_faces(e, 0)) - g.rho(e));
+    d(e) = wrap_angle(field.angle(t.edge_faces(e, 1)) + 2 * kPi * modulo(matching(e), N) / N - field.angle(t.edge_faces(e, 0)) - g.rho(e));
   }
   return indices_from_jumps(t, g, cycles, d, N);
 }

@@ -318,13 +318,6 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
 
 }  // namespace
 
-double mean_edge_length(const MatrixX3d& V, const Topology& t) {
-  if (t.num_edges == 0) return 0;
-  double sum = 0;
-  for (int e = 0; e < t.num_edges; ++e) sum += edge_length(V, t, e);
-  return sum / t.num_edges;
-}
-
 std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
                                             std::vector<std::pair<int, int>>* pairs) {
   if (!(distance >= 0) || !std::isfinite(distance))
@@ -529,9 +522,7 @@ void turn_toward(const FieldDesigner& designer, Field& field, const Field& guide
   std::vector<double> turn(t.components.size(), 0.0);
   for (auto [f, angle] : roots_toward(designer, field, guide, {}, fixed)) turn[t.face_component[f]] = angle - field.angle(f);
   for (int f = 0; f < t.num_faces; ++f) {
-    const double a = field.angle(f) + turn[t.face_component[f]];
-    field.angle(f) = a - kTwoPi * std::floor(a / kTwoPi);
-    if (field.angle(f) >= kTwoPi) field.angle(f) = 0;
+    field.angle(f) = wrap_two_pi(field.angle(f) + turn[t.face_component[f]]);
   }
 }
 

@@ -30,16 +30,6 @@ Eigen::Vector3d direction_k(const Geometry& g, const Field& field, int f, int k)
   return g.direction_in_face(f, field.angle(f) + 2 * kPi * k / field.N);
 }
 
-// The edge joining vertices i and j (either order), or −1: one scan of i's edges.
-int edge_between(const Topology& t, int i, int j) {
-  if (i < 0 || i >= t.num_vertices) return -1;
-  for (int a = t.vertex_edge_offsets[i]; a < t.vertex_edge_offsets[i + 1]; ++a) {
-    const int e = t.vertex_edges[a];
-    if (t.edge_vertices(e, 0) == std::min(i, j) && t.edge_vertices(e, 1) == std::max(i, j)) return e;
-  }
-  return -1;
-}
-
 void put_double(std::ostream& out, double v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); }
 
 using io::TextLines;

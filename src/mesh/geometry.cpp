@@ -68,13 +68,6 @@ Eigen::Vector3d corner_angles_of(const Eigen::Vector3d p[3]) {
 }
 }  // namespace
 
-double wrap_angle(double a) {
-  if (a > -kPi && a <= kPi) return a;                      // the usual case, exact
-  a -= 2 * kPi * std::floor((a + kPi) * (1 / (2 * kPi)));  // floor, not fmod: several times faster
-  if (a <= -kPi) a += 2 * kPi;
-  if (a > kPi) a -= 2 * kPi;
-  return a;
-}
 
 double Geometry::angle_in_face(int f, const Eigen::Vector3d& d) const { return std::atan2(d.dot(frame_y.row(f)), d.dot(frame_x.row(f))); }
 
@@ -243,6 +236,13 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
   }
   g.negative_cotan_edges = negative_cotan_edges, g.clamped_cotangents = clamped_cotangents, g.zero_weight_edges = zero_weight_edges;
   return g;
+}
+
+double mean_edge_length(const MatrixX3d& V, const Topology& t) {
+  if (t.num_edges == 0) return 0;
+  double sum = 0;
+  for (int e = 0; e < t.num_edges; ++e) sum += (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).norm();
+  return sum / t.num_edges;
 }
 
 }  // namespace trivcon

@@ -355,4 +355,13 @@ Topology build_topology(const MatrixX3i& F_in, int num_vertices) {
   return t;
 }
 
+int edge_between(const Topology& t, int i, int j) {
+  if (i < 0 || i >= t.num_vertices || j < 0 || j >= t.num_vertices) return -1;
+  for (int a = t.vertex_edge_offsets[i]; a < t.vertex_edge_offsets[i + 1]; ++a) {
+    const int e = t.vertex_edges[a];
+    if (t.edge_vertices(e, 0) == std::min(i, j) && t.edge_vertices(e, 1) == std::max(i, j)) return e;
+  }
+  return -1;
+}
+
 }  // namespace trivcon

@@ -80,12 +80,6 @@ std::vector<int> used_vertices(const Topology& t) {
   return used;
 }
 
-double mean_edge_length(const MatrixX3d& V, const Topology& t) {
-  double sum = 0;
-  for (int e = 0; e < t.num_edges; ++e) sum += (vertex(V, t.edge_vertices(e, 0)) - vertex(V, t.edge_vertices(e, 1))).norm();
-  return t.num_edges > 0 ? sum / t.num_edges : 0.0;
-}
-
 // Centre of the bounding box of the used vertices.
 Vector3d bounding_box_centre(const MatrixX3d& V, const std::vector<int>& used) {
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
