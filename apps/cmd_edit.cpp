@@ -27,6 +27,7 @@ struct EditOptions {
   PrescriptionOptions prescription;
   std::vector<std::string> fixes;
   bool align_boundary = false;
+  std::optional<double> feature_degrees;  // --align-features
   std::string host = "127.0.0.1";
   int port = 8642;
   CLI::Option* port_option = nullptr;
@@ -63,6 +64,7 @@ void run_edit(const EditOptions& o) {
   options.host = o.host;
   options.initial = o.prescription.build();
   options.align_boundary = o.align_boundary;
+  options.feature_degrees = o.feature_degrees;
   auto designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F);
   add_fix_options(o.fixes, designer->topology(), designer->geometry(), options.initial.fixed);
   const int faces = designer->topology().num_faces, vertices = designer->topology().num_vertices;
@@ -131,6 +133,9 @@ void register_edit(CLI::App& app) {
                   "Fixed direction at start: F:x,y,z (world, projected to the face), F:angle=A (radians, face frame), or a file with "
                   "'FACE x y z' / 'FACE angle=A' lines; repeatable");
   cmd->add_flag("--align-boundary", o.align_boundary, "Start with every boundary face fixed to its boundary edge's direction");
+  cmd->add_option("--align-features", o.feature_degrees,
+                  "Start with the faces beside every sharp edge (dihedral angle above DEG degrees) fixed to its direction")
+      ->check(CLI::Range(0.0, 180.0));
   o.port_option = cmd->add_option("--port", o.port, "Port to listen on (default 8642, or the next free one; 0: any free port)")
                       ->check(CLI::Range(0, 65535));
   cmd->add_option("--host", o.host,

@@ -32,6 +32,7 @@
 #include "report.h"
 #include "summary.h"
 #include "trivcon/auto.h"
+#include "trivcon/request.h"
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/error.h"
@@ -496,11 +497,9 @@ struct EditorServer::Impl {
 
   // One solve request, parsed.
   struct Request {
-    IndexPrescription prescription;
-    bool align_boundary = false;
-    std::map<int, double> explicit_fixed;  // from "fixed" (they win over align_boundary on the same face)
-    std::vector<int> fixed_faces;          // sorted: every face of prescription.fixed
-    double auto_cancel = 0;                // /api/auto's "cancel"
+    FieldRequest field;              // as asked (trivcon/request.h); field.prescription.fixed: the explicit directions of "fixed"
+    IndexPrescription prescription;  // with every fixed face: the alignments' and the explicit ones (RequestConstraints::fixed)
+    std::vector<int> fixed_faces;    // sorted: every face of prescription.fixed
   };
   // The smoothest field of the last /api/auto: later solves of its N take their rotation from it.
   std::mutex auto_guide_mutex;
@@ -510,9 +509,9 @@ struct EditorServer::Impl {
     token = options.token.empty() ? random_token() : options.token;
     designer = d ? std::move(d) : std::make_unique<FieldDesigner>(mesh.V, mesh.F);
     Request initial;
-    initial.prescription = options.initial;
-    initial.align_boundary = options.align_boundary;
-    initial.explicit_fixed = options.initial.fixed;
+    initial.field.prescription = options.initial;
+    initial.field.align_boundary = options.align_boundary;
+    initial.field.feature_degrees = options.feature_degrees;
     complete_fixed(initial);
     // Not validated here: a session may well start unbalanced (a bare sphere); the page says what is missing.
     designer->set_fixed_faces(initial.fixed_faces);  // factor now: the first edit should be as fast as the others
@@ -523,13 +522,12 @@ struct EditorServer::Impl {
 
   int num_generators() const { return static_cast<int>(designer->cycles().generators.size()); }
 
-  // Adds align_boundary's faces under the explicit ones, and lists the fixed faces.
+  // The complete prescription: the alignments' fixed faces under the explicit ones (trivcon/request.h).
   void complete_fixed(Request& r) const {
-    r.prescription.fixed.clear();
-    if (r.align_boundary) r.prescription.fixed = boundary_alignment(designer->V(), designer->topology(), designer->geometry());
-    for (auto [f, angle] : r.explicit_fixed) r.prescription.fixed[f] = angle;
-    r.fixed_faces.clear();
-    for (auto [f, angle] : r.prescription.fixed) r.fixed_faces.push_back(f);
+    RequestConstraints c = request_constraints(*designer, r.field);
+    r.prescription = r.field.prescription;
+    r.prescription.fixed = std::move(c.fixed);
+    r.fixed_faces = std::move(c.fixed_faces);
   }
 
   // The request in the API's own shape, ids and index texts normalized (GET /api/state, session files).
@@ -539,12 +537,13 @@ struct EditorServer::Impl {
     for (auto [v, n] : p.vertex) sing.push_back({v, format_index(n, p.N)});
     for (auto [g, n] : p.generator) gens.push_back({g, format_index(n, p.N)});
     for (auto [l, n] : p.loop) loops.push_back({l, format_index(n, p.N)});
-    for (auto [f, angle] : r.explicit_fixed) {
+    for (auto [f, angle] : r.field.prescription.fixed) {
       const Eigen::Vector3d d = designer->geometry().direction_in_face(f, angle);
       fixed.push_back({f, {d.x(), d.y(), d.z()}});
     }
     return {{"N", p.N},          {"singularities", sing}, {"generators", gens},
-            {"boundary", loops}, {"fixed", fixed},        {"align_boundary", r.align_boundary}};
+            {"boundary", loops}, {"fixed", fixed},        {"align_boundary", r.field.align_boundary},
+            {"align_features", r.field.feature_degrees ? ojson(*r.field.feature_degrees) : ojson(nullptr)}};
   }
 
   Request parse_request(const std::string& body_text) const {
@@ -568,7 +567,7 @@ struct EditorServer::Impl {
     }
     if (!body.is_object()) throw BadRequest{400, "the request body must be a JSON object, got " + std::string(body.type_name())};
     Request r;
-    IndexPrescription& p = r.prescription;
+    IndexPrescription& p = r.field.prescription;
     p.N = options.initial.N;
     if (body.contains("N")) {
       const json& N = body["N"];
@@ -607,22 +606,36 @@ struct EditorServer::Impl {
         } else {
           throw BadRequest{400, where + ": expected a direction [x, y, z] or {\"angle\": A}, got " + brief(e[1])};
         }
-        add_fixed_direction(spec, designer->topology(), designer->geometry(), r.explicit_fixed);
+        add_fixed_direction(spec, designer->topology(), designer->geometry(), p.fixed);
       }
     } catch (const Error& e) {
       throw BadRequest{400, e.what()};
     }
     if (body.contains("align_boundary")) {
       if (!body["align_boundary"].is_boolean()) throw BadRequest{400, "align_boundary: expected true or false"};
-      r.align_boundary = body["align_boundary"].get<bool>();
+      r.field.align_boundary = body["align_boundary"].get<bool>();
+    }
+    if (body.contains("align_features")) {  // the sharp edges' dihedral angle in degrees, or null for none
+      const json& a = body["align_features"];
+      if (a.is_null()) {
+        r.field.feature_degrees.reset();
+      } else {
+        if (!a.is_number() || !(a.get<double>() >= 0 && a.get<double>() <= 180))
+          throw BadRequest{400, "align_features: expected an angle in degrees in [0, 180] (sharp edges) or null, got " + brief(a)};
+        r.field.feature_degrees = a.get<double>();
+      }
     }
     if (body.contains("cancel")) {
       const json& c = body["cancel"];
       if (!c.is_number() || !std::isfinite(c.get<double>()) || c.get<double>() < 0)
         throw BadRequest{400, "cancel: expected a number >= 0 (mean edge lengths), got " + brief(c)};
-      r.auto_cancel = c.get<double>();
+      r.field.auto_options.cancel_distance = c.get<double>();
     }
-    complete_fixed(r);
+    try {
+      complete_fixed(r);
+    } catch (const Error& e) {
+      throw BadRequest{400, e.what()};
+    }
     return r;
   }
 
@@ -659,13 +672,14 @@ struct EditorServer::Impl {
     Solved s;
     try {
       with_designer(r.fixed_faces, [&](const FieldDesigner& d) {
-        Design design = d.design(r.prescription);
-        {  // after Auto: the field takes each component's rotation from the smoothest field (trivcon/auto.h)
+        std::optional<Field> guide;  // after Auto: the field takes each component's rotation from the smoothest field
+        {
           std::lock_guard guide_lock(auto_guide_mutex);
-          if (auto_guide && auto_guide->N == r.prescription.N) turn_toward(d, design.field, *auto_guide, r.prescription.fixed);
+          guide = auto_guide;
         }
+        const Design design = request_design(d, r.prescription, {}, guide ? &*guide : nullptr);
         const bool ok = design_verified(design);
-        const cli::ReportRun run{options.mesh_path, "", "cotan", "cholesky", r.align_boundary, options.read_seconds, 0, ok};
+        const cli::ReportRun run{options.mesh_path, "", "cotan", "cholesky", r.field.align_boundary, options.read_seconds, 0, ok};
         s.report = cli::solve_report(run, mesh, d, r.prescription, design);
         s.field = design.field;
         return 0;
@@ -1122,20 +1136,17 @@ struct EditorServer::Impl {
               }));
     http.Post("/api/auto", api_post([this](const httplib::Request&, const std::string& body, httplib::Response& res) {
                 const Request r = parse_request(body);
-                AutoOptions ao;
-                ao.N = r.prescription.N;
-                ao.cancel_distance = r.auto_cancel;
-                ao.fixed = r.prescription.fixed;
+                const int N = r.prescription.N;
                 std::shared_lock lock(designer_mutex);  // auto_singularities reads the designer; no refactoring meanwhile
-                const AutoResult a = auto_singularities(*designer, ao);
+                const AutoResult a = request_auto(*designer, r.field, RequestConstraints{r.prescription.fixed, r.fixed_faces, {}, {}, 0, 0});
                 lock.unlock();
                 {
                   std::lock_guard guide_lock(auto_guide_mutex);
                   auto_guide = a.field;
                 }
                 ojson sing = ojson::array();
-                for (auto [v, n] : a.vertex) sing.push_back({v, format_index(n, ao.N)});
-                ojson out = {{"N", ao.N}, {"singularities", sing}, {"found", a.found.size()}, {"cancelled_pairs", a.pairs.size()}};
+                for (auto [v, n] : a.vertex) sing.push_back({v, format_index(n, N)});
+                ojson out = {{"N", N}, {"singularities", sing}, {"found", a.found.size()}, {"cancelled_pairs", a.pairs.size()}};
                 res.set_content(out.dump() + "\n", kJson);
               }));
     http.Post("/api/export", api_post([this](const httplib::Request& req, const std::string& body, httplib::Response& res) {

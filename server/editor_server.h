@@ -16,6 +16,7 @@
 #pragma once
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "trivcon/design.h"
@@ -32,6 +33,7 @@ struct EditorOptions {
   double read_seconds = 0;            // reading the mesh (the report's seconds.read)
   IndexPrescription initial;          // the session the page starts with (-N, -s, --sing, --fix angles)
   bool align_boundary = false;        // --align-boundary at start
+  std::optional<double> feature_degrees;  // --align-features DEG at start
   // Connections: each is served on a thread of its own, up to max_connections at once (more wait for one to
   // end). A request's line and headers must arrive within header_seconds of its first byte, its body within
   // body_seconds after them; a read or write that makes no progress for io_idle_seconds fails; an idle

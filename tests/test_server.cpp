@@ -25,6 +25,7 @@
 #include "editor_server.h"
 #include "support.h"
 #include "trivcon/auto.h"
+#include "trivcon/request.h"
 #include "trivcon/field.h"
 #include "trivcon/generate.h"
 #include "trivcon/geometry.h"
@@ -1035,6 +1036,52 @@ TEST(ServerField, AfterAutoTheFieldKeepsTheSmoothestFieldsRotation) {
   ASSERT_EQ(after->status, 200) << after->body;
   EXPECT_LT(mean_difference(after), 0.03);
   EXPECT_TRUE(json::parse(after->body)["report"]["verified"].get<bool>());
+}
+
+// Feature alignment through the API, as the CLI's --align-features and Python's align_features (one request
+// layer, trivcon/request.h): on the flat-faced cube, Auto with align_features puts +1/4 at the 8 corners, and
+// the solve fixes the faces beside the 12 n cube edges along them, the same directions as solve_request gives;
+// the state remembers the angle; a bad angle is a 400.
+TEST(ServerField, FeatureAlignmentAsTheCliHasIt) {
+  const int n = 4;
+  const Mesh m = make_cube_sphere(n, false);
+  Running cube(m);
+  auto placed = cube.post("/api/auto", {{"N", 4}, {"align_features", 30}});
+  ASSERT_TRUE(placed);
+  ASSERT_EQ(placed->status, 200) << placed->body;
+  const json sing = json::parse(placed->body)["singularities"];
+  ASSERT_EQ(sing.size(), 8u);
+  for (const json& s : sing) {
+    EXPECT_EQ(s[1], "1/4");
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(std::abs(m.V(s[0].get<int>(), k)), 1.0);
+  }
+  auto r = cube.post("/api/solve", {{"N", 4}, {"singularities", sing}, {"align_features", 30}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json j = json::parse(r->body);
+  EXPECT_TRUE(j["report"]["verified"].get<bool>());
+  FieldDesigner designer(m.V, m.F);
+  FieldRequest q;
+  q.prescription.N = 4;
+  for (const json& s : sing) q.prescription.vertex[s[0].get<int>()] = 1;
+  q.feature_degrees = 30;
+  const FieldOutcome out = solve_request(designer, m.F, q);
+  EXPECT_EQ(out.sharp_edges.size(), static_cast<size_t>(12 * n));
+  EXPECT_EQ(j["report"]["fixed"]["faces"].get<int>(), static_cast<int>(out.prescription.fixed.size()));
+  const json d = j["directions"];
+  double worst = 0;
+  for (int f = 0; f < m.F.rows(); ++f) {
+    const Eigen::Vector3d v(d[3 * f].get<double>(), d[3 * f + 1].get<double>(), d[3 * f + 2].get<double>());
+    worst = std::max(worst, std::abs(reduce_angle(designer.geometry().angle_in_face(f, v) - out.design.field.angle(f), 4)));
+  }
+  EXPECT_LT(worst, 1e-6);
+  const json state = json::parse(cube.client->Get("/api/state")->body);
+  EXPECT_EQ(state["request"]["align_features"], 30);
+  auto bad = cube.post("/api/solve", {{"N", 4}, {"singularities", sing}, {"align_features", 200}});
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("align_features: expected an angle in degrees in [0, 180] (sharp edges) or null, got 200"), std::string::npos)
+      << bad->body;
 }
 
 }  // namespace

@@ -151,6 +151,8 @@ std::vector<std::pair<int, double>> roots_toward(const FieldDesigner& designer, 
 // The same rotation applied to `field` in place (each component's angles + θ, wrapped to [0, 2π)), without
 // designing again: what an interactive front end does after every edit (a rotation by a constant per
 // component changes none of the design's checks). Components with a fixed face keep their rotation.
-void turn_toward(const FieldDesigner& designer, Field& field, const Field& guide, const std::map<int, double>& fixed = {});
+// Components with a root in `roots` keep theirs too.
+void turn_toward(const FieldDesigner& designer, Field& field, const Field& guide, const std::map<int, double>& fixed = {},
+                 const std::vector<std::pair<int, double>>& roots = {});
 
 }  // namespace trivcon

@@ -91,6 +91,7 @@ class FieldDesigner {
   const ConnectionSolver& solver() const;                // set up on first use
   const PrepareTimings& timings() const { return timings_; }
   const SolverOptions& solver_options() const { return options_; }
+  const std::vector<int>& fixed_faces() const { return fixed_faces_; }  // what set_fixed_faces was last given
 
  private:
   MatrixX3d V_;

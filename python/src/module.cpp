@@ -23,12 +23,15 @@
 // setting of its own thread (omp_set_num_threads is per calling thread), and with one thread, OpenBLAS
 // single-threaded while it runs (trivcon::SingleThreadedBlas: OpenBLAS has one setting per process).
 #include <Python.h>
+#include <unistd.h>
 #include <dlfcn.h>
 #include <omp.h>
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -56,6 +59,8 @@
 #include "trivcon/split_large_turns.h"
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
+#include "trivcon/request.h"
+#include "trivcon/features.h"
 #include "trivcon/error.h"
 #include "trivcon/field.h"
 #include "trivcon/field_io.h"
@@ -170,7 +175,22 @@ std::invoke_result_t<Task&> interruptible(int threads, Task task) {
   }
   const bool poll = PyThread_get_thread_ident() == main_thread_ident;
   {
-    py::gil_scoped_release release;
+    // The GIL is taken back in the normal flow, not in a destructor: a daemon thread that comes back while the
+    // interpreter is finalizing must not try (3.11 ends the thread inside PyEval_RestoreThread, and unwinding
+    // through a noexcept destructor terminates the process); it sleeps until the process ends instead.
+    struct Release {
+      PyThreadState* state = PyEval_SaveThread();
+      void restore() {
+        if (!state) return;
+        if (_Py_IsFinalizing() && !poll_thread)
+          for (;;) pause();
+        PyEval_RestoreThread(state);
+        state = nullptr;
+      }
+      bool poll_thread = false;
+      ~Release() { restore(); }
+    } release;
+    release.poll_thread = poll;
     std::unique_lock<std::mutex> lock(job->mutex);
     while (!job->finished.wait_for(lock, std::chrono::milliseconds(20), [&] { return job->done; })) {
       if (!poll) continue;
@@ -187,6 +207,8 @@ std::invoke_result_t<Task&> interruptible(int threads, Task task) {
       }
       lock.lock();
     }
+    lock.unlock();
+    release.restore();
   }
   if (job->error) std::rethrow_exception(job->error);
   return std::move(*job->value);
@@ -903,90 +925,76 @@ PYBIND11_MODULE(_core, m) {
           "check_fixed_face", [](const DesignerState& s, int face) { check_face(s.topology(), face, "fixed face"); }, py::arg("face"))
       .def("boundary_alignment", [](const DesignerState& s) { return boundary_alignment(s.V, s.topology(), s.geometry()); })
       .def(
-          "design",
-          [](const DesignerPtr& s, int N, std::map<int, int> vertex, std::map<int, int> generator, std::map<int, int> loop,
-             std::map<int, double> fixed, std::vector<std::pair<int, double>> roots, std::optional<Eigen::VectorXd> guide) {
-            auto r = std::make_shared<DesignResult>();
-            r->state = s;
-            r->prescription.N = N;
-            r->prescription.vertex = std::move(vertex);
-            r->prescription.generator = std::move(generator);
-            r->prescription.loop = std::move(loop);
-            r->prescription.fixed = std::move(fixed);
-            return interruptible(s->threads, [r, roots = std::move(roots), guide = std::move(guide)]() mutable {
-              DesignerState& state = *r->state;
-              std::lock_guard<std::mutex> lock(state.mutex);
-              check_cancelled();  // abandoned while it waited for the designer
-              for (const auto& [f, angle] : r->prescription.fixed) check_face(state.topology(), f, "fixed face");
-              state.use_fixed_faces(r->prescription.fixed);
-              if (guide) {  // singularities="auto": each component's rotation from the smoothest field (trivcon/auto.h)
-                const Field g{r->prescription.N, *guide};
-                roots = roots_toward(*state.designer, state.designer->design(r->prescription, roots).field, g, roots, r->prescription.fixed);
-              }
-              r->design = state.designer->design(r->prescription, roots);
-              r->verified = design_verified(r->design);
-              return r;
-            });
-          },
-          py::arg("N"), py::arg("vertex"), py::arg("generator"), py::arg("loop"), py::arg("fixed"), py::arg("roots"),
-          py::arg("guide") = py::none(),
-          "A Design of the prescription (n = index·N per id; fixed: face -> angle); with `guide` (per-face angles of an N-field), "
-          "components without a root or fixed face take their rotation from it (roots_toward).")
-      .def(
-          "split_large_turns",
-          [](const DesignerPtr& s, int N, std::map<int, int> vertex, std::map<int, double> fixed, bool align_boundary, int max_rounds,
-             const std::string& weights, const std::string& solver, const std::string& factorization, double weight_floor) {
-            const SolverOptions options = solver_options(weights, solver, factorization, weight_floor);
-            struct Refined {
+          "solve_request",
+          [](const DesignerPtr& s, int N, std::optional<std::map<int, int>> vertex, std::map<int, int> generator, std::map<int, int> loop,
+             std::map<int, double> fixed, bool align_boundary, std::optional<double> feature_degrees,
+             std::vector<std::pair<int, int>> feature_edges, std::vector<std::pair<int, double>> roots, double auto_cancel, bool auto_cancel_absolute, int auto_iterations,
+             std::optional<double> curvature_t, bool split, int max_rounds) {
+            // The library's request layer (trivcon/request.h) does the work; here only the conversion.
+            FieldRequest q;
+            q.prescription.N = N;
+            if (vertex) q.prescription.vertex = std::move(*vertex);
+            q.prescription.generator = std::move(generator);
+            q.prescription.loop = std::move(loop);
+            q.prescription.fixed = std::move(fixed);
+            q.align_boundary = align_boundary;
+            q.feature_degrees = feature_degrees;
+            for (size_t k = 0; k < feature_edges.size(); ++k) {  // vertex pairs, as a --features file names them
+              const auto [i, j] = feature_edges[k];
+              const int e = edge_between(s->topology(), i, j);
+              if (e < 0)
+                throw Error("feature_edges[" + std::to_string(k) + "]: (" + std::to_string(i) + ", " + std::to_string(j) +
+                            ") is not an edge of the mesh");
+              q.feature_edges.push_back(e);
+            }
+            q.roots = std::move(roots);
+            q.auto_place = !vertex.has_value();
+            q.auto_options.cancel_distance = auto_cancel;
+            q.auto_options.cancel_absolute = auto_cancel_absolute;
+            q.auto_options.iterations = auto_iterations;
+            if (curvature_t) q.auto_options.align_curvature = true, q.auto_options.curvature_t = *curvature_t;
+            q.split_large_turns = split;
+            q.max_split_rounds = max_rounds;
+            struct Out {
               DesignerPtr designer;
               DesignResultPtr result;
+              AutoOutPtr auto_out;
               std::vector<int> parent;
               std::vector<RefineRound> rounds;
-              bool converged = false;
+              bool converged = true;
+              std::vector<int> sharp;
             };
-            Refined out = interruptible(s->threads, [s, N, vertex = std::move(vertex), fixed = std::move(fixed), align_boundary, max_rounds,
-                                                     options] {
-              Refined o;
-              auto r = std::make_shared<DesignResult>();
-              r->prescription.N = N;
-              r->prescription.vertex = vertex;
-              r->prescription.fixed = fixed;
+            Out out = interruptible(s->threads, [s, q = std::move(q)] {
+              Out o;
               std::lock_guard<std::mutex> lock(s->mutex);
               check_cancelled();  // abandoned while it waited for the designer
-              for (const auto& [f, angle] : fixed) check_face(s->topology(), f, "fixed face");
-              if (align_boundary)
-                for (auto [f, angle] : boundary_alignment(s->V, s->topology(), s->geometry())) r->prescription.fixed.emplace(f, angle);
-              s->use_fixed_faces(r->prescription.fixed);
-              // Each refined mesh: the boundary aligned again, the given fixed faces' directions (world
-              // vectors) on their children (they win, as on the input mesh).
-              std::map<int, Eigen::Vector3d> world;
-              for (auto [f, angle] : fixed) world[f] = s->geometry().direction_in_face(f, angle);
-              auto constraints = [&](const FieldDesigner& d, const std::vector<int>& parent_face) {
-                std::map<int, double> c;
-                if (align_boundary) c = boundary_alignment(d.V(), d.topology(), d.geometry());
-                for (int f = 0; f < static_cast<int>(parent_face.size()); ++f) {
-                  const auto it = world.find(parent_face[f]);
-                  if (it != world.end()) c[f] = d.geometry().angle_in_face(f, it->second);
-                }
-                return c;
-              };
-              RefinedDesign d = split_large_turns(*s->designer, s->F, r->prescription, options, constraints, max_rounds);
-              o.rounds = d.rounds, o.parent = d.parent_face, o.converged = d.converged;
+              FieldOutcome r = solve_request(*s->designer, s->F, q);
+              s->fixed_faces = s->designer->fixed_faces();
               o.designer = s;
-              if (d.designer) {
+              if (r.refined) {
                 auto refined = std::make_shared<DesignerState>();
                 refined->threads = s->threads;
-                refined->V = d.V, refined->F = d.F;
-                refined->designer = std::move(d.designer);
-                for (const auto& [f, angle] : d.prescription.fixed) refined->fixed_faces.push_back(f);
+                refined->V = std::move(r.V), refined->F = std::move(r.F);
+                refined->designer = std::move(r.refined);
+                refined->fixed_faces = refined->designer->fixed_faces();
                 refined->sort_edges();
                 o.designer = refined;
               }
-              r->state = o.designer;
-              r->prescription = d.prescription;
-              r->design = std::move(d.design);
-              r->verified = design_verified(r->design);
-              o.result = r;
+              if (r.auto_result) {
+                o.auto_out = std::make_shared<AutoOut>();
+                o.auto_out->state = s;
+                o.auto_out->result = std::move(*r.auto_result);
+              }
+              auto d = std::make_shared<DesignResult>();
+              d->state = o.designer;
+              d->prescription = std::move(r.prescription);
+              d->design = std::move(r.design);
+              d->verified = r.verified;
+              o.result = d;
+              o.parent = std::move(r.parent_face);
+              o.rounds = std::move(r.rounds);
+              o.converged = r.split_converged;
+              o.sharp = std::move(r.sharp_edges);
               return o;
             });
             py::list round_list;
@@ -995,12 +1003,29 @@ PYBIND11_MODULE(_core, m) {
               d["split_edges"] = k.split_edges, d["vertices"] = k.vertices, d["faces"] = k.faces, d["reweighted"] = k.reweighted;
               round_list.append(d);
             }
-            return py::make_tuple(out.designer, out.result, int64_vector(out.parent), round_list, out.converged);
+            py::object auto_out = out.auto_out ? py::cast(out.auto_out) : py::none();
+            const Topology& t = out.designer->topology();
+            Int64Array sharp({static_cast<py::ssize_t>(out.sharp.size()), static_cast<py::ssize_t>(2)});
+            auto S = sharp.mutable_unchecked<2>();
+            for (size_t k = 0; k < out.sharp.size(); ++k) S(k, 0) = t.edge_vertices(out.sharp[k], 0), S(k, 1) = t.edge_vertices(out.sharp[k], 1);
+            return py::make_tuple(out.designer, out.result, auto_out, int64_vector(out.parent), round_list, out.converged, sharp);
           },
-          py::arg("N"), py::arg("vertex"), py::arg("fixed"), py::arg("align_boundary"), py::arg("max_rounds"), py::arg("weights"),
-          py::arg("solver"), py::arg("factorization"), py::arg("weight_floor"),
-          "Design, refined until no edge turns by pi/N or more (trivcon/split_large_turns.h): (designer of the final mesh, DesignResult, "
-          "parent face of each face, rounds, converged).")
+          py::arg("N"), py::arg("vertex"), py::arg("generator"), py::arg("loop"), py::arg("fixed"), py::arg("align_boundary"),
+          py::arg("feature_degrees"), py::arg("feature_edges"), py::arg("roots"), py::arg("auto_cancel"), py::arg("auto_cancel_absolute"),
+          py::arg("auto_iterations"), py::arg("curvature_t"), py::arg("split"), py::arg("max_rounds"),
+          "One field request (trivcon/request.h; vertex None: the smoothest field's singularities): (designer of the final mesh, "
+          "DesignResult, AutoResult or None, parent face of each face (with split), rounds, converged, sharp edges).")
+      .def(
+          "sharp_edges",
+          [](const DesignerPtr& s, double degrees) {
+            const Topology& t = s->topology();
+            const std::vector<int> edges = sharp_edges(s->V, t, s->geometry(), degrees);
+            Int64Array out({static_cast<py::ssize_t>(edges.size()), static_cast<py::ssize_t>(2)});
+            auto o = out.mutable_unchecked<2>();
+            for (size_t k = 0; k < edges.size(); ++k) o(k, 0) = t.edge_vertices(edges[k], 0), o(k, 1) = t.edge_vertices(edges[k], 1);
+            return out;
+          },
+          py::arg("degrees"), "(n, 2) vertex pairs (i < j) of the interior edges sharper than `degrees` (trivcon/features.h).")
       .def(
           "auto_singularities",
           [](const DesignerPtr& s, int N, int iterations, double cancel, bool cancel_absolute, std::map<int, double> fixed,

@@ -2,6 +2,7 @@
 
 import json
 import os
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -166,3 +167,37 @@ def test_indices_of_the_programs_field(cli, tmp_path):
     report = json.loads(cli("check", path, field, "--json").stdout)
     assert {s["vertex"]: s["index"] for s in report["singularities"]} == {v: str(i) for v, i in found.items()}
     assert reference.Mesh(V, d.F).field_indices(directions, 4) == found == a.singularities
+
+
+def test_feature_alignment_agrees_with_the_program(cli, tmp_path):
+    """align_features is the CLI's --align-features (one request layer): on the flat-faced cube, --auto with the
+    sharp edges puts +1/4 at the 8 corners, every face beside a cube edge runs along it, and the module's field,
+    connection and singularities are the program's; feature_edges (vertex pairs) is the --features file."""
+    n = 5
+    V, F = trivcon.make_cube_sphere(n, spherical=False)
+    path = str(tmp_path / "cube.obj")
+    trivcon.write_mesh(path, V, F)
+    d = trivcon.FieldDesigner(V, F)
+    r = d.solve(N=4, singularities="auto", align_features=30)
+    assert r.verified and r.field_exact
+    assert r.sharp_edges.shape == (12 * n, 2)
+    corners = {v for v in range(len(V)) if (np.abs(V[v]) == 1).all()}
+    assert r.singularities == {v: Fraction(1, 4) for v in corners}
+    # Every face beside a sharp edge: its cross has an arm along the edge.
+    for i, j in r.sharp_edges:
+        e = V[j] - V[i]
+        for f in np.nonzero(((F == i) | (F == j)).sum(axis=1) == 2)[0]:
+            dirs = r.all_directions()[f]
+            assert np.max(np.abs(dirs @ e)) / np.linalg.norm(e) > 1 - 1e-9
+    agree(cli, tmp_path, path, 4, ["--auto", "--align-features", "30"], r)
+    # The same edges given as a list: the same field (the prescription as found above).
+    edges_file = tmp_path / "cube.features"
+    edges_file.write_text("".join(f"{i} {j}\n" for i, j in r.sharp_edges))
+    r.write_singularities(str(tmp_path / "auto.sing"))
+    listed = d.solve(N=4, singularities=r.singularities, feature_edges=r.sharp_edges)
+    assert np.abs(listed.directions - r.directions).max() < 1e-9  # fixed faces on the cube decide its rotation
+    agree(cli, tmp_path, path, 4, ["-s", str(tmp_path / "auto.sing"), "--features", str(edges_file)], listed)
+    with pytest.raises(trivcon.Error, match=r"^feature_edges\[0\]: \(0, 1000\) is not an edge of the mesh$"):
+        d.solve(N=4, singularities=r.singularities, feature_edges=[[0, 1000]])
+    with pytest.raises(trivcon.Error, match=r"^align_features: expected None or an angle in degrees in \[0, 180\], got 200$"):
+        d.solve(N=4, singularities="auto", align_features=200)

@@ -785,8 +785,9 @@ class FieldDesigner(_Cached):
         out.update(explicit)
         return out
 
-    def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False, roots=None,
-              auto_cancel=0.0, align_curvature=None, split_large_turns=False, max_rounds=8):
+    def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False,
+              align_features=None, feature_edges=None, roots=None, auto_cancel=0.0, align_curvature=None,
+              split_large_turns=False, max_rounds=8):
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
@@ -797,12 +798,16 @@ class FieldDesigner(_Cached):
           every closed component the indices must sum to chi (Gauss-Bonnet). Boundary vertices cannot
           be singular. Or "auto": those of the globally smoothest field (auto_singularities, with
           auto_cancel as its cancel distance, align_curvature as its curvature guidance and the same fixed
-          faces), then the exact solve.
+          faces), then the exact solve; each component takes its rotation from that smoothest field.
         generators, boundary: {id: index} (or the same other forms) for generators and boundary loops (ids
           as num_generators and boundary_loops); those not given are chosen to make the field smoothest.
         fixed: {face: direction}, an angle in radians in the face's frame or a world vector (x, y, z)
           (projected onto the face): the field holds it exactly, modulo 2 pi / N.
         align_boundary: fix every face with a boundary edge to that edge's direction (fixed= wins).
+        align_features: None, or an angle in degrees: fix the faces beside every interior edge whose
+          dihedral angle exceeds it to that edge's direction (as solve --align-features DEG; over
+          align_boundary, under fixed=); feature_edges: (n, 2) vertex pairs of more such edges (as a
+          --features file). Result.sharp_edges lists the edges followed.
         roots: {face: angle}: where the field's propagation starts per component (default: each
           component's smallest face, angle 0; a component with fixed faces starts at its smallest one).
 
@@ -813,55 +818,66 @@ class FieldDesigner(_Cached):
           of it (input vertices keep their ids, new ones appended; a split face keeps its id for its
           first child), Result.parent_face the input face of each face, Result.split_rounds one dict per
           round (split_edges, vertices, faces), Result.split_converged whether no large turn is left. The
-          boundary is aligned again on every refined mesh; fixed faces pass their direction to their
-          children. Not with generators or boundary indices (the refined mesh has cycles of its own), nor
-          with roots.
+          boundary and the sharp edges are aligned again on every refined mesh; fixed faces pass their
+          direction to their children. Not with generators or boundary indices (the refined mesh has cycles
+          of its own), nor with roots or feature_edges.
 
+        The request means the same as the CLI's and the editor's (the library's trivcon/request.h does it).
         Errors in the prescription raise trivcon.Error with the library's message. The result is
         verified (residuals, transport, indices read back): see Result.verified and Result.field_exact.
         """
         N = _symmetry(N)
-        fixed_angles = self._fixed(fixed, align_boundary)
-        auto = None
+        explicit = self._fixed(fixed, False)
+        curvature_t = None
         if isinstance(singularities, str) and singularities == "auto":
-            auto = self.auto_singularities(N=N, cancel=auto_cancel, fixed=fixed, align_boundary=align_boundary,
-                                           align_curvature=align_curvature)
-            vertex = dict(auto._a.vertex)
+            vertex = None
+            cancel, curvature_t = _auto_arguments(auto_cancel, align_curvature)
         else:
             if auto_cancel:
                 raise Error("auto_cancel needs singularities='auto'")
             if align_curvature is not None:
                 raise Error("align_curvature needs singularities='auto'")
             vertex = _indices(singularities, N, "singularities")
+            cancel = 0.0
         root_list = []
         for key, angle in _items(roots, "roots"):
             face = _id(key, "roots")
             if isinstance(angle, bool) or not isinstance(angle, _numbers.Real):
                 raise Error(f"roots[{face}]: the angle must be a number, got {angle!r}")
             root_list.append((face, float(angle)))
+        degrees = None
+        if align_features is not None:
+            if isinstance(align_features, bool) or not isinstance(align_features, _numbers.Real) or not (0 <= align_features <= 180):
+                raise Error(f"align_features: expected None or an angle in degrees in [0, 180], got {align_features!r}")
+            degrees = float(align_features)
+        edge_pairs = []
+        if feature_edges is not None:
+            e = _array(feature_edges, "feature_edges")
+            if e.size and (e.ndim != 2 or e.shape[1] != 2 or e.dtype.kind not in "iu"):
+                raise Error(f"feature_edges: expected (n, 2) vertex ids, got an array of shape {e.shape} and type {e.dtype}")
+            edge_pairs = [(_id(int(a), "feature_edges"), _id(int(b), "feature_edges")) for a, b in e.reshape(-1, 2)]
         if split_large_turns:
             if generators or boundary:
                 raise Error("split_large_turns makes new generators and boundary loops: leave their indices to be chosen")
             if root_list:
                 raise Error("split_large_turns: roots are not supported (the refined mesh starts each component itself)")
+            if edge_pairs:
+                raise Error("split_large_turns splits edges, which feature_edges names: use align_features instead")
             if isinstance(max_rounds, bool) or not isinstance(max_rounds, _numbers.Integral) or max_rounds < 0:
                 raise Error(f"max_rounds must be a whole number >= 0, not {max_rounds!r}")
-            explicit = self._fixed(fixed, False)
-            core, r, parent, rounds, converged = self._d.split_large_turns(
-                N, vertex, explicit, bool(align_boundary), int(max_rounds), self.weights, self.solver, self.factorization,
-                self.weight_floor)
-            designer = self if core is self._d else FieldDesigner._of_core(core, self)
-            result = Result(designer, r, auto)
+        core, r, a, parent, rounds, converged, sharp = self._d.solve_request(
+            N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), explicit, bool(align_boundary),
+            degrees, edge_pairs, root_list, cancel, False, 8, curvature_t, bool(split_large_turns), int(max_rounds))
+        auto = AutoResult(a, self) if a is not None else None
+        designer = self if core is self._d else FieldDesigner._of_core(core, self)
+        result = Result(designer, r, auto)
+        if degrees is not None or edge_pairs:
+            result.sharp_edges = _frozen(sharp)
+        if split_large_turns:
             result.parent_face = _frozen(parent)
             result.split_rounds = rounds
             result.split_converged = converged
-            return result
-        # With "auto", the exact field takes each component's rotation from the smoothest field it came from
-        # (components with a root or a fixed face keep theirs), as solve --auto does.
-        guide = _np.asarray(auto.angles, dtype=_np.float64) if auto is not None else None
-        r = self._d.design(N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), fixed_angles,
-                           root_list, guide)
-        return Result(self, r, auto)
+        return result
 
     def auto_singularities(self, N=1, cancel=0.0, cancel_absolute=False, iterations=8, fixed=None, align_boundary=False,
                            align_curvature=None):
@@ -877,20 +893,10 @@ class FieldDesigner(_Cached):
         Returns an AutoResult; AutoResult.singularities go straight into solve(singularities=...).
         """
         N = _symmetry(N)
-        curvature_t = 0.0
-        if align_curvature is not None:
-            if isinstance(align_curvature, bool) or not isinstance(align_curvature, _numbers.Real):
-                raise Error(f"align_curvature must be None or a number t < 1, got {align_curvature!r}")
-            curvature_t = float(align_curvature)
-        try:
-            cancel = float(cancel)
-        except (TypeError, ValueError):
-            raise Error(f"cancel must be a number, got {cancel!r}") from None
-        if not (_math.isfinite(cancel) and cancel >= 0):
-            raise Error(f"singularity cancellation: invalid distance {cancel!r} (need a finite number >= 0)")
+        cancel, curvature_t = _auto_arguments(cancel, align_curvature)
         fixed_angles = self._fixed(fixed, align_boundary)
         return AutoResult(self._d.auto_singularities(N, int(iterations), cancel, bool(cancel_absolute), fixed_angles,
-                                                     align_curvature is not None, curvature_t), self)
+                                                     curvature_t is not None, curvature_t or 0.0), self)
 
     def field_indices(self, directions, N=1, arrays=False):
         """{vertex: Fraction} of a per-face field (m, 3) on this mesh (as trivcon.field_indices); with
@@ -906,6 +912,22 @@ class FieldDesigner(_Cached):
         _, loops, generators = self._d.field_indices(_directions(directions, self.num_faces), N)
         return _fractions(loops, N), _fractions(generators, N)
 
+
+
+def _auto_arguments(cancel, align_curvature):
+    """(cancel distance, curvature strength or None) of automatic placement, checked."""
+    curvature_t = None
+    if align_curvature is not None:
+        if isinstance(align_curvature, bool) or not isinstance(align_curvature, _numbers.Real):
+            raise Error(f"align_curvature must be None or a number t < 1, got {align_curvature!r}")
+        curvature_t = float(align_curvature)
+    try:
+        cancel = float(cancel)
+    except (TypeError, ValueError):
+        raise Error(f"cancel must be a number, got {cancel!r}") from None
+    if not (_math.isfinite(cancel) and cancel >= 0):
+        raise Error(f"singularity cancellation: invalid distance {cancel!r} (need a finite number >= 0)")
+    return cancel, curvature_t
 
 
 def _all_directions(designer, angles, N):
@@ -954,7 +976,7 @@ class Result(_Cached):
 
     def __getstate__(self):
         state = {"designer": self._designer, "core": self._r.get_state(), "auto": self.auto}
-        for key in ("parent_face", "split_rounds", "split_converged"):
+        for key in ("parent_face", "split_rounds", "split_converged", "sharp_edges"):
             if key in self.__dict__:
                 state[key] = self.__dict__[key]
         return state
@@ -964,6 +986,8 @@ class Result(_Cached):
         self._r = _core.DesignResult.restore(self._designer._d, state["core"])
         self.auto = state["auto"]
         self._cache = {}
+        if "sharp_edges" in state:
+            self.sharp_edges = state["sharp_edges"]
         if "parent_face" in state:  # after split_large_turns
             self.parent_face = _frozen(_np.array(state["parent_face"], dtype=_np.int64))
             self.split_rounds, self.split_converged = state["split_rounds"], state["split_converged"]

@@ -139,6 +139,8 @@ class FieldDesigner:
         boundary: Optional[_Indices] = ...,
         fixed: Union[Mapping[int, _Direction], Iterable[Tuple[int, _Direction]], None] = ...,
         align_boundary: bool = ...,
+        align_features: Optional[float] = ...,
+        feature_edges: Optional[npt.ArrayLike] = ...,
         roots: Union[Mapping[int, float], Iterable[Tuple[int, float]], None] = ...,
         auto_cancel: float = ...,
         align_curvature: Optional[float] = ...,
@@ -167,6 +169,7 @@ class Result:
     auto: Optional[AutoResult]
     # Only after solve(split_large_turns=True):
     parent_face: _IntArray
+    sharp_edges: _IntArray
     split_rounds: List[Dict[str, Any]]
     split_converged: bool
     def __init__(self, designer: FieldDesigner, result: Any, auto: Optional[AutoResult] = ...) -> None: ...

@@ -517,10 +517,12 @@ std::vector<std::pair<int, double>> roots_toward(const FieldDesigner& designer, 
   return out;
 }
 
-void turn_toward(const FieldDesigner& designer, Field& field, const Field& guide, const std::map<int, double>& fixed) {
+void turn_toward(const FieldDesigner& designer, Field& field, const Field& guide, const std::map<int, double>& fixed,
+                 const std::vector<std::pair<int, double>>& roots) {
   const Topology& t = designer.topology();
   std::vector<double> turn(t.components.size(), 0.0);
-  for (auto [f, angle] : roots_toward(designer, field, guide, {}, fixed)) turn[t.face_component[f]] = angle - field.angle(f);
+  const std::vector<std::pair<int, double>> out = roots_toward(designer, field, guide, roots, fixed);
+  for (size_t k = roots.size(); k < out.size(); ++k) turn[t.face_component[out[k].first]] = out[k].second - field.angle(out[k].first);
   for (int f = 0; f < t.num_faces; ++f) {
     field.angle(f) = wrap_two_pi(field.angle(f) + turn[t.face_component[f]]);
   }

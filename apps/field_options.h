@@ -1,0 +1,44 @@
+// The options that state a field request (trivcon/request.h), shared by `solve` and `param`: the
+// prescription, fixed directions, boundary and feature alignment, automatic placement, roots, the solver's
+// options and splitting of large turns. What the request means is the library's; here only the parsing.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "feature_options.h"
+#include "prescription_options.h"
+#include "trivcon/design.h"
+#include "trivcon/request.h"
+
+namespace trivcon::cli {
+
+struct FieldOptions {
+  PrescriptionOptions prescription;
+  std::string weights = "cotan", solver = "cholesky", factorization = "own";
+  double weight_floor = 0;
+  std::vector<int> root_faces;
+  std::vector<double> root_angles;
+  std::vector<std::string> fixes;
+  bool align_boundary = false;
+  FeatureOptions features;  // --align-features, --features
+  bool auto_place = false;  // --auto
+  double auto_cancel = 0;   // --auto-cancel, in mean edge lengths
+  std::string align;        // --align curvature[:t]
+  std::string sing_from_field;
+  bool split_large_turns = false;  // --split-large-turns
+  CLI::Option* auto_flag = nullptr;
+  CLI::Option* from_field_option = nullptr;
+
+  // Adds the options to `cmd` (-N among them unless `fixed_N`: `param` is for N = 4 only).
+  void add_to(CLI::App* cmd, bool fixed_N = false);
+  SolverOptions solver_options() const;
+  // The request on `designer`'s mesh: specs parsed, files read (-s, --fix, --features, --sing-from-field);
+  // the vertex singularities of --sing-from-field are filled in. Throws trivcon::Error.
+  FieldRequest request(const FieldDesigner& designer) const;
+};
+
+// The strength T of --align curvature[:T] (0 when not given), or nothing when the text is not of that form.
+std::optional<double> alignment_strength(const std::string& text);
+
+}  // namespace trivcon::cli

@@ -1,0 +1,90 @@
+// trivcon/request.h: one field request, as every front end states it (the CLI's options, the editor's JSON,
+// Python's keywords), turned into a design. The front ends parse and print; what a request means is here.
+//
+//   trivcon::FieldDesigner designer(V, F);
+//   trivcon::FieldRequest r;  r.prescription.N = 4;  r.auto_place = true;  r.align_boundary = true;
+//   trivcon::FieldOutcome out = trivcon::solve_request(designer, F, r);
+//   out.design.field, out.prescription.vertex (the singularities used), out.constraints.fixed ...
+//
+// Fixed faces, in the order in which later ones win on the same face: the boundary's edge directions
+// (align_boundary), the sharp edges' directions (feature_degrees / feature_edges, trivcon/features.h), then
+// the explicit directions of prescription.fixed.
+// Orientation: with auto_place, each component without a root or fixed face takes its rotation from the
+// smoothest field the singularities came from (turn_toward, trivcon/auto.h); otherwise the field starts at
+// angle 0 at the component's first face (FieldDesigner::design).
+#pragma once
+#include <map>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "trivcon/auto.h"
+#include "trivcon/constraints.h"
+#include "trivcon/design.h"
+#include "trivcon/features.h"
+#include "trivcon/split_large_turns.h"
+
+namespace trivcon {
+
+struct FieldRequest {
+  // N, the vertex / generator / loop indices (vertex ones ignored with auto_place), and the explicit fixed
+  // directions (face -> angle in its frame), which win over both alignments.
+  IndexPrescription prescription;
+  bool align_boundary = false;           // fix every face with a boundary edge to that edge's direction
+  std::optional<double> feature_degrees; // fix the faces beside every interior edge sharper than this (degrees)
+  std::vector<int> feature_edges;        // ... and beside these edges (ids of the designer's topology)
+  bool auto_place = false;               // the singularities of the smoothest field (auto_singularities)
+  AutoOptions auto_options;              // its cancel distance, iterations, curvature guidance (N and fixed: the request's)
+  std::vector<std::pair<int, double>> roots;  // (face, angle): where a component's field starts
+  bool split_large_turns = false;        // refine where the connection turns by π/N or more (split_large_turns.h)
+  int max_split_rounds = 8;
+  bool features_given() const { return feature_degrees.has_value() || !feature_edges.empty(); }
+};
+
+// What a request fixes on a mesh.
+struct RequestConstraints {
+  std::map<int, double> fixed;    // every fixed face: face -> angle in its frame
+  std::vector<int> fixed_faces;   // its faces, increasing (FieldDesigner::set_fixed_faces)
+  std::vector<int> sharp_edges;   // the feature edges, increasing
+  FeatureAlignment features;      // the faces fixed beside them, corners, conflicts
+  int convex_edges = 0;           // sharp edges that are ridges (is_convex_edge)
+  int boundary_overridden = 0;    // faces align_boundary fixed that a sharp edge turned (modulo 2π/N)
+};
+
+// The fixed faces of `request` on `designer`'s mesh. Throws trivcon::Error for a fixed face or feature edge
+// out of range, or a feature angle outside [0, 180].
+RequestConstraints request_constraints(const FieldDesigner& designer, const FieldRequest& request);
+
+// The design of `prescription` (its fixed map complete: RequestConstraints::fixed) on a designer already set
+// up for its fixed faces; with `guide`, components without a root or fixed face are turned toward it.
+Design request_design(const FieldDesigner& designer, const IndexPrescription& prescription,
+                      const std::vector<std::pair<int, double>>& roots = {}, const Field* guide = nullptr);
+
+// The request's smoothest field and singularities (auto_place), with the constraints' fixed faces held.
+AutoResult request_auto(const FieldDesigner& designer, const FieldRequest& request, const RequestConstraints& constraints);
+
+struct FieldOutcome {
+  IndexPrescription prescription;         // what was designed: the singularities used, every fixed face (on the final mesh)
+  RequestConstraints constraints;         // on the input mesh
+  std::vector<int> sharp_edges;           // the feature edges of the final mesh
+  Design design;                          // on the final mesh
+  bool verified = false;                  // design_verified(design)
+  std::optional<AutoResult> auto_result;  // with auto_place
+  // With split_large_turns: the refined mesh (refined == nullptr when no round was needed: the input's).
+  std::unique_ptr<FieldDesigner> refined;
+  MatrixX3d V;                            // the refined mesh (empty without one)
+  MatrixX3i F;
+  std::vector<int> parent_face;           // input face of each face of the final mesh (empty without splitting)
+  std::vector<RefineRound> rounds;
+  bool split_converged = true;
+  // The designer the design belongs to.
+  const FieldDesigner& designer(const FieldDesigner& input) const { return refined ? *refined : input; }
+};
+
+// The whole request: constraints, set-up (set_fixed_faces, only when they changed), auto placement,
+// validation (check_aligned_index_sums, validate_prescription: the CLI's messages), design, splitting.
+// `F` is the faces `designer` was built from, as given (for split_large_turns). Throws trivcon::Error.
+FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const FieldRequest& request);
+
+}  // namespace trivcon

@@ -1,0 +1,156 @@
+// trivcon/request.h: a field request turned into a design, once for every front end.
+#include "trivcon/request.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "trivcon/error.h"
+
+namespace trivcon {
+
+namespace {
+
+void check_face_id(const Topology& t, int f, const char* what) {
+  if (f < 0 || f >= t.num_faces)
+    throw Error(std::string(what) + ": face " + std::to_string(f) + " out of range (the mesh has " + std::to_string(t.num_faces) +
+                " faces)");
+}
+
+// The sharp edges of a request on a mesh: those sharper than feature_degrees, and the listed ones.
+std::vector<int> request_sharp_edges(const FieldDesigner& d, const FieldRequest& r) {
+  const Topology& t = d.topology();
+  std::vector<int> out;
+  if (r.feature_degrees) out = sharp_edges(d.V(), t, d.geometry(), *r.feature_degrees);
+  for (int e : r.feature_edges) {
+    if (e < 0 || e >= t.num_edges)
+      throw Error("feature edges: edge " + std::to_string(e) + " out of range (the mesh has " + std::to_string(t.num_edges) + " edges)");
+    if (t.is_boundary_edge(e))
+      throw Error("feature edges: edge " + std::to_string(e) + " (" + std::to_string(t.edge_vertices(e, 0)) + ", " +
+                  std::to_string(t.edge_vertices(e, 1)) + ") is a boundary edge (align the boundary instead)");
+    out.push_back(e);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// The fixed faces of a request on `d` (the input mesh or a refined one): boundary, then features, then `explicit_fixed`.
+std::map<int, double> fixed_on(const FieldDesigner& d, const FieldRequest& r, const std::map<int, double>& explicit_fixed,
+                               RequestConstraints* report) {
+  const Topology& t = d.topology();
+  std::map<int, double> fixed;
+  if (r.align_boundary) fixed = boundary_alignment(d.V(), t, d.geometry());
+  if (r.features_given()) {
+    const std::vector<int> edges = request_sharp_edges(d, r);
+    FeatureAlignment a = feature_alignment(d.V(), t, d.geometry(), edges, r.prescription.N);
+    int overridden = 0;
+    for (auto [f, angle] : a.fixed) {
+      const auto it = fixed.find(f);
+      if (it != fixed.end() && std::abs(reduce_angle(it->second - angle, r.prescription.N)) > kFeatureAngleTolerance) ++overridden;
+      fixed[f] = angle;
+    }
+    if (report) {
+      for (int e : edges) report->convex_edges += is_convex_edge(d.V(), t, d.geometry(), e);
+      report->sharp_edges = edges;
+      report->features = std::move(a);
+      report->boundary_overridden = overridden;
+    }
+  }
+  for (auto [f, angle] : explicit_fixed) fixed[f] = angle;
+  return fixed;
+}
+
+}  // namespace
+
+RequestConstraints request_constraints(const FieldDesigner& designer, const FieldRequest& request) {
+  for (auto [f, angle] : request.prescription.fixed) {
+    check_face_id(designer.topology(), f, "fixed");
+    if (!std::isfinite(angle)) throw Error("fixed: face " + std::to_string(f) + " has a direction angle that is not a finite number");
+  }
+  RequestConstraints c;
+  c.fixed = fixed_on(designer, request, request.prescription.fixed, &c);
+  for (auto [f, angle] : c.fixed) c.fixed_faces.push_back(f);
+  return c;
+}
+
+Design request_design(const FieldDesigner& designer, const IndexPrescription& prescription, const std::vector<std::pair<int, double>>& roots,
+                      const Field* guide) {
+  Design d = designer.design(prescription, roots);
+  // A rotation by a constant per component changes none of the design's checks (trivcon/auto.h).
+  if (guide && guide->N == prescription.N) turn_toward(designer, d.field, *guide, prescription.fixed, roots);
+  return d;
+}
+
+AutoResult request_auto(const FieldDesigner& designer, const FieldRequest& request, const RequestConstraints& constraints) {
+  AutoOptions o = request.auto_options;
+  o.N = request.prescription.N;
+  o.fixed = constraints.fixed;
+  return auto_singularities(designer, o);
+}
+
+FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const FieldRequest& request) {
+  FieldOutcome out;
+  out.constraints = request_constraints(designer, request);
+  IndexPrescription& p = out.prescription;
+  p = request.prescription;
+  p.fixed = out.constraints.fixed;
+  if (request.split_large_turns) {
+    if (!p.generator.empty() || !p.loop.empty())
+      throw Error("splitting large turns makes new generators and boundary loops: leave their indices to be chosen");
+    if (!request.feature_edges.empty())
+      throw Error("splitting large turns splits edges, which a list of feature edges names: use a feature angle instead");
+  }
+  out.sharp_edges = out.constraints.sharp_edges;
+  if (designer.fixed_faces() != out.constraints.fixed_faces) designer.set_fixed_faces(out.constraints.fixed_faces);
+  if (request.auto_place) {
+    out.auto_result = request_auto(designer, request, out.constraints);
+    p.vertex = out.auto_result->vertex;
+  }
+  if (!request.split_large_turns) {
+    out.design = request_design(designer, p, request.roots, out.auto_result ? &out.auto_result->field : nullptr);
+    out.verified = design_verified(out.design);
+    return out;
+  }
+  // Each refined mesh: the boundary and the sharp edges found again on it, the explicit directions (as world
+  // vectors) passed on to the children of their faces (they win, as on the input mesh).
+  std::map<int, Eigen::Vector3d> world;
+  for (auto [f, angle] : request.prescription.fixed) world[f] = designer.geometry().direction_in_face(f, angle);
+  auto constraints = [&](const FieldDesigner& refined, const std::vector<int>& parent) {
+    std::map<int, double> explicit_fixed;
+    for (int f = 0; f < static_cast<int>(parent.size()); ++f) {
+      const auto it = world.find(parent[f]);
+      if (it != world.end()) explicit_fixed[f] = refined.geometry().angle_in_face(f, it->second);
+    }
+    RequestConstraints c;
+    std::map<int, double> fixed = fixed_on(refined, request, explicit_fixed, &c);
+    out.sharp_edges = std::move(c.sharp_edges);
+    return fixed;
+  };
+  RefinedDesign r = split_large_turns(designer, F, p, designer.solver_options(), constraints, request.max_split_rounds, request.roots);
+  out.rounds = std::move(r.rounds);
+  out.split_converged = r.converged;
+  out.parent_face = std::move(r.parent_face);
+  out.prescription = std::move(r.prescription);
+  out.design = std::move(r.design);
+  const FieldDesigner& final_designer = r.designer ? *r.designer : designer;
+  if (out.auto_result) {  // the guide on the final faces: each child lies in its parent's plane
+    const Field& parent_guide = out.auto_result->field;
+    Field guide{parent_guide.N, Eigen::VectorXd(static_cast<Eigen::Index>(out.parent_face.size()))};
+    for (size_t f = 0; f < out.parent_face.size(); ++f) {
+      const int parent = out.parent_face[f];
+      guide.angle(static_cast<Eigen::Index>(f)) = final_designer.geometry().angle_in_face(
+          static_cast<int>(f), designer.geometry().direction_in_face(parent, parent_guide.angle(parent)));
+    }
+    turn_toward(final_designer, out.design.field, guide, out.prescription.fixed, r.designer ? std::vector<std::pair<int, double>>{} : request.roots);
+  }
+  if (r.designer) {
+    out.V = std::move(r.V);
+    out.F = std::move(r.F);
+    out.refined = std::move(r.designer);
+  }
+  out.verified = design_verified(out.design);
+  return out;
+}
+
+}  // namespace trivcon

@@ -1,0 +1,118 @@
+// trivcon/request.h: one request, the same meaning in every front end (the CLI, the editor and Python are
+// tested against it through their own files; here the layer itself).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "trivcon/common.h"
+#include "trivcon/error.h"
+#include "trivcon/generate.h"
+#include "trivcon/request.h"
+
+namespace trivcon {
+namespace {
+
+// Fixed faces in the order in which later ones win: the boundary, the sharp edges, the explicit directions.
+TEST(Request, ExplicitDirectionsWinOverFeaturesOverTheBoundary) {
+  const Mesh m = make_capped_cylinder(6, 24, 8);  // a flat cap meets the side at a sharp rim
+  FieldDesigner d(m.V, m.F);
+  FieldRequest r;
+  r.prescription.N = 4;
+  r.feature_degrees = 60;
+  const RequestConstraints features = request_constraints(d, r);
+  ASSERT_FALSE(features.sharp_edges.empty());
+  EXPECT_EQ(features.fixed, features.features.fixed);
+  const int face = features.fixed.begin()->first;
+  r.prescription.fixed[face] = features.fixed.at(face) + 0.3;
+  const RequestConstraints c = request_constraints(d, r);
+  EXPECT_EQ(c.fixed.at(face), features.fixed.at(face) + 0.3);
+  EXPECT_EQ(c.fixed.size(), features.fixed.size());
+  std::vector<int> keys;
+  for (auto [f, angle] : c.fixed) keys.push_back(f);
+  EXPECT_EQ(c.fixed_faces, keys);
+  r.feature_edges = {-1};
+  EXPECT_THROW(request_constraints(d, r), Error);
+}
+
+TEST(Request, ExplicitDirectionsWinOverTheBoundary) {
+  const Mesh m = make_annulus(4, 24);
+  FieldDesigner d(m.V, m.F);
+  FieldRequest r;
+  r.prescription.N = 4;
+  r.align_boundary = true;
+  const std::map<int, double> boundary = boundary_alignment(d.V(), d.topology(), d.geometry());
+  EXPECT_EQ(request_constraints(d, r).fixed, boundary);
+  const int face = boundary.begin()->first;
+  r.prescription.fixed[face] = 0.25;
+  EXPECT_EQ(request_constraints(d, r).fixed.at(face), 0.25);
+}
+
+// Auto: the singularities used are the smoothest field's, the design verified, and the designer set up for
+// the request's fixed faces once (a second request with the same faces does not set it up again).
+TEST(Request, AutoOnACubeAndOneSetUp) {
+  const Mesh m = make_cube_sphere(4, false);
+  FieldDesigner d(m.V, m.F);
+  FieldRequest r;
+  r.prescription.N = 4;
+  r.auto_place = true;
+  r.feature_degrees = 30;
+  const FieldOutcome out = solve_request(d, m.F, r);
+  ASSERT_TRUE(out.auto_result);
+  EXPECT_EQ(out.prescription.vertex, out.auto_result->vertex);
+  EXPECT_EQ(out.prescription.vertex.size(), 8u);
+  EXPECT_TRUE(out.verified);
+  EXPECT_TRUE(out.design.field_exact);
+  EXPECT_EQ(d.fixed_faces(), out.constraints.fixed_faces);
+  const ConnectionSolver* solver = &d.solver();
+  r.auto_place = false;
+  r.prescription.vertex = out.prescription.vertex;
+  const FieldOutcome again = solve_request(d, m.F, r);
+  EXPECT_EQ(&d.solver(), solver);
+  double worst = 0;
+  for (int f = 0; f < m.F.rows(); ++f)
+    worst = std::max(worst, std::abs(reduce_angle(again.design.field.angle(f) - out.design.field.angle(f), 4)));
+  EXPECT_LT(worst, 1e-9);  // every face of the cube is on a fixed component: the same field
+}
+
+// Auto without fixed faces: each component takes its rotation from the smoothest field (turn_toward), and a
+// root keeps a component where it was put.
+TEST(Request, AutoTurnsTowardTheSmoothestFieldUnlessRooted) {
+  Mesh m = make_icosphere(3);
+  for (int v = 0; v < m.V.rows(); ++v) m.V.row(v) = Eigen::RowVector3d(2.0 * m.V(v, 0), m.V(v, 1), 0.6 * m.V(v, 2));
+  FieldDesigner d(m.V, m.F);
+  FieldRequest r;
+  r.prescription.N = 4;
+  r.auto_place = true;
+  const FieldOutcome out = solve_request(d, m.F, r);
+  auto mean_difference = [&](const Field& field) {
+    double sum = 0, area = 0;
+    for (int f = 0; f < m.F.rows(); ++f) {
+      sum += d.geometry().face_area(f) * std::abs(reduce_angle(field.angle(f) - out.auto_result->field.angle(f), 4));
+      area += d.geometry().face_area(f);
+    }
+    return sum / area;
+  };
+  EXPECT_LT(mean_difference(out.design.field), 0.03);
+  r.roots = {{0, 0.0}};
+  const FieldOutcome rooted = solve_request(d, m.F, r);
+  EXPECT_NEAR(rooted.design.field.angle(0), 0.0, 1e-12);
+  EXPECT_GT(mean_difference(rooted.design.field), 0.1);
+}
+
+TEST(Request, SplittingRefusesWhatItCannotCarry) {
+  const Mesh m = make_cube_sphere(3, false);
+  FieldDesigner d(m.V, m.F);
+  FieldRequest r;
+  r.prescription.N = 4;
+  r.split_large_turns = true;
+  r.feature_edges = {0};
+  try {
+    solve_request(d, m.F, r);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "splitting large turns splits edges, which a list of feature edges names: use a feature angle instead");
+  }
+}
+
+}  // namespace
+}  // namespace trivcon
