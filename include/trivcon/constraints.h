@@ -35,10 +35,6 @@ struct FixedPath {
 // a path may have no usable edge at all ("rigid": the two directions must then agree after parallel transport).
 std::vector<FixedPath> fixed_face_paths(const Topology& topology, const std::vector<int>& fixed_faces, const std::vector<char>& usable);
 
-// Angle in face f's frame of a world direction, after projection onto the face's plane. Errors name the
-// face: a zero or non-finite direction, or one perpendicular to the face.
-double fixed_angle_from_direction(const Geometry& geometry, int face, const Eigen::Vector3d& direction);
-
 // Adds fixed directions from a file: one "FACE x y z" (world direction) or "FACE angle=A" (radians, in the
 // face's frame) per line, '#' comments; and from "F:x,y,z" or "F:angle=A" specs (--fix). Face ids are
 // checked against the mesh; a face given twice is an error.

@@ -78,5 +78,9 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& topology, int thre
 // glyph size, and of anything else measured "in mean edge lengths".
 double mean_edge_length(const MatrixX3d& V, const Topology& topology);
 
+// Angle in face f's frame of a world direction, after projection onto the face's plane. Errors name the
+// face: a zero or non-finite direction, or one perpendicular to the face.
+double fixed_angle_from_direction(const Geometry& geometry, int face, const Eigen::Vector3d& direction);
+
 
 }  // namespace trivcon

@@ -22,6 +22,10 @@
 
 namespace trivcon {
 
+// |p| and q of an index p/q, |n| = |index · N| of any index and the sum of the magnitudes on a component,
+// and N of a .sings file, are at most this: sums of indices stay far from int's range.
+constexpr long long kMaxIndexPart = 1000000000;
+
 struct IndexPrescription {
   int N = 1;
   std::map<int, int> vertex;     // vertex id → n (index n/N); absent: 0

@@ -39,9 +39,8 @@ std::vector<double> parse_numbers(const TextLines& lines, size_t expected) {
   std::vector<double> values;
   std::string token;
   while (fields >> token) {
-    char* end = nullptr;
-    const double v = std::strtod(token.c_str(), &end);
-    if (end != token.c_str() + token.size() || !std::isfinite(v)) throw Error(lines.where() + ": malformed number '" + token + "'");
+    double v = 0;
+    if (!io::parse_double(token, v) || !std::isfinite(v)) throw Error(lines.where() + ": malformed number '" + token + "'");
     values.push_back(v);
   }
   if (values.size() != expected)

@@ -1,11 +1,10 @@
 // Internal: the lines of a small text file (field, matching, feature-edge files), for readers that go line by
 // line and name "path:line" in their errors.
 #pragma once
-#include <cerrno>
-#include <cstdlib>
 #include <sstream>
 #include <string>
 
+#include "io/text_scanner.h"
 #include "trivcon/error.h"
 
 namespace trivcon::io {
@@ -31,10 +30,8 @@ struct TextLines {
 
 // A whole number token within [lo, hi], or an error naming the line and what it should be.
 inline long long whole_number(const std::string& token, const TextLines& lines, long long lo, long long hi, const char* what) {
-  char* end = nullptr;
-  errno = 0;
-  const long long v = std::strtoll(token.c_str(), &end, 10);
-  if (token.empty() || end != token.c_str() + token.size() || errno == ERANGE || v < lo || v > hi)
+  long long v = 0;
+  if (!parse_integer(token, v) || v < lo || v > hi)
     throw Error(lines.where() + ": " + what + " '" + token + "' is not a whole number in [" + std::to_string(lo) + ", " +
                 std::to_string(hi) + "]");
   return v;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include "linalg/parallel.h"
 #include "trivcon/cancel.h"
+#include "trivcon/error.h"
 
 namespace trivcon {
 
@@ -243,6 +244,15 @@ double mean_edge_length(const MatrixX3d& V, const Topology& t) {
   double sum = 0;
   for (int e = 0; e < t.num_edges; ++e) sum += (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).norm();
   return sum / t.num_edges;
+}
+
+double fixed_angle_from_direction(const Geometry& g, int face, const Eigen::Vector3d& d) {
+  if (!d.allFinite()) throw Error("fixed direction of face " + std::to_string(face) + " is not finite");
+  if (d.squaredNorm() == 0) throw Error("fixed direction of face " + std::to_string(face) + " is zero");
+  const double along = std::hypot(d.dot(g.frame_x.row(face)), d.dot(g.frame_y.row(face)));
+  if (!(along > 1e-9 * d.norm()))
+    throw Error("fixed direction of face " + std::to_string(face) + " is perpendicular to the face: nothing is left after projection");
+  return g.angle_in_face(face, d);
 }
 
 }  // namespace trivcon
