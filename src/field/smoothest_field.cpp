@@ -36,7 +36,7 @@ double edge_length(const MatrixX3d& V, const Topology& t, int e) {
   return (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).norm();
 }
 
-// The per-face mass and per-edge weight of trivcon/auto.h.
+// The per-face mass and per-edge weight of docs/auto.md ("The field").
 struct Weights {
   Eigen::VectorXd mass, w;
 };
@@ -133,7 +133,7 @@ SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, c
   return std::move(candidate[dissect ? 1 : 0]);
 }
 
-// The smoothest field's complex values per face (see trivcon/auto.h).
+// The smoothest field's complex values per face (see docs/auto.md, "The eigen-solve").
 std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o,
                                       const std::vector<Complex>* guidance, AutoTimings& time, std::string& ordering_used) {
   auto t0 = Clock::now();
@@ -152,7 +152,7 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   const int n = static_cast<int>(face_of.size());
   if (n == 0) return u;
 
-  // The shift ε of trivcon/auto.h and the upper triangle of the Hermitian A + εM in compressed columns
+  // The shift ε of docs/auto.md and the upper triangle of the Hermitian A + εM in compressed columns
   // (n × n complex, values as (real, imaginary) pairs).
   Eigen::VectorXd diag = Eigen::VectorXd::Zero(t.num_faces);
   for (int e = 0; e < t.num_edges; ++e)

@@ -29,7 +29,7 @@ std::vector<int> elimination_tree(const Pattern& pattern, const std::vector<int>
 // their own longest axis). Why not METIS_NodeND, which finds smaller separators: on the 400k-face sphere it
 // takes 1.2-1.5 s, against 0.07 s for this. Why not only this: on scanned meshes (the dragon, armadillo) its
 // plane cuts meet the surface in long curves and it needs 3-4 times AMD's flops, so it is a candidate to
-// compare, not a replacement (trivcon/auto.h takes the one with fewer flops). Deterministic.
+// compare, not a replacement (the smoothest field takes the one with fewer flops, docs/auto.md). Deterministic.
 std::vector<int> coordinate_dissection(const Pattern& pattern, const std::vector<std::array<double, 3>>& point, int leaf = 16);
 
 }  // namespace trivcon::linalg
