@@ -1,6 +1,6 @@
 // Internal: fill-reducing orders and their elimination trees.
 // - The pattern and elimination tree of the normal matrix's vertex block, to postorder a fill-reducing order
-//   (see CholeskyEngine::vertex_order in solver.cpp).
+//   (see vertex_order in src/connection/cholesky_engine.cpp).
 // - A nested dissection by coordinates, the second candidate order of the smoothest field's matrix
 //   (trivcon/auto.h).
 #pragma once
