@@ -54,9 +54,10 @@ using Clock = std::chrono::steady_clock;
 constexpr int kMaxN = 1000;
 
 // cpp-httplib compresses (brotli, gzip) any answer whose type is application/json or text/… when the client
-// accepts it, brotli at its slowest level: a field export of 400k faces took over a minute that way, on a
-// connection that is almost always this machine's loopback. No answer is compressed: the server drops the
-// request's Accept-Encoding before routing (Http::process_and_close_socket).
+// accepts it, brotli at its slowest level: a large field export took far longer compressed than sent as
+// it is, on a connection that is almost always this machine's loopback (BENCHMARKS.md, "The editor"). No
+// answer is compressed: the server drops the request's Accept-Encoding before routing
+// (Http::process_and_close_socket).
 constexpr const char* kJson = "application/json; charset=utf-8";
 
 // What a chunked body may add to its payload on the wire (chunk-size lines): reads past the body limit by

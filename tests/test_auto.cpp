@@ -283,7 +283,7 @@ Mesh split_vertex_into_collapsed_triangle(const Mesh& in, int v) {
 }
 
 // Zero-area faces, coincident vertices and a face with three coincident corners leave the smoothest field of
-// the surface as it was: the shift, the weights and the masses come from the mollified lengths (auto.h), so
+// the surface as it was: the shift, the weights and the masses come from the mollified lengths (docs/auto.md), so
 // no face is cut off from its neighbours and no vanishing mass makes a mode localise there. (Before: a
 // capsule of this kind got 2176 singularities, the dragon's zero-area faces left every face "vanishing".)
 TEST(Auto, CoincidentVerticesAndCollapsedFacesChangeNothing) {

@@ -267,7 +267,7 @@ TEST(Constraints, ManyFixedFacesSparseRoute) {
   }
 }
 
-// The sparse route's path turns (more than 256 paths, trivcon/solver.h): a one-edge path between two
+// The sparse route's path turns (more than 256 paths, docs/solver.md "Fixed-face paths"): a one-edge path between two
 // adjacent fixed faces takes the smallest turn, |x_e| ≤ π/N, whatever the sign of the difference between
 // their directions (here random, within ±π/N after parallel transport).
 TEST(Constraints, SparsePathsTakeTheSmallestTurnEitherWay) {

@@ -256,7 +256,7 @@ TEST(FeatureAlignment, CappedCylinderWithAuto) {
   expect_exact_and_aligned(designer, s);
 }
 
-// With more than 256 fixed-face paths (the sparse route, trivcon/solver.h) a path of one edge between two
+// With more than 256 fixed-face paths (the sparse route, docs/solver.md "Fixed-face paths") a path of one edge between two
 // adjacent fixed faces takes the smallest turn: |x_e| ≤ π/N. On a capped cylinder's rims the fixed
 // directions of neighbouring faces differ by a little (the rim turns), so any other whole number would
 // make that edge turn by nearly π/2.

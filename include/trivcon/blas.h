@@ -3,7 +3,8 @@
 // The supernodal factorization (src/linalg/supernodal.h) spends most of its time in BLAS (dgemm, dsyrk, dtrsm). Debian 12's
 // OpenBLAS 0.3.21 picks its kernels for the CPU when it is loaded, and does not recognise recent CPUs
 // (e.g. Intel family 6 model 207, the machine of BENCHMARKS.md): it falls back to its generic "Prescott"
-// (SSE3) kernels, which factor 1.3–1.5× slower there than its AVX-512 ("SkylakeX") ones. OpenBLAS only
+// (SSE3) kernels, which factor markedly slower there than its AVX-512 ("SkylakeX") ones (BENCHMARKS.md,
+// "What changed since the first measurement"). OpenBLAS only
 // reads its choice (OPENBLAS_CORETYPE) when it is loaded, so a program that wants the better kernels
 // must be started with it set.
 #pragma once
@@ -25,7 +26,7 @@ std::string native_blas_kernels();
 // thread count is set to 1, and restored when the last such object in the process is destroyed). For
 // code that calls BLAS from several threads at once: OpenBLAS 0.3.21's pthread build would give each call
 // its thread pool, and concurrent calls then wait for each other (the factorization's two threads took
-// 2–3× longer). Does nothing if the BLAS is not OpenBLAS.
+// several times longer). Does nothing if the BLAS is not OpenBLAS.
 class SingleThreadedBlas {
  public:
   SingleThreadedBlas();

@@ -1,49 +1,19 @@
 // trivcon/solver.h: the trivial connection closest to Levi-Civita (paper Sections 2.3–2.6, 3).
+// How it is solved and why (the two routes, ordering, edits, refinement, fixed-face paths, free indices):
+// docs/solver.md.
 //
-// Unknowns: one adjustment angle x_e per interior edge (a dual 1-form), with the sign convention of
-// trivcon/geometry.h: a direction at angle β_L in L = edge_faces(e, 0) is carried to
-// β_R = β_L + ρ_e − x_e in R = edge_faces(e, 1) (paper Eq. 3). Constraints, with indices k = n/N:
+// Unknowns: one adjustment angle x_e per interior edge, with the sign convention of trivcon/geometry.h:
+// a direction at angle β_L in L = edge_faces(e, 0) is carried to β_R = β_L + ρ_e − x_e in
+// R = edge_faces(e, 1) (paper Eq. 3). Constraints, with indices k = n/N:
 //   interior vertex v:      Σ_e s_ve x_e = K_v − 2π k_v      (s_ve = +1 if v is e's larger id, else −1)
 //   boundary loop ℓ:        Σ_e c_e x_e  = K_ℓ − 2π k_ℓ      (c: the loop cycle, K_ℓ its loop_curvature)
 //   generator γ:            Σ_e c_e x_e  = z_γ − 2π k_γ      (z_γ = levi_civita_holonomy)
-// Objective: minimise Σ x_e² / w_e (w = cotan or unit weights; the cotan weights are clamped and, on meshes
-// with slivers or degenerate faces, mollified: trivcon/geometry.h); an edge with w_e = 0 gets x_e = 0, except
-// where that would make the constraints unsatisfiable: the edges of a cycle or fixed-face path that has no
-// edge of positive weight, and the edges around a vertex that zero weights cut off from the rest of its
-// component, get 1e-6 × the median positive weight, so the field can still turn there when nothing else
-// can (regularized_edges()). Since the mollification, zero-area faces no longer cause either. With fixed
-// faces, every edge lighter than that (0, or a round-off 1e-17 where both opposite angles are right) gets it:
-// path and vertex rows can otherwise be dependent on the weighted edges alone (feature lines of CAD meshes,
-// trivcon/features.h).
-//
-// Default route (SolverKind::Cholesky): x = W Aᵀ y with (A W Aᵀ) y = b, where A = [D; C] holds the
-// interior-vertex rows D and the cycle rows C (loops, generators). D W Dᵀ is the cotan Laplacian on
-// interior vertices; on a closed component one vertex row is dropped (Gauss–Bonnet makes it redundant),
-// and on a component with boundary one loop row is (its index follows from the others). A W Aᵀ is
-// factored once (supernodal LLᵀ: CHOLMOD's symbolic analysis, our numeric factorization into CHOLMOD's
-// factor on OpenMP's threads, src/linalg/supernodal.h, or CHOLMOD's own with Factorization::Cholmod; OpenBLAS), the vertex rows in a
-// fill-reducing order and the cycle rows last, so that the trailing block of the factor is the Cholesky factor of the Schur complement S =
-// CWCᵀ − CWDᵀ(DWDᵀ)⁻¹DWCᵀ. The vertex order is minimum degree: CAMD with the cycle rows constrained last, or AMD without cycle rows. A new
-// prescription only changes b: nothing is refactored. The forward substitution of the prescription without singularities is stored, so an
-// edit that places a few singularities updates it along their paths in the elimination tree only, then does one full backward substitution,
-// on OpenMP's threads (the top of the elimination tree first, then one set of independent subtrees per thread).
-// Every solve is verified (Connection's residuals); when the largest residual exceeds 2.5e-10 × max(1, rhs_scale),
-// up to 3 steps of iterative refinement with the same factor follow (x += W Aᵀ (A W Aᵀ)⁻¹ (b − A x)), each kept
-// only if it lowers the residual (Connection::refinements): one substitution is not enough where the weights
-// span many orders of magnitude.
-// Paper-literal route (SolverKind::QR): the minimum-norm solution of the full weighted constraint
-// system by SuiteSparseQR (a QR factorization of (A W^½)ᵀ, reused for every right-hand side).
-//
-// Fixed-face paths (trivcon/constraints.h) are cycle rows too. With more than 256 of them the Cholesky
-// route puts them with the vertex rows instead, keeping the dense block small; each path's whole number
-// of turns is then the one that makes its turn beyond parallel transport smallest (for a path of one edge
-// between adjacent fixed faces, the principal matching of their two directions).
-//
-// Free cycle indices (generators and loops not prescribed) are chosen so that the field is smoothest:
-// the energy is a quadratic function of them, E = E₀ + (2π/N)² (u − n)ᵀ P (u − n) with P = S⁻¹; the
-// real minimiser (given the prescribed ones) is rounded one index at a time (Babai's nearest plane, fixed-
-// face paths first, each given the ones already rounded and the rest real), then improved by single ±1
-// steps while the energy decreases.
+//   fixed-face path:        a whole number of 1/N turns between two fixed directions (trivcon/constraints.h)
+// Objective: minimise Σ x_e² / w_e (cotan or unit weights, trivcon/geometry.h). x_e = 0 where w_e = 0,
+// except on the edges given 1e-6 × the median positive weight where x = 0 would make the constraints
+// unsatisfiable (regularized_edges()). Generator and loop indices not prescribed, and every path's turns,
+// are chosen so that the field is smoothest. Every solve is verified; above 2.5e-10 × max(1, rhs_scale)
+// up to 3 steps of iterative refinement follow. Angles in radians; errors throw trivcon::Error.
 #pragma once
 #include <Eigen/Core>
 #include <functional>
@@ -96,7 +66,7 @@ struct Connection {
   // Verification: largest |Σ coefficient · x − right-hand side| over all interior vertices (including
   // the dropped ones), all loops and all generators, and the scale of the right-hand sides.
   double max_vertex_residual = 0, max_cycle_residual = 0, rhs_scale = 0;
-  // Steps of iterative refinement the solve took (0 on most meshes; see ConnectionSolver::solve).
+  // Steps of iterative refinement the solve took, at most 3 (0 on most meshes; docs/solver.md).
   int refinements = 0;
 };
 
@@ -154,15 +124,15 @@ class ConnectionSolver {
 
   const Eigen::VectorXd& weights() const;  // per edge, 0 on boundary edges
   const SetupTimings& timings() const;
-  // The fill-reducing order of the factorization: "AMD" or "CAMD" (see the route above), or
-  // "SuiteSparseQR default".
+  // The fill-reducing order of the factorization: "AMD" or "CAMD" (the Cholesky route, docs/solver.md),
+  // or "SuiteSparseQR default".
   std::string ordering() const;
   int num_generators() const;
   // Levi-Civita holonomy the constraints use: K_ℓ per loop, z_γ per generator.
   const std::vector<double>& loop_curvatures() const;
   const std::vector<double>& generator_holonomies() const;
   const std::vector<int>& fixed_faces() const;  // sorted, without repeats
-  // Zero-weight edges given a small weight (see above).
+  // Zero-weight edges given the small regularizing weight (see above; docs/solver.md "The objective").
   int regularized_edges() const;
   int floored_edges() const;  // interior edges raised to SolverOptions::weight_floor
   const std::vector<FixedPath>& fixed_paths() const;

@@ -6,14 +6,14 @@
 //  - glibc.malloc.hugetlb=1 in GLIBC_TUNABLES: malloc asks for transparent huge pages (madvise) for its
 //    large blocks. On kernels that give huge pages only on request (/sys/kernel/mm/transparent_hugepage/
 //    enabled says [madvise], Debian's default), every 4 KiB page of a new array otherwise costs a page
-//    fault when first written; in a virtual machine that is expensive: the 400k-face set-up spent a
-//    third of its time in page faults on the machine of BENCHMARKS.md ("Huge pages");
+//    fault when first written; in a virtual machine that is expensive: a large set-up can spend much of
+//    its time in page faults (BENCHMARKS.md, "Huge pages");
 //  - OPENBLAS_THREAD_TIMEOUT=4: after a multithreaded BLAS call (the top of a factorization's elimination
 //    tree), OpenBLAS's idle threads spin for 2^28 cycles (about 0.1 s) before they sleep, and take a core
 //    from trivcon's own OpenMP threads meanwhile: the first parallel substitution after a factorization then
-//    waited for them (each of the smoothest field's 8 solves on a small mesh took 0.1 s instead of 0.4 ms,
-//    now and then; an edit right after a factorization likewise). With 4 they spin 2^4 cycles; waking them
-//    for the next BLAS call costs microseconds.
+//    waited for them (the smoothest field's solves on a small mesh took many times longer now and then; an
+//    edit right after a factorization likewise; BENCHMARKS.md, "Figures that were in code comments"). With
+//    4 they spin 2^4 cycles; waking them for the next BLAS call costs microseconds.
 #pragma once
 
 namespace trivcon {

@@ -101,7 +101,7 @@ indices on component 0 sum to 3/2, but Gauss-Bonnet needs its Euler characterist
 errors name the array and its shape or dtype (e.g. "V must have shape (n, 3), got shape (8, 2)")."""
 
 _INT32_MAX = 2**31 - 1
-_MAX_INDEX_PART = 10**9  # the library's bound on p and q of an index "p/q" (src/indices.cpp)
+_MAX_INDEX_PART = 10**9  # the library's bound on p and q of an index "p/q" (src/connection/indices.cpp)
 _INDEX_TEXT = _re.compile(r"\s*([+-]?[0-9]+)(?:/([+-]?[0-9]+))?\s*\Z")
 
 

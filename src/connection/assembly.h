@@ -1,5 +1,5 @@
 // src/connection/assembly.h (internal): the constraint system of the trivial connection as matrices
-// (trivcon/solver.h states the system, its signs and which rows it has).
+// (trivcon/solver.h states the system and its signs; docs/solver.md which rows it has and why).
 //
 // - row_layout / loop_rows: which interior vertices and boundary loops have a row (one vertex dropped per
 //   closed component, one loop per component with boundary: Gauss–Bonnet makes them redundant).
@@ -41,7 +41,7 @@ struct EdgeRows {
 // pattern depends on ends, Et and Ct only (SolverAnalysis relies on it). Fills `edges`.
 Csc normal_matrix(const EdgeEnds& ends, int nV, const SparseMatrix& Et, const SparseMatrix& Ct, const Eigen::VectorXd& w, EdgeRows& edges);
 
-// Which rows the reduced system has (see trivcon/solver.h): per component the dropped vertex (closed
+// Which rows the reduced system has (docs/solver.md): per component the dropped vertex (closed
 // component: its largest interior vertex) or loop (with boundary: the longest loop, ties to the smallest
 // id), and the row of each other interior vertex (−1: none).
 struct RowLayout {

@@ -24,13 +24,13 @@ namespace {
 
 // A fill-reducing order of the nD vertex rows of M (the nC cycle rows come last). Minimum degree (AMD;
 // CAMD when there are cycle rows, constrained to order them last, so that it sees how they couple the
-// vertices: a quarter fewer flops on the dragon), then postordered by the vertex block's elimination
+// vertices: fewer flops on meshes with many cycles), then postordered by the vertex block's elimination
 // tree so that CHOLMOD finds large supernodes without postordering the whole system (which could move
 // the cycle rows). Not CHOLMOD's default choice, which tries METIS on large meshes: its analysis alone
-// takes 3 s (the dragon) to 16 s (the dragon subdivided) on our 2-core machine, more than the fill it
-// saves. (A nested dissection by vertex coordinates, tried as a second candidate, cut the flops by a
-// third on smooth closed surfaces but not the time with AVX-512 BLAS kernels, and lost on the dragon;
-// see BENCHMARKS.md.)
+// takes longer than the fill it saves. (A nested dissection by vertex coordinates, tried as a second
+// candidate, cut the flops on smooth closed surfaces but not the time with AVX-512 BLAS kernels, and lost
+// on scanned meshes.) The figures: BENCHMARKS.md, "What changed since the first measurement" and "Tried
+// and dropped".
 std::vector<int> vertex_order(const Csc& M, int nD, int nC, cholmod_common& cc) {
   std::vector<int> order(nD);
   if (nD == 0) return order;

@@ -24,9 +24,8 @@ namespace {
 constexpr int kMaxDensePaths = 256;
 // Iterative refinement (see ConnectionSolver::solve): when the largest constraint residual exceeds this
 // (relative to max(1, the right-hand sides' scale): a quarter of what verification accepts), up to this many
-// steps. Not lower: one substitution's round-off alone reaches 3e-11 at 400k faces and 5e-10 at 6.4M, where a
-// step costs as much as a whole edit and cannot do better (measured: with 1e-11 the 400k edits took 85 ms
-// instead of 21).
+// steps. Not lower: one substitution's round-off alone grows with the mesh to the order of this limit, and
+// a step costs as much as a whole edit and cannot do better (BENCHMARKS.md, "Exact on slivers").
 constexpr double kRefineAbove = 2.5e-10;
 constexpr int kMaxRefinements = 3;
 using linalg::Clock;
@@ -266,7 +265,7 @@ void ConnectionSolver::Impl::factor(const std::function<SolverAnalysis()>& analy
   } else {
     // The vertex and path rows together, ordered anew (CAMD). (Ordering the path rows first, or each
     // before the first of its vertices, with the vertex order of the system without them, made the
-    // factorization 60–80 times slower on a cube's feature lines: 4,367 paths, many sharing edges.)
+    // factorization far slower on feature lines, where many paths share edges: BENCHMARKS.md, "Fixed directions".)
     const SparseMatrix Et =
         connection::cycle_columns(m, edge_column, static_cast<int>(paths.size()), [&](int k) -> const DualCycle& { return paths[k].path; });
     engine = connection::make_cholesky_engine(ends, num_vertex_rows, Et, Ct, w, options.factorization, timings);
@@ -448,8 +447,8 @@ ConnectionSolver::Impl::CycleRhs ConnectionSolver::Impl::cycle_rhs(const IndexPr
 // faces, most of them on feature lines and boundaries) that turn is the edge's x itself, fixed by the two
 // directions alone, so this is the principal matching of the two fixed directions. (Rounding instead the
 // turn of the field without path constraints, which knows nothing of the fixed directions, gave a CAD
-// mesh 65 times the energy of the dense route's choice, and needed a second factorization; this choice is
-// within 0.2 % there, BENCHMARKS.md "Fixed directions".) Returns the right-hand side of the vertex and
+// mesh many times the energy of the dense route's choice, and needed a second factorization; this choice
+// is close to it there, BENCHMARKS.md "Fixed directions".) Returns the right-hand side of the vertex and
 // path rows.
 Eigen::VectorXd ConnectionSolver::Impl::round_sparse_path_turns(const IndexPrescription& prescription, const Eigen::VectorXd& b_D,
                                                                 Eigen::VectorXd& n_E) const {

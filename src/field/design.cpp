@@ -52,7 +52,7 @@ FieldDesigner::FieldDesigner(const MatrixX3d& V, const MatrixX3i& F, SolverOptio
       return SolverAnalysis(topology_, cycles_);
     });
   // With the analysis running, the geometry leaves it a core: on two cores, OpenMP's two threads and the
-  // analysis would share them, and the analysis, the longer of the two, would finish later (dragon: 0.15 s).
+  // analysis would share them, and the analysis, the longer of the two, would finish later.
   const int threads = concurrent ? std::max(1, linalg::max_threads() - 1) : 0;
   timed(timings_.geometry, [&] { geometry_ = compute_geometry(V_, topology_, threads); });
   check_cancelled(cancel.get());

@@ -36,7 +36,7 @@ double edge_length(const MatrixX3d& V, const Topology& t, int e) {
   return (V.row(t.edge_vertices(e, 1)) - V.row(t.edge_vertices(e, 0))).norm();
 }
 
-// The per-face mass and per-edge weight of trivcon/auto.h.
+// The per-face mass and per-edge weight of docs/auto.md ("The field").
 struct Weights {
   Eigen::VectorXd mass, w;
 };
@@ -75,14 +75,13 @@ struct FactorDeleter {
 //
 // Two candidate orders, analysed side by side on two threads, and the one with fewer flops (CHOLMOD's
 // count) kept: AMD, and a nested dissection by the faces' centroids (src/linalg/ordering.h). Neither wins
-// everywhere: on the 400k-face sphere (a regular grid of faces, AMD's worst case) AMD needs 7.0e9 flops,
-// the dissection 3.9e9; on scans the dissection needs 3-4 times AMD's (the dragon: 9.9e9 against 2.7e9;
-// armadillo 3.3e8 against 7.6e7). (METIS would need 2.1e9 on the sphere and wins on scans too, but
-// METIS_NodeND alone takes 1.2-1.5 s there, against 0.15-0.25 s for either analysis here.) Small meshes,
-// or one thread, take AMD alone. Supernodes are amalgamated less than CHOLMOD's default (zrelax 0.8, 0.1,
-// 0.05): the explicit zeros that buys are read again by each solve and first-touched by the factorization
-// (the sphere's factor: 1.90e7 entries for 1.39e7 nonzeros, 2.22e7 with the default); the factorization
-// itself did not get measurably slower.
+// everywhere: on a regular grid of faces (AMD's worst case) the dissection needs far fewer flops; on scans
+// it needs several times AMD's. (METIS would need fewer flops on both, but METIS_NodeND alone takes
+// several times as long as either analysis here.) Small meshes, or one thread, take AMD alone. Supernodes
+// are amalgamated less than CHOLMOD's default (zrelax 0.8, 0.1, 0.05): the explicit zeros that buys are
+// read again by each solve and first-touched by the factorization (the factor has a sixth fewer entries);
+// the factorization itself did not get measurably slower. The figures: BENCHMARKS.md, "Figures that were
+// in code comments".
 struct SymbolicFactor {
   std::unique_ptr<linalg::CholmodContext> context;
   std::unique_ptr<cholmod_factor, FactorDeleter> factor{nullptr, FactorDeleter{nullptr}};
@@ -104,7 +103,7 @@ SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, c
   }
   candidate[0].context->get()->method[0].ordering = CHOLMOD_AMD, candidate[0].ordering = "AMD";
   candidate[1].context->get()->method[0].ordering = CHOLMOD_GIVEN, candidate[1].ordering = "coordinate dissection";
-  // The pattern alone (with the complex values the analyses copied them too: 0.04 s at 400k).
+  // The pattern alone (with the complex values the analyses copied them too, a cost that grows with the mesh).
   cholmod_sparse A = linalg::upper_pattern_view(outer, inner, n);
   const bool compare = n >= linalg::kParallelMinElements && linalg::max_threads() > 1;
   std::exception_ptr error;
@@ -133,7 +132,7 @@ SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, c
   return std::move(candidate[dissect ? 1 : 0]);
 }
 
-// The smoothest field's complex values per face (see trivcon/auto.h).
+// The smoothest field's complex values per face (see docs/auto.md, "The eigen-solve").
 std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o,
                                       const std::vector<Complex>* guidance, AutoTimings& time, std::string& ordering_used) {
   auto t0 = Clock::now();
@@ -152,7 +151,7 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   const int n = static_cast<int>(face_of.size());
   if (n == 0) return u;
 
-  // The shift ε of trivcon/auto.h and the upper triangle of the Hermitian A + εM in compressed columns
+  // The shift ε of docs/auto.md and the upper triangle of the Hermitian A + εM in compressed columns
   // (n × n complex, values as (real, imaginary) pairs).
   Eigen::VectorXd diag = Eigen::VectorXd::Zero(t.num_faces);
   for (int e = 0; e < t.num_edges; ++e)
@@ -201,11 +200,11 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   ordering_used = symbolic.ordering;
   // The numeric factor by trivcon's own supernodal code (src/linalg/supernodal.h, the same that factors the
   // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another,
-  // and took 3-4 times as long on the 400k-face sphere (2.8-3.1 s against 0.73-1.06 s after METIS).
+  // and took several times as long (BENCHMARKS.md, "The cost of --auto at 400k faces").
   if (const int minor = linalg::factorize_complex(*L, outer, inner, values, c); minor < n)
     throw Error("automatic singularities: the smoothest-field matrix is not positive definite (column " + std::to_string(minor) +
                 " of " + std::to_string(n) + "): a non-finite or degenerate weight");
-  // The solves below on both cores (src/linalg/substitution.h): CHOLMOD's own took 0.1 s each at 400k faces.
+  // The solves below on both cores (src/linalg/substitution.h): CHOLMOD's own, on one core, were several times slower.
   const linalg::Substitution<Complex> substitution(*L);
   time.factor = seconds_since(t0);
 

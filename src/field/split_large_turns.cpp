@@ -42,7 +42,7 @@ RefinedDesign split_large_turns(const FieldDesigner& designer, const MatrixX3i& 
     if (reweighting) {
       if (reweights == 3 * max_rounds) break;
       ++reweights;
-      // Lower the weights of the edges still turning too much (see refine.h), on a designer of our own.
+      // Lower the weights of the edges still turning too much (see trivcon/split_large_turns.h), on a designer of our own.
       if (!out.designer) {
         out.designer = std::make_unique<FieldDesigner>(out.V, out.F, options);
         std::vector<int> faces;

@@ -5,7 +5,7 @@
 // we must keep the file's vertex order and ids exactly (no merging, no dropping of unreferenced
 // vertices), report every error with the file and the 1-based line or byte offset, survive hostile
 // input (truncation, 10^12-element headers) without crashing or allocating by a header's word, and
-// read a 33 MB ASCII PLY in a fraction of a second. The libraries Debian ships give none of these
+// read large ASCII files fast (BENCHMARKS.md, "Against the targets"). The libraries Debian ships give none of these
 // together. All parsing works on the whole file in memory: lines are found with memchr and numbers
 // parsed with std::from_chars (correctly rounded, locale-independent, and many times faster than
 // iostream >>).

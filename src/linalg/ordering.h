@@ -1,6 +1,6 @@
 // Internal: fill-reducing orders and their elimination trees.
 // - The pattern and elimination tree of the normal matrix's vertex block, to postorder a fill-reducing order
-//   (see CholeskyEngine::vertex_order in solver.cpp).
+//   (see vertex_order in src/connection/cholesky_engine.cpp).
 // - A nested dissection by coordinates, the second candidate order of the smoothest field's matrix
 //   (trivcon/auto.h).
 #pragma once
@@ -26,10 +26,10 @@ std::vector<int> elimination_tree(const Pattern& pattern, const std::vector<int>
 // (a mesh's faces by their centroids): the rows are split at the median of the axis along which their
 // points spread most; the rows of the smaller side that have a neighbour on the other side are the
 // separator, ordered after both halves, which are ordered the same way, down to `leaf` rows (sorted along
-// their own longest axis). Why not METIS_NodeND, which finds smaller separators: on the 400k-face sphere it
-// takes 1.2-1.5 s, against 0.07 s for this. Why not only this: on scanned meshes (the dragon, armadillo) its
-// plane cuts meet the surface in long curves and it needs 3-4 times AMD's flops, so it is a candidate to
-// compare, not a replacement (trivcon/auto.h takes the one with fewer flops). Deterministic.
+// their own longest axis). Why not METIS_NodeND, which finds smaller separators: it takes many times as
+// long as this. Why not only this: on scanned meshes its plane cuts meet the surface in long curves and it
+// needs several times AMD's flops (BENCHMARKS.md, "Figures that were in code comments"), so it is a candidate to
+// compare, not a replacement (the smoothest field takes the one with fewer flops, docs/auto.md). Deterministic.
 std::vector<int> coordinate_dissection(const Pattern& pattern, const std::vector<std::array<double, 3>>& point, int leaf = 16);
 
 }  // namespace trivcon::linalg

@@ -140,7 +140,7 @@ void Substitution<T>::backward_in_factor_order(T* z) const {
   // entries (v: its rows, in its row order), then solves its columns last to first, each column read from
   // its last row up: the supernodes come in decreasing order, so the whole pass reads the factor as one
   // descending stream, which the processor prefetches (read in ascending order per supernode, the pass
-  // took 1.8 times as long as the forward one).
+  // took much longer than the forward one).
   auto backward = [&](int s, std::vector<T>& v) {
     const int ncol = S.cols(s), nrow = S.height(s);
     const T* panel = values + S.px[s];

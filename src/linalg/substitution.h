@@ -3,7 +3,7 @@
 // Why not cholmod_solve: CHOLMOD 3 (Debian 12) visits the supernodes one after another, on one core, with a
 // BLAS call per supernode even where a supernode is a few columns wide (most of them, on a mesh). The inverse
 // iterations of the smoothest field (trivcon/auto.h) are a chain of such solves, which took as long as the
-// factorization itself at 400k faces. Here, as for the factorization (src/linalg/supernodal.h), the
+// factorization itself on large meshes. Here, as for the factorization (src/linalg/supernodal.h), the
 // supernodal elimination tree is split into a top and disjoint subtrees, one set per thread:
 // - forward, L y = P b: each thread its subtrees (descendants first); what a subtree sends to rows of the
 //   top goes to a buffer of that thread's own and is added afterwards, so the result does not depend on
@@ -15,8 +15,8 @@
 // columns are read as a stream (forward: first to last; backward: last to first, so that the whole
 // backward pass is one descending stream the processor prefetches), with plain loops (BLAS's per-call cost
 // is more than most supernodes' work). The split is balanced by entries and goes down the tree while that
-// shortens top + heaviest part (split_tree's `refine`). At 400k faces on 2 cores a complex solve takes
-// 30 ms (1.9e7 factor entries: about 20 GB/s), against 0.1 s for cholmod_solve.
+// shortens top + heaviest part (split_tree's `refine`). It is several times faster than cholmod_solve
+// (BENCHMARKS.md, "Figures that were in code comments").
 // solve and solve_in_factor_order are not for concurrent calls on one object (their work vectors are shared).
 #pragma once
 #include <cholmod.h>

@@ -43,9 +43,9 @@ namespace trivcon::linalg {
 namespace {
 
 // Below these sizes a block is computed by inlined loops (Eigen; our own panel factorization) instead of
-// a BLAS call. Most supernodes near the leaves are a few columns wide; on the 400k-face meshes the
-// thresholds (from all-BLAS to none below 10⁹ flops) moved the time by less than the machine's noise, except
-// that without BLAS at all the top of the tree takes 4× longer.
+// a BLAS call. Most supernodes near the leaves are a few columns wide; the thresholds (tried from all-BLAS
+// to none below 10⁹ flops) moved the time by less than the machine's noise, except that without BLAS at all
+// the top of the tree takes several times longer (BENCHMARKS.md, "Figures that were in code comments").
 constexpr double kBlasUpdateFlops = 8192;  // ndrow2 · ndrow1 · ndcol of one descendant's update
 constexpr int kBlasColumns = 24;           // columns of a supernode's own factorization
 
@@ -379,9 +379,9 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
   // lists of pending updates (`head`); its lists for the supernodes of the top are handed over when both
   // are done. Then the top, one supernode at a time, with OpenBLAS's threads inside the large dense
   // blocks there. (Gathering each thread's updates to the top in buffers of its own, so that they are
-  // computed on both cores too, saved nothing: on the 400k-face sphere it took each thread as long as it
-  // saved the top.) The result does not depend on the timing of the threads: each part is computed in
-  // its own order and the lists are handed over in a fixed one.
+  // computed on both cores too, saved nothing: it took each thread as long as it saved the top;
+  // BENCHMARKS.md, "Tried and dropped".) The result does not depend on the timing of the threads: each
+  // part is computed in its own order and the lists are handed over in a fixed one.
   const bool several = parts > 1 && !split.part[1].empty();
   std::vector<std::vector<int>> head(parts);
   std::vector<int> failed(parts, -1);

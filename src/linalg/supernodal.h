@@ -1,6 +1,6 @@
 // Internal: the numeric supernodal Cholesky factorization behind ConnectionSolver, on several threads.
 //
-// CHOLMOD does the ordering and the symbolic factorization (trivcon/solver.h); this computes the values of
+// CHOLMOD does the ordering and the symbolic factorization (docs/solver.md); this computes the values of
 // CHOLMOD's own supernodal factor object, so that everything else (CHOLMOD's solves, the solver's sparse
 // forward update and backward substitution) reads it unchanged. Why not cholmod_factorize: CHOLMOD 3
 // (Debian 12) visits the supernodes one after another and uses the second core only inside BLAS calls on

@@ -206,7 +206,7 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& t, int threads) {
       const double epsilon = component_epsilon[c];
       // A face whose margin is at least kMollifyReach δ keeps its own cotangents: adding ε ≤ δ to its lengths
       // would change them by less than about 1/kMollifyReach relative (and recomputing every face of a large
-      // component cost 15 % of the geometry on the dragon).
+      // component made the geometry measurably slower: BENCHMARKS.md, "Exact on slivers").
       if (epsilon == 0 || shortfall[f] < -(kMollifyReach - 1) * kMollifyFactor * component_length[c] / component_edges[c]) continue;
       const double l[3] = {length[t.face_edges(f, 0)] + epsilon, length[t.face_edges(f, 1)] + epsilon,
                            length[t.face_edges(f, 2)] + epsilon};
