@@ -1,4 +1,5 @@
-// trivcon render MESH --field F -o picture.png [options]: a picture of a field (trivcon/render.h).
+// trivcon render MESH (--field F | --uv P.obj) -o picture.png [options]: a picture of a field and/or of a map's
+// checkerboard (trivcon/render.h).
 #include <iostream>
 #include <tuple>
 
@@ -15,7 +16,7 @@ namespace trivcon::cli {
 namespace {
 
 struct RenderCommand {
-  std::string mesh, field, output, size = "1200x900", view = "30,20", style = "hedgehog", up = "y", streamlines_out;
+  std::string mesh, field, uv, output, size = "1200x900", view = "30,20", style = "hedgehog", up = "y", streamlines_out;
   int N = 0;  // 0: the field file's
   std::vector<std::string> sing_files, sings;
   double spacing = 11;
@@ -60,12 +61,15 @@ void run_render(const RenderCommand& c) {
   check_coordinate_range(mesh.V, t);
   const Geometry g = compute_geometry(mesh.V, t);
   int file_N = 0;
-  const MatrixX3d directions = read_field(c.field, t.num_faces, &file_N);
+  // Without --field (a checkerboard of --uv alone): a zero field, not drawn.
+  const MatrixX3d directions = c.field.empty() ? MatrixX3d(g.frame_x) : read_field(c.field, t.num_faces, &file_N);
   const int N = c.N > 0 ? c.N : std::max(1, file_N);
   const Field field = field_from_directions(g, directions, N);
 
   std::vector<std::pair<int, int>> singularities;
   if (c.sing_files.empty() && c.sings.empty()) {
+    if (c.field.empty()) {}  // nothing to mark
+    else
     // Nothing given: mark where the field itself is singular.
     singularities = singular_vertices(field_indices(t, g, compute_cycles(t), field).vertex);
   } else {
@@ -89,6 +93,15 @@ void run_render(const RenderCommand& c) {
   o.smooth_shading = !c.flat;
   o.legend = !c.no_legend;
   o.sharp_edges = c.features.edges(mesh.V, t, g);
+  if (!c.uv.empty()) {  // the file's corners in the input's order, the renderer's in the topology's
+    const Eigen::MatrixXd input = read_corner_uv(c.uv, mesh.F);
+    o.corner_uv.resize(t.num_faces, 6);
+    for (int f = 0; f < t.num_faces; ++f)
+      for (int k = 0; k < 3; ++k)
+        for (int j = 0; j < 3; ++j)
+          if (mesh.F(f, j) == t.F(f, k)) o.corner_uv(f, 2 * k) = input(f, 2 * j), o.corner_uv(f, 2 * k + 1) = input(f, 2 * j + 1);
+  }
+  if (c.field.empty()) o.draw_field = false, o.legend = o.legend && !singularities.empty();
   if (o.style == FieldStyle::Streamlines || !c.streamlines_out.empty()) {
     const std::vector<Streamline> lines = trace_streamlines(mesh.V, t, g, field, singularities, render_streamline_options(mesh.V, t, o));
     if (!c.streamlines_out.empty()) write_streamlines_obj(c.streamlines_out, lines);
@@ -106,7 +119,10 @@ void register_render(CLI::App& app) {
   static RenderCommand c;
   auto* cmd = app.add_subcommand("render", "Draw a field on its surface to a PNG (hedgehog glyphs or streamlines)");
   cmd->add_option("mesh", c.mesh, "Mesh file: .obj .off .ply, optionally .gz")->required();
-  cmd->add_option("--field", c.field, "Field: trivcon's .txt or .ply, Directional's .rawfield or QuadWild's .rosy")->required();
+  auto* field = cmd->add_option("--field", c.field, "Field: trivcon's .txt or .ply, Directional's .rawfield or QuadWild's .rosy");
+  auto* uv = cmd->add_option("--uv", c.uv,
+                             "OBJ with (u, v) per corner (trivcon param -o): draw its unit squares as a checkerboard on the surface");
+
   cmd->add_option("-o,--output", c.output, "PNG to write")->required();
   cmd->add_option("-N,--symmetry", c.N, "Symmetry N (default: the field file's)")->check(CLI::Range(1, 1000));
   cmd->add_option("-s,--singularities", c.sing_files, "Singularity file to mark (default: the field's own singular vertices)");
@@ -120,7 +136,10 @@ void register_render(CLI::App& app) {
   cmd->add_flag("--flat", c.flat, "Flat shading (one normal per face)");
   cmd->add_flag("--no-legend", c.no_legend, "Leave out the legend");
   c.features.add_to(cmd, "drawn as lines");
-  cmd->callback([] { run_render(c); });
+  cmd->callback([field, uv] {
+    if (field->count() == 0 && uv->count() == 0) throw CLI::RequiredError("--field or --uv");
+    run_render(c);
+  });
 }
 
 }  // namespace trivcon::cli

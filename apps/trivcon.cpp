@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   trivcon::cli::register_info(app);
   trivcon::cli::register_solve(app);
+  trivcon::cli::register_param(app);
   trivcon::cli::register_check(app);
   trivcon::cli::register_render(app);
 #ifdef TRIVCON_EDITOR

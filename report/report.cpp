@@ -1,5 +1,7 @@
 #include "report.h"
 
+#include <cmath>
+
 #include "summary.h"
 #include "trivcon/matching.h"
 #include "trivcon/blas.h"
@@ -103,6 +105,38 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
   // Whether a reader of the per-face field (closest matching) sees exactly the prescription (Design::field_exact).
   report["field_exact"] = d.field_exact;
   return report;
+}
+
+nlohmann::ordered_json param_report(const Parametrization& param) {
+  const ParamQuality& q = param.quality;
+  auto finite = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); };
+  return {{"edge_length", param.edge_length},
+          {"seamless", q.seamless},
+          {"cones", q.cones},
+          {"cut_edges", q.cut_edges},
+          {"integer_unknowns", q.integer_unknowns},
+          {"rounding_rounds", q.rounding_rounds},
+          {"factorizations", q.factorizations},
+          {"stiffening_rounds", q.stiffening_rounds},
+          {"folds_real_valued", q.folds_real_valued},
+          {"folds_rounded", q.folds_rounded},
+          {"cones_moved", q.cones_moved},
+          {"flipped_faces", q.flipped_faces},
+          {"degenerate_faces", q.degenerate_faces},
+          {"first_flipped", q.first_flipped},
+          {"max_transition_residual", q.max_transition_residual},
+          {"max_cone_offset", q.max_cone_offset},
+          {"max_cone_angle_error", q.max_cone_angle_error},
+          {"aligned_edges", q.aligned_edges},
+          {"unaligned_edges", q.unaligned_edges},
+          {"max_alignment_error", q.max_alignment_error},
+          {"mean_distortion", q.mean_distortion},
+          {"max_distortion", finite(q.max_distortion)},  // null: a degenerate (u, v) triangle
+          {"unit_squares", q.unit_squares},
+          {"target_squares", q.target_squares},
+          {"non_unimodular", q.non_unimodular},
+          {"seconds", {{"cut", q.seconds_cut}, {"setup", q.seconds_setup}, {"rounding", q.seconds_rounding},
+                       {"stiffening", q.seconds_stiffening}, {"check", q.seconds_check}}}};
 }
 
 }  // namespace trivcon::cli

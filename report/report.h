@@ -5,6 +5,7 @@
 
 #include "trivcon/design.h"
 #include "trivcon/io.h"
+#include "trivcon/param.h"
 
 namespace trivcon::cli {
 
@@ -19,5 +20,9 @@ struct ReportRun {
 
 nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, const FieldDesigner& designer,
                                     const IndexPrescription& prescription, const Design& d);
+
+// The "param" entry of `param`'s and `quad`'s reports: the map's size, its integers, what it promises
+// checked on the result (ParamQuality) and the time per stage.
+nlohmann::ordered_json param_report(const Parametrization& param);
 
 }  // namespace trivcon::cli

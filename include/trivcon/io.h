@@ -45,6 +45,12 @@ std::string read_file_bytes(const std::string& path);
 
 void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F);
 void write_ply(const std::string& path, const MatrixX3d& V, const MatrixX3i& F);  // binary little-endian, double x y z, int list
+// OBJ with one texture coordinate per corner: the vertices and faces as given, then `vt u v` for corner k of
+// face f at line 3f + k + 1 of the vt lines, and `f a/ta b/tb c/tc`. corner_uv: F × 6 ((u, v) of corners 0, 1, 2).
+void write_uv_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Eigen::MatrixXd& corner_uv);
+// The (u, v) of every corner (F × 6) from an OBJ whose faces are F's triangles, in order, with 'v/vt' corners
+// (what write_uv_obj writes). Throws trivcon::Error naming the file and line of anything else.
+Eigen::MatrixXd read_corner_uv(const std::string& path, const MatrixX3i& F);
 
 // Writes via `fill` into a temporary file beside `path`, then renames it into place. If `fill`
 // throws or the stream fails, the temporary is removed and `path` is untouched. All of trivcon's

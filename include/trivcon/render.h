@@ -38,6 +38,7 @@
 //   lists N and the indices present, in the image corner where it hides the least of the surface (lower left
 //   on ties). Boundary loops: green lines. Sharp (feature) edges given in RenderOptions::sharp_edges
 //   (trivcon/features.h): magenta lines of the same width, with a legend row.
+// - Checkerboard (corner_uv): squares with floor(u) + floor(v) odd take Palette::checker instead of the front colour.
 // - Sizes in pixels scale with the image's smaller side (the values below are for 900 pixels).
 // - Deterministic: identical inputs give identical pixels and bytes (single thread, no clocks, no
 //   uninitialised memory).
@@ -81,6 +82,7 @@ struct Palette {
   Rgb positive{215, 35, 35};  // singularity with index > 0
   Rgb negative{30, 80, 215};  // index < 0
   Rgb text{40, 40, 40};
+  Rgb checker{120, 140, 175};  // the darker squares of a (u, v) checkerboard (RenderOptions::corner_uv)
 };
 
 struct RenderOptions {
@@ -93,6 +95,10 @@ struct RenderOptions {
   bool legend = true;
   std::vector<int> sharp_edges;  // edge ids (trivcon/topology.h) drawn as feature lines; empty: none
   int supersampling = 3;         // samples per pixel along each axis (anti-aliasing)
+  // Empty, or F × 6: (u, v) of corners 0, 1, 2 of each face of Topology::F (trivcon/param.h). The surface is then
+  // a checkerboard of unit squares of (u, v), interpolated perspective-correctly: the grid of a seamless map.
+  Eigen::MatrixXd corner_uv;
+  bool draw_field = true;  // false: the surface (and checkerboard) only, no glyphs or streamlines
   Palette palette;
 };
 

@@ -97,6 +97,43 @@ void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) 
   write_file_atomically(path, [&](std::ostream& out) { out.write(text.data(), static_cast<std::streamsize>(text.size())); });
 }
 
+void write_uv_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Eigen::MatrixXd& corner_uv) {
+  check_writable(path, V, F);
+  if (corner_uv.rows() != F.rows() || corner_uv.cols() != 6)
+    throw Error("cannot write " + path + ": the texture coordinates are not one (u, v) per corner of every face");
+  if (!corner_uv.allFinite()) throw Error("cannot write " + path + ": a texture coordinate is not finite");
+  std::string text = "# trivcon seamless parametrization: " + std::to_string(V.rows()) + " vertices, " + std::to_string(F.rows()) +
+                     " faces, one vt per corner\n";
+  text.reserve(text.size() + 64 * V.rows() + 90 * F.rows());
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    text += 'v';
+    for (int axis = 0; axis < 3; ++axis) {
+      text += ' ';
+      append_coordinate(text, V(v, axis));
+    }
+    text += '\n';
+  }
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      text += "vt ";
+      append_coordinate(text, corner_uv(f, 2 * c));
+      text += ' ';
+      append_coordinate(text, corner_uv(f, 2 * c + 1));
+      text += '\n';
+    }
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    text += 'f';
+    for (int c = 0; c < 3; ++c) {
+      text += ' ';
+      append_number(text, F(f, c) + 1);
+      text += '/';
+      append_number(text, 3 * f + c + 1);
+    }
+    text += '\n';
+  }
+  write_file_atomically(path, [&](std::ostream& out) { out.write(text.data(), static_cast<std::streamsize>(text.size())); });
+}
+
 void write_ply(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
   check_writable(path, V, F);
   std::string data = "ply\nformat binary_little_endian 1.0\ncomment written by trivcon\nelement vertex " + std::to_string(V.rows()) +

@@ -170,10 +170,12 @@ class Renderer {
       draw_surface();
       draw_boundary();
       draw_sharp_edges();
-      if (streamlines != nullptr)
+      if (!o_.draw_field) {
+      } else if (streamlines != nullptr) {
         for (const Streamline& line : *streamlines) draw_streamline(line);
-      else
+      } else {
         draw_hedgehog();
+      }
       draw_singularities(singularities);
     }
     if (o_.legend) draw_legend(singularities);
@@ -245,6 +247,8 @@ class Renderer {
     const ScreenPoint& c = screen_[t_.F(f, 2)];
     const double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
     if (!(std::abs(area) > 1e-12)) return;
+    const Eigen::MatrixXd& uv = o_.corner_uv;
+    const bool checker = uv.rows() == t_.num_faces && uv.cols() == 6 && base == o_.palette.front;
     // wa(x, y) = ax·x + ay·y + a0, likewise wb; wc = 1 − wa − wb.
     const double ax = (b.y - c.y) / area, ay = (c.x - b.x) / area, a0 = (b.x * c.y - b.y * c.x) / area;
     const double bx = (c.y - a.y) / area, by = (a.x - c.x) / area, b0 = (c.x * a.y - c.y * a.x) / area;
@@ -262,7 +266,13 @@ class Renderer {
         const float inverse_depth = static_cast<float>(wa * a.inverse_depth + wb * b.inverse_depth + wc * c.inverse_depth);
         if (inverse_depth <= canvas_.inverse_depth[k]) continue;
         canvas_.inverse_depth[k] = inverse_depth;
-        canvas_.set(k, scaled(base, wa * light[0] + wb * light[1] + wc * light[2]));
+        Rgb colour = base;
+        if (checker) {  // (u, v) interpolated perspective-correctly: weights over depth, normalised
+          const double pa = wa * a.inverse_depth, pb = wb * b.inverse_depth, pc = wc * c.inverse_depth, sum = pa + pb + pc;
+          const double u = (pa * uv(f, 0) + pb * uv(f, 2) + pc * uv(f, 4)) / sum, v = (pa * uv(f, 1) + pb * uv(f, 3) + pc * uv(f, 5)) / sum;
+          if (((static_cast<long long>(std::floor(u)) + static_cast<long long>(std::floor(v))) & 1) != 0) colour = o_.palette.checker;
+        }
+        canvas_.set(k, scaled(colour, wa * light[0] + wb * light[1] + wc * light[2]));
       }
     }
   }
@@ -488,6 +498,9 @@ void check_options(const Topology& t, const Field& field, const RenderOptions& o
   if (field.N < 1) throw Error("render: field N must be at least 1");
   if (field.angle.size() != t.num_faces)
     throw Error("render: the field has " + std::to_string(field.angle.size()) + " faces, the mesh " + std::to_string(t.num_faces));
+  if (o.corner_uv.size() > 0 && (o.corner_uv.rows() != t.num_faces || o.corner_uv.cols() != 6))
+    throw Error("render: the (u, v) are not one pair per corner of the mesh's " + std::to_string(t.num_faces) + " faces");
+  if (!o.corner_uv.allFinite()) throw Error("render: a (u, v) is not finite");
 }
 
 Image render(const MatrixX3d& V, const Topology& t, const Geometry& g, const Field& field,

@@ -1,0 +1,134 @@
+// trivcon param MESH [field options] (--target-faces K | --edge-length H) -o P.obj: the seamless integer-grid map
+// of the field (trivcon/param.h), written as the input mesh with one texture coordinate per corner.
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "commands.h"
+#include "field_options.h"
+#include "outputs.h"
+#include "report.h"
+#include "summary.h"
+#include "trivcon/design.h"
+#include "trivcon/error.h"
+#include "trivcon/field_io.h"
+#include "trivcon/param.h"
+#include "trivcon/request.h"
+
+namespace trivcon::cli {
+
+namespace {
+
+struct ParamCommand {
+  std::string mesh, output, sing_out, report;
+  FieldOptions field;
+  double target_faces = 0, edge_length = 0;
+  bool quiet = false;
+};
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << std::setprecision(3) << v;
+  return s.str();
+}
+
+void run_param(const ParamCommand& o) {
+  const auto t0 = Clock::now();
+  const MeshData mesh = load_mesh(o.mesh);
+  const double read_seconds = seconds_since(t0);
+  FieldDesigner designer(mesh.V, mesh.F, o.field.solver_options());
+  FieldRequest request = o.field.request(designer);
+  // With --auto, a ± pair closer than one unit of the map cannot sit on two integer points without folding it:
+  // unless --auto-cancel says otherwise, pairs within one quad edge cancel.
+  double area = 0;
+  for (int f = 0; f < designer.topology().num_faces; ++f) area += designer.geometry().face_area[f];
+  const double unit = o.edge_length > 0 ? o.edge_length : std::sqrt(area / o.target_faces);
+  if (request.auto_place && o.field.auto_cancel == 0) request.auto_options.cancel_distance = unit, request.auto_options.cancel_absolute = true;
+  const FieldOutcome out = solve_request(designer, mesh.F, request);
+  if (!out.verified)
+    throw Error("the field did not pass verification, so no map was made: " + verification_failure(designer, out.design));
+  const Topology& t = designer.topology();
+  ParamOptions options;
+  options.edge_length = o.edge_length;
+  options.target_faces = o.target_faces;
+  if (request.align_boundary)
+    for (int e = 0; e < t.num_edges; ++e)
+      if (t.is_boundary_edge(e)) options.aligned_edges.push_back(e);
+  options.aligned_edges.insert(options.aligned_edges.end(), out.sharp_edges.begin(), out.sharp_edges.end());
+  const Parametrization param = parametrize(designer, out.design, options);
+  const ParamQuality& q = param.quality;
+
+  const auto t1 = Clock::now();
+  StagedOutputs staged;
+  staged.write(o.output, [&](const std::string& path) { write_uv_obj(path, mesh.V, mesh.F, input_corner_uv(param, t, mesh.F)); });
+  if (!o.sing_out.empty())
+    staged.write(o.sing_out, [&](const std::string& path) { write_singularities(path, out.prescription.vertex, 4); });
+  if (!o.report.empty()) {
+    nlohmann::ordered_json report = {{"mesh", o.mesh},
+                                     {"vertices", t.num_vertices},
+                                     {"faces", t.num_faces},
+                                     {"components", t.components.size()},
+                                     {"euler_characteristic", t.euler_characteristic()},
+                                     {"boundary_loops", t.boundary_loops.size()},
+                                     {"N", 4},
+                                     {"singularities", nlohmann::ordered_json::array()},
+                                     {"field", {{"verified", out.verified}, {"energy", out.design.connection.energy}}},
+                                     {"param", param_report(param)},
+                                     {"seconds", {{"read", read_seconds}, {"write", seconds_since(t1)}}}};
+    for (size_t i = 0; i < param.cones.size(); ++i)
+      report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
+    staged.write(o.report, [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& s) { s << report.dump(2) << "\n"; }); });
+  }
+  staged.commit();
+
+  if (!o.quiet)
+    std::cout << "mesh " << o.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
+              << " component(s), chi " << t.euler_characteristic() << ", " << t.boundary_loops.size() << " boundary loop(s)\n"
+              << "field: N 4, " << param.cones.size() << " singular vertices, verified\n"
+              << "map: edge length " << fmt(param.edge_length) << ", " << fmt(q.unit_squares) << " unit squares (target " << fmt(q.target_squares)
+              << "), " << q.cut_edges << " cut edges, " << q.integer_unknowns << " integers rounded in " << q.rounding_rounds << " solves\n"
+              << "seamless: " << (q.seamless ? "yes" : "NO") << " (transition residual " << fmt(q.max_transition_residual) << ", cones off integer points by "
+              << fmt(q.max_cone_offset) << ", cone angles off by " << fmt(q.max_cone_angle_error) << " rad"
+              << (q.aligned_edges + q.unaligned_edges > 0
+                      ? ", " + std::to_string(q.aligned_edges) + " aligned edges off iso-lines by " + fmt(q.max_alignment_error) +
+                            (q.unaligned_edges ? ", " + std::to_string(q.unaligned_edges) + " edges the field crosses obliquely left free" : "")
+                      : std::string())
+              << ")\n"
+              << "flipped faces " << q.flipped_faces << ", degenerate " << q.degenerate_faces << " (" << q.stiffening_rounds
+              << " stiffening rounds); distortion mean " << fmt(q.mean_distortion) << ", max " << fmt(q.max_distortion) << "\n"
+              << "time: read " << fmt(read_seconds) << " s, field " << fmt(out.design.solve_seconds + out.design.field_seconds) << " s, map "
+              << fmt(q.seconds_cut + q.seconds_setup + q.seconds_rounding + q.seconds_stiffening + q.seconds_check) << " s (cut "
+              << fmt(q.seconds_cut) << ", setup " << fmt(q.seconds_setup) << ", rounding " << fmt(q.seconds_rounding) << ", stiffening "
+              << fmt(q.seconds_stiffening) << ", check " << fmt(q.seconds_check) << ")\n";
+  if (const std::string w = param_warning(param); !w.empty()) std::cerr << "trivcon: warning: " << w << "\n";
+  if (!q.seamless) exit_code = kVerificationFailed;
+}
+
+}  // namespace
+
+void register_param(CLI::App& app) {
+  static ParamCommand o;
+  auto* cmd = app.add_subcommand("param", "Seamless integer-grid parametrization of the cross field (N = 4): an OBJ with one vt per corner");
+  cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply, optionally .gz")->required();
+  o.field.add_to(cmd, true);
+  auto* target = cmd->add_option("--target-faces", o.target_faces, "About this many unit squares (quads) over the surface")
+                     ->check(CLI::PositiveNumber);
+  auto* length = cmd->add_option("--edge-length", o.edge_length, "The length of one unit of (u, v), in the mesh's units")
+                     ->check(CLI::PositiveNumber);
+  target->excludes(length);
+  cmd->add_option("-o,--output", o.output, "OBJ of the input mesh with (u, v) per corner ('f a/ta b/tb c/tc')")->required();
+  cmd->add_option("--sing-out", o.sing_out, "Singularity file of the singularities used ('VERTEX INDEX' lines, readable by -s)");
+  cmd->add_option("--report", o.report, "JSON report: the field, the map's integers and quality, time per stage");
+  cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");
+  cmd->callback([target, length] {
+    if (target->count() == 0 && length->count() == 0)
+      throw CLI::ValidationError("--target-faces / --edge-length", "give the scale of the map: one of them");
+    if (o.field.split_large_turns)
+      throw CLI::ValidationError("--split-large-turns",
+                                 "not needed by param: the map uses the connection's own matching, so large turns are no problem");
+    run_param(o);
+  });
+}
+
+}  // namespace trivcon::cli

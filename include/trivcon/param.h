@@ -1,0 +1,95 @@
+// trivcon/param.h: a seamless integer-grid parametrization from a cross field (N = 4) and its trivial
+// connection (Kälberer, Nieser & Polthier 2007; Bommes, Zimmer & Kobbelt 2009), the map a quad mesh is
+// extracted from (trivcon/quad.h). The mathematics and its choices: docs/param.md.
+//
+//   trivcon::Parametrization p = trivcon::parametrize(designer, design, {.edge_length = 0.05});
+//   p.uv.row(3 * f + k)   // (u, v) of corner k of face f
+//
+// Conventions
+// - Corners: row 3f + k of `uv` is corner k of face f of Topology::F (the input's faces, with the corners of
+//   a re-oriented face in the topology's order; input_corner_uv gives them in the input's order).
+// - The cut: interior edges across which the map is discontinuous (a spanning tree of the dual per component,
+//   its complement pruned back to the singularities, the handles' loops and the boundary). Off the cut, the two
+//   faces of an edge share the (u, v) of its ends. Across a cut edge e, from L = edge_faces(e, 0) to R:
+//   φ_R = J^r φ_L + t at both ends of e, J the rotation by +π/2, r = rotation[e] in [0, 4) and t =
+//   translation.row(e) two whole numbers. r is the connection's own matching (trivcon/matching.h,
+//   connection_matching) composed with the per-face choice of which of the four directions is u: never a
+//   matching recomputed from the directions, so large turns of the connection are no problem.
+// - Gradients: in every face, ∇u follows the chosen direction of the field and ∇v its quarter turn
+//   counter-clockwise, both of length about 1 / edge_length: one unit of (u, v) is one quad edge.
+// - Integers: every translation, the (u, v) of every singular vertex and the constant coordinate of every
+//   aligned edge are whole numbers (greedy rounding with re-solves); the solve is our sparse Cholesky.
+#pragma once
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "trivcon/design.h"
+
+namespace trivcon {
+
+struct ParamOptions {
+  double edge_length = 0;   // the quad edge length in the mesh's units (> 0 wins over target_faces)
+  double target_faces = 0;  // otherwise: about this many unit squares (edge_length = √(area / target_faces))
+  // Edges to put on integer iso-lines (topology edge ids): boundary edges (align_boundary) and sharp edges.
+  // An edge is aligned in each face beside it whose field runs along it or across it (within 0.1 rad);
+  // the others are counted in ParamQuality::unaligned_edges.
+  std::vector<int> aligned_edges;
+  // Greedy rounding: each round fixes the integers nearest to whole numbers, this fraction of those left (at
+  // least one), then re-solves.
+  double rounding_fraction = 0.3;
+  int max_stiffening_rounds = 20;  // re-solves with the flipped faces stiffened (MIQ's §5), integers kept
+};
+
+struct ParamQuality {
+  int faces = 0, cones = 0, cut_edges = 0;
+  int integer_unknowns = 0;   // free whole numbers the rounding fixed
+  int rounding_rounds = 0;    // solves of the rounding
+  int factorizations = 0;     // numeric factorizations of the map's system in all
+  int stiffening_rounds = 0;  // re-solves against flips
+  int folds_real_valued = 0;  // folded faces of the first, real-valued map (before stiffening)
+  int folds_rounded = 0;      // folded faces right after the rounding (before stiffening again)
+  int cones_moved = 0;        // singularities moved to a neighbouring integer point against a fold or a shared point
+  int flipped_faces = 0;      // faces whose (u, v) triangle is inverted
+  int degenerate_faces = 0;   // faces whose (u, v) triangle has (nearly) zero area
+  std::vector<int> first_flipped;  // up to 10 ids of flipped or degenerate faces
+  double max_transition_residual = 0;  // over cut edges: how far φ_R − J^r φ_L is from one whole vector at both ends
+  double max_cone_offset = 0;          // distance of a singular vertex's (u, v) from the nearest integer point
+  double max_cone_angle_error = 0;     // |Σ (u, v) corner angles − 2π(1 − k)| at singular vertices, radians
+  int aligned_edges = 0, unaligned_edges = 0;
+  double max_alignment_error = 0;      // distance of an aligned edge's constant coordinate from a whole number
+  double mean_distortion = 0;          // area-weighted mean of σ_max / σ_min of the map's Jacobian
+  double max_distortion = 0;           // its largest (infinite on a degenerate (u, v) triangle)
+  double unit_squares = 0;             // total (u, v) area
+  double target_squares = 0;           // mesh area / edge_length²
+  int non_unimodular = 0;              // integer relations the elimination could not keep whole (0 expected)
+  double seconds_cut = 0, seconds_setup = 0, seconds_rounding = 0, seconds_stiffening = 0, seconds_check = 0;
+  // True when the map is seamless (transitions whole to 1e-6), every cone on an integer point, every aligned edge
+  // on an iso-line: what the linear constraints promise. Folds (and a cone angle off by whole turns, which a
+  // fold around the cone makes) are counted above.
+  bool seamless = false;
+};
+
+struct Parametrization {
+  Eigen::MatrixXd uv;               // 3F × 2, see the conventions
+  std::vector<int> cut_edges;       // increasing edge ids
+  Eigen::VectorXi rotation;         // per edge, r in [0, 4) on cut edges, 0 elsewhere
+  Eigen::MatrixXi translation;      // per edge × 2, t on cut edges, 0 elsewhere
+  std::vector<int> cones;           // singular interior vertices, increasing
+  std::vector<int> cone_index;      // n per cone (index n / 4)
+  double edge_length = 0;
+  ParamQuality quality;
+};
+
+// The map of `design`'s field (N = 4) on `designer`'s mesh. Throws trivcon::Error for another N, a missing
+// or non-positive scale, an aligned edge id out of range, or a system our factorization finds not positive definite.
+Parametrization parametrize(const FieldDesigner& designer, const Design& design, const ParamOptions& options);
+
+// The (u, v) of the corners of the input's faces `F` (the faces the designer was built from), F × 6: (u, v)
+// of corner 0, 1, 2 in the input's corner order.
+Eigen::MatrixXd input_corner_uv(const Parametrization& param, const Topology& topology, const MatrixX3i& F);
+
+// One sentence on what is wrong with the map ("" when seamless without flips): for a report or a warning.
+std::string param_warning(const Parametrization& param);
+
+}  // namespace trivcon

@@ -1,0 +1,88 @@
+#include "linalg/sparse_cholesky.h"
+
+#include <cholmod.h>
+
+#include <string>
+
+#include "linalg/cholmod.h"
+#include "linalg/substitution.h"
+#include "linalg/supernodal.h"
+#include "trivcon/error.h"
+
+namespace trivcon::linalg {
+
+struct SparseCholesky::State {
+  CholmodContext context;
+  cholmod_factor* factor = nullptr;
+  std::vector<int> outer, inner;       // the upper triangle's pattern, compressed columns
+  std::vector<double> values;
+  std::unique_ptr<Substitution<double>> substitution;
+  std::string what;
+  ~State() {
+    substitution.reset();
+    if (factor) cholmod_free_factor(&factor, context.get());
+  }
+};
+
+namespace {
+
+// The upper triangle of A (row ≤ column) in compressed columns, values in `values` when it is not null.
+void upper_triangle(const Eigen::SparseMatrix<double>& A, std::vector<int>& outer, std::vector<int>& inner, std::vector<double>* values) {
+  const int n = static_cast<int>(A.cols());
+  outer.assign(n + 1, 0);
+  inner.clear();
+  if (values) values->clear();
+  for (int j = 0; j < n; ++j) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it) {
+      if (it.row() > j) continue;
+      inner.push_back(static_cast<int>(it.row()));
+      if (values) values->push_back(it.value());
+    }
+    outer[j + 1] = static_cast<int>(inner.size());
+  }
+}
+
+}  // namespace
+
+SparseCholesky::SparseCholesky(const Eigen::SparseMatrix<double>& A, const char* what) : state_(std::make_unique<State>()) {
+  check_numeric_libraries();
+  if (A.rows() != A.cols()) throw Error(std::string(what) + ": the matrix is not square");
+  n_ = static_cast<int>(A.cols());
+  state_->what = what;
+  upper_triangle(A, state_->outer, state_->inner, nullptr);
+  cholmod_common* c = state_->context.get();
+  c->nmethods = 1;
+  c->method[0].ordering = CHOLMOD_AMD;
+  c->postorder = 1;
+  c->supernodal = CHOLMOD_SUPERNODAL;  // linalg::factorize fills a supernodal factor
+  cholmod_sparse pattern = upper_pattern_view(state_->outer, state_->inner, n_);
+  state_->factor = cholmod_analyze(&pattern, c);
+  require(state_->factor != nullptr, std::string(what) + ": CHOLMOD could not analyse the matrix", state_->context.common());
+}
+
+SparseCholesky::~SparseCholesky() = default;
+
+int SparseCholesky::factorize(const Eigen::SparseMatrix<double>& A) {
+  std::vector<int> outer, inner;
+  upper_triangle(A, outer, inner, &state_->values);
+  if (A.cols() != n_ || outer != state_->outer || inner != state_->inner)
+    throw Error(state_->what + ": the matrix's pattern changed after its analysis");
+  state_->substitution.reset();
+  const int minor = linalg::factorize(*state_->factor, state_->outer, state_->inner, state_->values, *state_->context);
+  if (minor < n_) {
+    const int* perm = static_cast<const int*>(state_->factor->Perm);
+    return perm ? perm[minor] : minor;
+  }
+  state_->substitution = std::make_unique<Substitution<double>>(*state_->factor);
+  return -1;
+}
+
+Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& b) const {
+  if (!state_->substitution) throw Error(state_->what + ": solve without a successful factorization");
+  if (b.size() != n_) throw Error(state_->what + ": the right-hand side has the wrong size");
+  Eigen::VectorXd x = b;
+  if (n_ > 0) state_->substitution->solve(x.data());
+  return x;
+}
+
+}  // namespace trivcon::linalg

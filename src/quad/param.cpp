@@ -1,0 +1,670 @@
+// The integer-grid map (trivcon/param.h; the mathematics: docs/param.md).
+//
+// Stages: the cut and the combing (which of the four directions is u in each face), the corners grouped
+// into wedges (one (u, v) unknown pair per wedge: the corners around a vertex between two cut edges), the
+// linear relations (transitions across the cut, cones on integer points, aligned edges on iso-lines) turned
+// into a substitution x = P y over free unknowns y, the least-squares system Pᵀ H P y = Pᵀ g, greedy rounding of
+// the free integers with re-solves, stiffening against flips, and a check of everything the map promises.
+#include "trivcon/param.h"
+
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <memory>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+#include "linalg/sparse_cholesky.h"
+#include "linalg/timing.h"
+#include "trivcon/error.h"
+#include "trivcon/matching.h"
+
+namespace trivcon {
+
+namespace {
+
+
+using Terms = std::vector<std::pair<int, double>>;
+
+// Unknowns: 2 per wedge (u then v), then the integers (cone positions, iso-line values, translations).
+// Linear relations Σ c x = 0 are eliminated one at a time: a relation is rewritten in the unknowns still free,
+// then solved for one of them (a real one if there is one; among integers, one with coefficient ±1, so that
+// the integers left free determine the others as whole numbers). Eliminated unknowns keep their expression,
+// compressed to the free unknowns whenever it is read.
+class Elimination {
+ public:
+  Elimination(int reals, int integers) : expr_(reals + integers), eliminated_(reals + integers, 0), reals_(reals) {}
+  int size() const { return static_cast<int>(expr_.size()); }
+  bool is_integer(int v) const { return v >= reals_; }
+  bool eliminated(int v) const { return eliminated_[v]; }
+  int non_unimodular() const { return non_unimodular_; }
+
+  // The unknown as a combination of free unknowns.
+  Terms resolve(int v) {
+    if (!eliminated_[v]) return {{v, 1.0}};
+    bool stale = false;
+    for (const auto& [u, c] : expr_[v]) stale |= eliminated_[u] != 0;
+    if (stale) {
+      Terms out;
+      for (const auto& [u, c] : expr_[v])
+        for (const auto& [w, d] : resolve(u)) out.emplace_back(w, c * d);
+      expr_[v] = merge(std::move(out));
+    }
+    return expr_[v];
+  }
+
+  void add(const Terms& relation) {
+    Terms row;
+    for (const auto& [v, c] : relation)
+      for (const auto& [w, d] : resolve(v)) row.emplace_back(w, c * d);
+    row = merge(std::move(row));
+    if (row.empty()) return;  // implied by the relations before it
+    int pivot = -1;
+    for (int k = 0; k < static_cast<int>(row.size()); ++k)
+      if (!is_integer(row[k].first) && (pivot < 0 || std::abs(row[k].second) > std::abs(row[pivot].second))) pivot = k;
+    if (pivot < 0) {
+      // Integers only: scale to whole coefficients, then solve for the newest one with coefficient ±1.
+      double scale = 1;
+      for (double m = 1; m <= 12; ++m) {
+        bool whole = true;
+        for (const auto& [v, c] : row) whole &= std::abs(c * m - std::round(c * m)) < 1e-9;
+        if (whole) {
+          scale = m;
+          break;
+        }
+      }
+      for (auto& term : row) term.second = std::round(term.second * scale);
+      row = merge(std::move(row));
+      if (row.empty()) return;
+      long long divisor = 0;  // the relation holds over the reals: divide by its coefficients' gcd
+      for (const auto& term : row) divisor = std::gcd(divisor, static_cast<long long>(std::abs(term.second)));
+      if (divisor > 1)
+        for (auto& term : row) term.second /= static_cast<double>(divisor);
+      for (int k = 0; k < static_cast<int>(row.size()); ++k)
+        if (std::abs(row[k].second) == 1 && (pivot < 0 || row[k].first > row[pivot].first)) pivot = k;
+      if (pivot < 0) {
+        ++non_unimodular_;
+        pivot = 0;
+        for (int k = 1; k < static_cast<int>(row.size()); ++k)
+          if (std::abs(row[k].second) < std::abs(row[pivot].second)) pivot = k;
+      }
+    }
+    const int v = row[pivot].first;
+    const double c = row[pivot].second;
+    Terms e;
+    for (int k = 0; k < static_cast<int>(row.size()); ++k)
+      if (k != pivot) e.emplace_back(row[k].first, -row[k].second / c);
+    expr_[v] = std::move(e);
+    eliminated_[v] = 1;
+  }
+
+ private:
+  static Terms merge(Terms t) {
+    std::sort(t.begin(), t.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    Terms out;
+    for (const auto& [v, c] : t) {
+      if (!out.empty() && out.back().first == v)
+        out.back().second += c;
+      else
+        out.emplace_back(v, c);
+    }
+    out.erase(std::remove_if(out.begin(), out.end(), [](const auto& p) { return std::abs(p.second) < 1e-12; }), out.end());
+    return out;
+  }
+  std::vector<Terms> expr_;
+  std::vector<char> eliminated_;
+  int reals_;
+  int non_unimodular_ = 0;
+};
+
+int find_root(std::vector<int>& parent, int a) {
+  while (parent[a] != a) a = parent[a] = parent[parent[a]];
+  return a;
+}
+
+// J^r applied to (u, v): J the rotation by +π/2.
+Eigen::Vector2d rotate(int r, const Eigen::Vector2d& p) {
+  switch (((r % 4) + 4) % 4) {
+    case 1: return {-p.y(), p.x()};
+    case 2: return -p;
+    case 3: return {p.y(), -p.x()};
+    default: return p;
+  }
+}
+// Entry (row a, column b) of J^r.
+double rotation_entry(int r, int a, int b) {
+  const Eigen::Vector2d column = rotate(r, b == 0 ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(0, 1));
+  return column[a];
+}
+
+int corner_of(const Topology& t, int f, int v) {
+  for (int k = 0; k < 3; ++k)
+    if (t.F(f, k) == v) return k;
+  return -1;
+}
+
+// Face f laid out in its frame (x along corner 0 → 1), from its edge lengths plus `epsilon` (the
+// mollification of trivcon/geometry.h, so that no face is degenerate): the corners' 2D positions.
+std::array<Eigen::Vector2d, 3> layout(const MatrixX3d& V, const Topology& t, int f, double epsilon) {
+  const Eigen::Vector3d p0 = V.row(t.F(f, 0)), p1 = V.row(t.F(f, 1)), p2 = V.row(t.F(f, 2));
+  const double a = (p1 - p0).norm() + epsilon, b = (p2 - p1).norm() + epsilon, c = (p0 - p2).norm() + epsilon;
+  const double x = (a * a + c * c - b * b) / (2 * a);
+  const double y = std::sqrt(std::max(0.0, c * c - x * x));
+  return {Eigen::Vector2d(0, 0), Eigen::Vector2d(a, 0), Eigen::Vector2d(x, y)};
+}
+
+// The gradients of the three hat functions of a laid-out triangle, and its area.
+void hat_gradients(const std::array<Eigen::Vector2d, 3>& p, std::array<Eigen::Vector2d, 3>& g, double& area) {
+  const Eigen::Vector2d e1 = p[1] - p[0], e2 = p[2] - p[0];
+  area = 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector2d opposite = p[(k + 2) % 3] - p[(k + 1) % 3];
+    g[k] = Eigen::Vector2d(-opposite.y(), opposite.x()) / (2 * area);
+  }
+}
+
+double signed_area(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const Eigen::Vector2d e1 = b - a, e2 = c - a;
+  return 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+}
+
+double whole_offset(double x) { return std::abs(x - std::round(x)); }
+
+}  // namespace
+
+Parametrization parametrize(const FieldDesigner& designer, const Design& design, const ParamOptions& options) {
+  const auto t0 = linalg::Clock::now();
+  const Topology& t = designer.topology();
+  const Geometry& g = designer.geometry();
+  const MatrixX3d& V = designer.V();
+  const Field& field = design.field;
+  if (field.N != 4) throw Error("param: a seamless parametrization needs a cross field (N = 4), got N = " + std::to_string(field.N));
+  const int nF = t.num_faces, nE = t.num_edges, nV = t.num_vertices;
+  if (field.angle.size() != nF || design.connection.x.size() != nE) throw Error("param: the design does not belong to this mesh");
+
+  double area = 0;
+  for (int f = 0; f < nF; ++f) area += g.face_area[f];
+  Parametrization out;
+  if (options.edge_length > 0 && std::isfinite(options.edge_length)) {
+    out.edge_length = options.edge_length;
+  } else if (options.target_faces > 0 && std::isfinite(options.target_faces)) {
+    out.edge_length = std::sqrt(area / options.target_faces);
+  } else {
+    throw Error("param: give a positive edge length or target face count (--edge-length H or --target-faces K)");
+  }
+  if (!(out.edge_length > 0) || !std::isfinite(out.edge_length))
+    throw Error("param: the mesh has no area to parametrize");
+  const double s = 1.0 / out.edge_length;
+  ParamQuality& q = out.quality;
+  q.faces = nF;
+  q.target_squares = area * s * s;
+
+  // --- The cut and the combing ---------------------------------------------------------------------------
+  const Eigen::VectorXi matching = connection_matching(t, g, field, design.connection.x);
+  const FieldIndices indices = indices_with_matching(t, g, designer.cycles(), field, matching);
+  std::vector<int> comb(nF, -1);          // which direction is u: k_f
+  std::vector<char> tree_edge(nE, 0);
+  for (int c = 0; c < static_cast<int>(t.components.size()); ++c) {
+    const int root = t.components[c].first_face;
+    comb[root] = 0;
+    std::vector<int> queue{root};
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const int f = queue[head];
+      for (int k = 0; k < 3; ++k) {
+        const int e = t.face_edges(f, k);
+        const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+        if (L < 0 || R < 0) continue;
+        const int other = L == f ? R : L;
+        if (comb[other] >= 0) continue;
+        // Direction k_L of L is paired with direction k_L + m_e of R.
+        comb[other] = other == R ? (comb[f] + matching[e]) % 4 : ((comb[f] - matching[e]) % 4 + 4) % 4;
+        tree_edge[e] = 1;
+        queue.push_back(other);
+      }
+    }
+  }
+  std::vector<char> singular(nV, 0);
+  for (int v = 0; v < nV; ++v)
+    if (t.is_interior_vertex(v) && indices.vertex[v] != 0) {
+      singular[v] = 1;
+      out.cones.push_back(v);
+      out.cone_index.push_back(indices.vertex[v]);
+    }
+  std::vector<char> cut(nE, 0);
+  std::vector<int> degree(nV, 0);
+  for (int e = 0; e < nE; ++e)
+    if (!t.is_boundary_edge(e) && !tree_edge[e]) {
+      cut[e] = 1;
+      ++degree[t.edge_vertices(e, 0)], ++degree[t.edge_vertices(e, 1)];
+    }
+  {  // Prune: an edge ending at an interior regular vertex it alone reaches is not needed (its residual matching is 0).
+    std::vector<int> leaves;
+    auto prunable = [&](int v) { return degree[v] == 1 && t.is_interior_vertex(v) && !singular[v]; };
+    for (int v = 0; v < nV; ++v)
+      if (prunable(v)) leaves.push_back(v);
+    while (!leaves.empty()) {
+      const int v = leaves.back();
+      leaves.pop_back();
+      if (!prunable(v)) continue;
+      for (int j = t.vertex_edge_offsets[v]; j < t.vertex_edge_offsets[v + 1]; ++j) {
+        const int e = t.vertex_edges[j];
+        if (!cut[e]) continue;
+        cut[e] = 0;
+        --degree[v];
+        const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+        if (--degree[w] == 1 && prunable(w)) leaves.push_back(w);
+        break;
+      }
+    }
+  }
+  out.rotation = Eigen::VectorXi::Zero(nE);
+  out.translation = Eigen::MatrixXi::Zero(nE, 2);
+  for (int e = 0; e < nE; ++e)
+    if (cut[e]) {
+      out.cut_edges.push_back(e);
+      const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+      out.rotation[e] = ((comb[L] + matching[e] - comb[R]) % 4 + 4) % 4;
+    }
+  // Pruned edges carry no turn: every non-cut edge's residual matching is 0.
+  for (int e = 0; e < nE; ++e)
+    if (!cut[e] && !t.is_boundary_edge(e)) {
+      const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+      if (((comb[L] + matching[e] - comb[R]) % 4 + 4) % 4 != 0)
+        throw Error("param: internal error: the cut misses a turn of the field at edge " + std::to_string(e));
+    }
+  q.cones = static_cast<int>(out.cones.size());
+  q.cut_edges = static_cast<int>(out.cut_edges.size());
+
+  // --- Wedges ------------------------------------------------------------------------------------------
+  std::vector<int> parent(3 * nF);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int e = 0; e < nE; ++e) {
+    if (cut[e] || t.is_boundary_edge(e)) continue;
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    for (int end = 0; end < 2; ++end) {
+      const int v = t.edge_vertices(e, end);
+      const int a = find_root(parent, 3 * L + corner_of(t, L, v)), b = find_root(parent, 3 * R + corner_of(t, R, v));
+      if (a != b) parent[a] = b;
+    }
+  }
+  std::vector<int> wedge(3 * nF, -1), wedge_id(3 * nF, -1);
+  int W = 0;
+  for (int c = 0; c < 3 * nF; ++c) {
+    const int r = find_root(parent, c);
+    if (wedge_id[r] < 0) wedge_id[r] = W++;
+    wedge[c] = wedge_id[r];
+  }
+  auto wedge_at = [&](int f, int v) { return wedge[3 * f + corner_of(t, f, v)]; };
+
+  // Combed frame per face: the angle of u's direction, θ_f = β_f + k_f π/2, in the face's frame.
+  std::vector<double> theta(nF);
+  for (int f = 0; f < nF; ++f) theta[f] = field.angle[f] + comb[f] * kPi / 2;
+
+  // --- Relations -------------------------------------------------------------------------------------------
+  // Integer unknowns: 2 per cone, 1 per aligned (edge, face), 2 per cut edge.
+  std::vector<std::pair<int, int>> aligned;  // (edge, face) with the coordinate that is constant: stored below
+  std::vector<int> aligned_coordinate;
+  for (int e : options.aligned_edges) {
+    if (e < 0 || e >= nE) throw Error("param: aligned edge " + std::to_string(e) + " is out of range (the mesh has " + std::to_string(nE) + " edges)");
+    bool any = false;
+    for (int side = 0; side < 2; ++side) {
+      const int f = t.edge_faces(e, side);
+      if (f < 0) continue;
+      int k = 0;
+      while (t.face_edges(f, k) != e) ++k;
+      const double relative = g.half_edge_angle(f, k) - theta[f];
+      const double quarters = relative / (kPi / 2);
+      const double nearest = std::round(quarters);
+      if (std::abs(quarters - nearest) * (kPi / 2) > 0.1) continue;
+      const int along = ((static_cast<long long>(nearest) % 2) + 2) % 2;  // 0: along ±u (v constant), 1: along ±v
+      aligned.emplace_back(e, f);
+      aligned_coordinate.push_back(along == 0 ? 1 : 0);
+      any = true;
+    }
+    any ? ++q.aligned_edges : ++q.unaligned_edges;
+  }
+  const int nCone = static_cast<int>(out.cones.size()), nAligned = static_cast<int>(aligned.size()), nCut = static_cast<int>(out.cut_edges.size());
+  const int cone0 = 2 * W, aligned0 = cone0 + 2 * nCone, cut0 = aligned0 + nAligned;
+  Elimination elim(2 * W, 2 * nCone + nAligned + 2 * nCut);
+  for (int i = 0; i < nCone; ++i) {
+    const int v = out.cones[i];
+    const int f = t.vertex_faces[t.vertex_face_offsets[v]];
+    const int w = wedge_at(f, v);
+    for (int c = 0; c < 2; ++c) elim.add({{2 * w + c, 1.0}, {cone0 + 2 * i + c, -1.0}});
+  }
+  for (int i = 0; i < nAligned; ++i) {
+    const auto [e, f] = aligned[i];
+    const int c = aligned_coordinate[i];
+    for (int end = 0; end < 2; ++end) elim.add({{2 * wedge_at(f, t.edge_vertices(e, end)) + c, 1.0}, {aligned0 + i, -1.0}});
+  }
+  for (int i = 0; i < nCut; ++i) {
+    const int e = out.cut_edges[i];
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1), r = out.rotation[e];
+    for (int end = 0; end < 2; ++end) {
+      const int v = t.edge_vertices(e, end);
+      const int wL = wedge_at(L, v), wR = wedge_at(R, v);
+      for (int a = 0; a < 2; ++a) {  // φ_R[a] − Σ_b J^r[a][b] φ_L[b] − t[a] = 0
+        Terms row{{2 * wR + a, 1.0}, {cut0 + 2 * i + a, -1.0}};
+        for (int b = 0; b < 2; ++b)
+          if (const double j = rotation_entry(r, a, b); j != 0) row.emplace_back(2 * wL + b, -j);
+        elim.add(row);
+      }
+    }
+  }
+  q.non_unimodular = elim.non_unimodular();
+
+  // Free unknowns and x = P y.
+  const int nX = elim.size();
+  std::vector<int> free_index(nX, -1), free_vars;
+  for (int v = 0; v < nX; ++v)
+    if (!elim.eliminated(v)) free_index[v] = static_cast<int>(free_vars.size()), free_vars.push_back(v);
+  const int nY = static_cast<int>(free_vars.size());
+  std::vector<Eigen::Triplet<double>> pt;
+  for (int v = 0; v < nX; ++v)
+    for (const auto& [u, c] : elim.resolve(v)) pt.emplace_back(v, free_index[u], c);
+  Eigen::SparseMatrix<double> P(nX, nY);
+  P.setFromTriplets(pt.begin(), pt.end());
+  std::vector<int> integer_free;
+  for (int j = 0; j < nY; ++j)
+    if (elim.is_integer(free_vars[j])) integer_free.push_back(j);
+  q.integer_unknowns = static_cast<int>(integer_free.size());
+  q.seconds_cut = linalg::seconds_since(t0);
+
+  // --- The least-squares system -------------------------------------------------------------------------------
+  const auto t1 = linalg::Clock::now();
+  std::vector<std::array<Eigen::Vector2d, 3>> grad(nF);
+  std::vector<double> face_area(nF);
+  for (int f = 0; f < nF; ++f) {
+    const double eps = g.component_epsilon.empty() ? 0.0 : g.component_epsilon[t.face_component[f]];
+    hat_gradients(layout(V, t, f, eps), grad[f], face_area[f]);
+  }
+  std::vector<double> weight(nF, 1.0);
+  Eigen::VectorXd rhs_full(nX);
+  auto assemble = [&](Eigen::SparseMatrix<double>& K, Eigen::VectorXd& b) {
+    std::vector<Eigen::Triplet<double>> ht;
+    ht.reserve(18 * static_cast<size_t>(nF));
+    rhs_full.setZero();
+    for (int f = 0; f < nF; ++f) {
+      const double A = face_area[f] * weight[f];
+      const Eigen::Vector2d X(std::cos(theta[f]), std::sin(theta[f])), Y(-X.y(), X.x());
+      for (int i = 0; i < 3; ++i) {
+        const int wi = wedge[3 * f + i];
+        rhs_full[2 * wi] += A * s * grad[f][i].dot(X);
+        rhs_full[2 * wi + 1] += A * s * grad[f][i].dot(Y);
+        for (int j = 0; j < 3; ++j) {
+          const double h = A * grad[f][i].dot(grad[f][j]);
+          const int wj = wedge[3 * f + j];
+          ht.emplace_back(2 * wi, 2 * wj, h);
+          ht.emplace_back(2 * wi + 1, 2 * wj + 1, h);
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> H(nX, nX);
+    H.setFromTriplets(ht.begin(), ht.end());
+    K = Eigen::SparseMatrix<double>(P.transpose() * H * P);
+    // The map is defined up to a translation per component: a tiny pull of every unknown toward 0 makes the
+    // system definite without moving anything else measurably (the right-hand side is orthogonal to translations).
+    double diagonal = 0;
+    for (int j = 0; j < nY; ++j) diagonal += K.coeff(j, j);
+    const double epsilon = 1e-11 * (nY > 0 ? diagonal / nY : 1.0);
+    for (int j = 0; j < nY; ++j) K.coeffRef(j, j) += epsilon;
+    b = P.transpose() * rhs_full;
+  };
+  Eigen::SparseMatrix<double> K;
+  Eigen::VectorXd b;
+  assemble(K, b);
+  K.makeCompressed();
+  auto solver = std::make_unique<linalg::SparseCholesky>(K, "param");
+  std::vector<char> fixed(nY, 0);
+  Eigen::VectorXd value = Eigen::VectorXd::Zero(nY);  // the fixed integers' values
+  // Solve K y = b with the fixed unknowns held: their rows and columns become the identity (same pattern).
+  // The matrix depends on which unknowns are fixed, not on their values: it is factored again only after K or
+  // the fixed set changed (refactor = true), so that trying other values (the local search below) costs one solve each.
+  bool refactor = true;
+  auto solve_fixed = [&]() -> Eigen::VectorXd {
+    Eigen::VectorXd r = b;
+    for (int j = 0; j < nY; ++j)
+      if (fixed[j])
+        for (Eigen::SparseMatrix<double>::InnerIterator it(K, j); it; ++it)
+          if (!fixed[it.row()]) r[it.row()] -= it.value() * value[j];
+    for (int j = 0; j < nY; ++j)
+      if (fixed[j]) r[j] = value[j];
+    if (refactor) {
+      Eigen::SparseMatrix<double> M = K;
+      for (int j = 0; j < nY; ++j)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(M, j); it; ++it) {
+          const int i = static_cast<int>(it.row());
+          if (fixed[i] || fixed[j]) it.valueRef() = i == j ? 1.0 : 0.0;
+        }
+      const int bad = solver->factorize(M);
+      if (bad >= 0)
+        throw Error("param: the map's system is not positive definite (unknown " + std::to_string(bad) + "); the mesh or the field is degenerate");
+      refactor = false;
+      ++q.factorizations;
+    }
+    return solver->solve(r);
+  };
+  q.seconds_setup = linalg::seconds_since(t1);
+
+  // --- (u, v) per corner, flips, stiffening ------------------------------------------------------------------
+  Eigen::VectorXd y, x(nX);
+  auto corner_uv = [&]() {
+    x = P * y;
+    out.uv.resize(3 * nF, 2);
+    for (int c = 0; c < 3 * nF; ++c) out.uv(c, 0) = x[2 * wedge[c]], out.uv(c, 1) = x[2 * wedge[c] + 1];
+  };
+  auto uv_area = [&](int f) {
+    return signed_area(out.uv.row(3 * f).transpose(), out.uv.row(3 * f + 1).transpose(), out.uv.row(3 * f + 2).transpose());
+  };
+  auto folded = [&](int f) { return !(uv_area(f) > 1e-12 * face_area[f] * s * s); };
+  // σ_max / σ_min of the map's Jacobian on face f (rows ∇u, ∇v in the face's frame); infinite when σ_min = 0.
+  auto distortion = [&](int f) {
+    Eigen::Matrix2d J = Eigen::Matrix2d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      J.row(0) += out.uv(3 * f + i, 0) * grad[f][i].transpose();
+      J.row(1) += out.uv(3 * f + i, 1) * grad[f][i].transpose();
+    }
+    // Singular values of a 2 × 2 matrix in closed form.
+    const double e = (J(0, 0) + J(1, 1)) / 2, ff = (J(0, 0) - J(1, 1)) / 2, gg = (J(1, 0) + J(0, 1)) / 2, h = (J(1, 0) - J(0, 1)) / 2;
+    const double qq = std::hypot(e, h), rr = std::hypot(ff, gg);
+    const double smax = qq + rr, smin = std::abs(qq - rr);
+    return smin > 0 ? smax / smin : std::numeric_limits<double>::infinity();
+  };
+  // Stiffening (MIQ, Bommes et al. 2009, §5): while faces fold, each face weighs more by its distortion, so that
+  // it keeps its shape and the distortion spreads over its neighbours; a folded face counts as very distorted.
+  // Before the rounding (on the real-valued map, so that the integers are chosen on a map without folds) and
+  // after it (the integers held).
+  auto stiffen = [&](int rounds) {
+    int fewest = std::numeric_limits<int>::max(), stalled = 0;
+    for (int round = 0; round < rounds; ++round) {
+      int folds = 0;
+      for (int f = 0; f < nF; ++f) folds += folded(f);
+      if (folds == 0) return;
+      // Stop when three rounds in a row found no fewer folds than before them.
+      if (folds < fewest) fewest = folds, stalled = 0;
+      else if (++stalled == 3) return;
+      for (int f = 0; f < nF; ++f) {
+        const double ratio = folded(f) ? 20.0 : distortion(f);
+        if (ratio > 2) weight[f] += std::min(ratio - 1, 20.0);
+      }
+      Eigen::SparseMatrix<double> K2;
+      assemble(K2, b);
+      K2.makeCompressed();
+      K = std::move(K2);
+      refactor = true;
+      y = solve_fixed();
+      corner_uv();
+      ++q.stiffening_rounds;
+    }
+  };
+  auto count_folds = [&]() {
+    int n = 0;
+    for (int f = 0; f < nF; ++f) n += folded(f);
+    return n;
+  };
+
+  const auto t2 = linalg::Clock::now();
+  y = solve_fixed();
+  corner_uv();
+  ++q.rounding_rounds;
+  q.folds_real_valued = count_folds();
+  stiffen(options.max_stiffening_rounds);
+  // --- Greedy rounding: the integers nearest to whole numbers first, a fraction of those left per solve --------
+  std::vector<int> left = integer_free;
+  while (!left.empty()) {
+    std::sort(left.begin(), left.end(), [&](int a, int c) {
+      const double da = whole_offset(y[a]), dc = whole_offset(y[c]);
+      return da != dc ? da < dc : a < c;
+    });
+    size_t take = std::max<size_t>(1, static_cast<size_t>(std::ceil(options.rounding_fraction * left.size())));
+    while (take < left.size() && whole_offset(y[left[take]]) < 1e-9) ++take;  // already whole: free to fix
+    for (size_t k = 0; k < take; ++k) fixed[left[k]] = 1, value[left[k]] = std::round(y[left[k]]);
+    refactor = true;
+    left.erase(left.begin(), left.begin() + static_cast<long>(take));
+    y = solve_fixed();
+    ++q.rounding_rounds;
+  }
+  corner_uv();
+  // Local search on the singularities' integer points: a singularity that shares its point with another of one of
+  // its faces (they were closer than a unit), or whose ring folds (the ring winds around it once too few or too
+  // many times), tries the 8 integer points around its own; the one with the fewest folded faces, then the least
+  // energy, is kept (staying is a candidate unless it coincides). Each singularity is tried once.
+  auto energy = [&](const Eigen::VectorXd& yy) { return 0.5 * yy.dot(K * yy) - b.dot(yy); };
+  auto ring_is_bad = [&](int v) {
+    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
+      const int f = t.vertex_faces[j];
+      if (folded(f)) return true;
+      const int i = corner_of(t, f, v);
+      for (int k = 1; k < 3; ++k)
+        if (singular[t.F(f, (i + k) % 3)] && (out.uv.row(3 * f + i) - out.uv.row(3 * f + (i + k) % 3)).lpNorm<Eigen::Infinity>() < 1e-6)
+          return true;
+    }
+    return false;
+  };
+  std::vector<char> tried(nCone, 0);
+  for (int k = 0; k < nCone; ++k) {
+    const int v = out.cones[k];
+    if (tried[k] || !ring_is_bad(v) || elim.eliminated(cone0 + 2 * k) || elim.eliminated(cone0 + 2 * k + 1)) continue;
+    tried[k] = 1;
+    const int ju = free_index[cone0 + 2 * k], jv = free_index[cone0 + 2 * k + 1];
+    const double u0 = value[ju], v0 = value[jv];
+    // The solution is affine in the two values: y + dx·g_u + dy·g_v, with g_j the response to a unit change of
+    // fixed value j (two solves with the current factorization, instead of one per candidate).
+    auto response = [&](int j) {
+      Eigen::VectorXd r = Eigen::VectorXd::Zero(nY);
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, j); it; ++it)
+        if (!fixed[it.row()]) r[it.row()] = -it.value();
+      r[j] = 1;
+      return solver->solve(r);
+    };
+    const Eigen::VectorXd y0 = y, gu = response(ju), gv = response(jv);
+    std::pair<int, double> best{std::numeric_limits<int>::max(), std::numeric_limits<double>::infinity()};
+    Eigen::Vector2d step(0, 0);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy) {
+        y = y0 + dx * gu + dy * gv;
+        corner_uv();
+        const std::pair<int, double> score{count_folds() + (ring_is_bad(v) ? 1 : 0), energy(y)};
+        if (score < best) best = score, step = Eigen::Vector2d(dx, dy);
+      }
+    y = y0 + step.x() * gu + step.y() * gv;
+    value[ju] = u0 + step.x(), value[jv] = v0 + step.y();
+    corner_uv();
+    if (step.squaredNorm() > 0) ++q.cones_moved;
+    k = -1;  // a move changes the others' rings: look again from the first untried one
+  }
+  q.folds_rounded = count_folds();
+  q.seconds_rounding = linalg::seconds_since(t2);
+  const auto t3 = linalg::Clock::now();
+  stiffen(options.max_stiffening_rounds);
+  q.seconds_stiffening = linalg::seconds_since(t3);
+
+  // --- What the map promises, checked on the result --------------------------------------------------------
+  const auto t4 = linalg::Clock::now();
+  for (int f = 0; f < nF; ++f) {
+    const double a = uv_area(f);
+    if (a < -1e-12 * face_area[f] * s * s) {
+      ++q.flipped_faces;
+      if (q.first_flipped.size() < 10) q.first_flipped.push_back(f);
+    } else if (!(a > 1e-12 * face_area[f] * s * s)) {
+      ++q.degenerate_faces;
+      if (q.first_flipped.size() < 10) q.first_flipped.push_back(f);
+    }
+    const double ratio = distortion(f);
+    q.max_distortion = std::max(q.max_distortion, ratio);
+    if (std::isfinite(ratio)) q.mean_distortion += g.face_area[f] * ratio;
+    q.unit_squares += a;
+  }
+  if (area > 0) q.mean_distortion /= area;
+  for (int i = 0; i < nCut; ++i) {
+    const int e = out.cut_edges[i];
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1), r = out.rotation[e];
+    Eigen::Vector2d d[2];
+    for (int end = 0; end < 2; ++end) {
+      const int v = t.edge_vertices(e, end);
+      const Eigen::Vector2d pL = out.uv.row(3 * L + corner_of(t, L, v)).transpose(), pR = out.uv.row(3 * R + corner_of(t, R, v)).transpose();
+      d[end] = pR - rotate(r, pL);
+    }
+    const Eigen::Vector2d whole(std::round(d[0].x()), std::round(d[0].y()));
+    out.translation(e, 0) = static_cast<int>(whole.x()), out.translation(e, 1) = static_cast<int>(whole.y());
+    q.max_transition_residual = std::max({q.max_transition_residual, (d[0] - whole).lpNorm<Eigen::Infinity>(), (d[1] - whole).lpNorm<Eigen::Infinity>()});
+  }
+  for (int i = 0; i < nCone; ++i) {
+    const int v = out.cones[i];
+    double angle = 0;
+    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
+      const int f = t.vertex_faces[j], k = corner_of(t, f, v);
+      const Eigen::Vector2d p = out.uv.row(3 * f + k).transpose();
+      const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
+      angle += std::atan2(a.x() * c.y() - a.y() * c.x(), a.dot(c));
+      q.max_cone_offset = std::max({q.max_cone_offset, whole_offset(p.x()), whole_offset(p.y())});
+    }
+    q.max_cone_angle_error = std::max(q.max_cone_angle_error, std::abs(angle - 2 * kPi * (1 - out.cone_index[i] / 4.0)));
+  }
+  for (int i = 0; i < nAligned; ++i) {
+    const auto [e, f] = aligned[i];
+    const int c = aligned_coordinate[i];
+    const double a = out.uv(3 * f + corner_of(t, f, t.edge_vertices(e, 0)), c), bb = out.uv(3 * f + corner_of(t, f, t.edge_vertices(e, 1)), c);
+    q.max_alignment_error = std::max({q.max_alignment_error, whole_offset(a), std::abs(a - bb)});
+  }
+  q.seamless = q.max_transition_residual < 1e-6 && q.max_cone_offset < 1e-6 && q.max_alignment_error < 1e-6 && q.non_unimodular == 0;
+  q.seconds_check = linalg::seconds_since(t4);
+  return out;
+}
+
+Eigen::MatrixXd input_corner_uv(const Parametrization& param, const Topology& topology, const MatrixX3i& F) {
+  if (F.rows() != topology.num_faces || param.uv.rows() != 3 * F.rows()) throw Error("param: the faces do not belong to the map's mesh");
+  Eigen::MatrixXd out(F.rows(), 6);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int c = corner_of(topology, f, F(f, k));
+      if (c < 0) throw Error("param: face " + std::to_string(f) + " does not match the map's mesh");
+      out(f, 2 * k) = param.uv(3 * f + c, 0), out(f, 2 * k + 1) = param.uv(3 * f + c, 1);
+    }
+  return out;
+}
+
+std::string param_warning(const Parametrization& param) {
+  const ParamQuality& q = param.quality;
+  std::ostringstream s;
+  if (!q.seamless) {
+    s << "the map is not exactly seamless (transition residual " << q.max_transition_residual << ", cone offset " << q.max_cone_offset
+      << ", alignment error " << q.max_alignment_error << ", " << q.non_unimodular << " integer relations not kept whole)";
+  }
+  const int bad = q.flipped_faces + q.degenerate_faces;
+  if (bad > 0) {
+    if (!s.str().empty()) s << "; ";
+    s << bad << " of " << q.faces << " faces are flipped or degenerate in (u, v) (first: ";
+    for (size_t i = 0; i < q.first_flipped.size(); ++i) s << (i ? ", " : "") << q.first_flipped[i];
+    s << ")";
+    if (q.max_cone_angle_error > 1e-6) s << ", folding around singularities (cone angles off by up to " << q.max_cone_angle_error << " rad)";
+    s << " after " << q.stiffening_rounds << " stiffening rounds: a larger edge length, or singularities further apart, usually removes them";
+  }
+  return s.str();
+}
+
+}  // namespace trivcon

@@ -1,0 +1,224 @@
+// trivcon/param.h: the integer-grid map on generated meshes with known answers. Every test checks what the
+// map promises from the (u, v) alone (transitions, cones, iso-lines, flips), not the solver's own report only.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "trivcon/common.h"
+#include "trivcon/error.h"
+#include "trivcon/generate.h"
+#include "trivcon/param.h"
+#include "trivcon/render.h"
+#include "trivcon/request.h"
+
+namespace trivcon {
+namespace {
+
+constexpr double kHalfPi = 1.5707963267948966;
+
+struct MapRun {
+  std::unique_ptr<FieldDesigner> designer;
+  FieldOutcome outcome;
+  Parametrization param;
+};
+
+MapRun run(const Mesh& m, FieldRequest r, ParamOptions o, bool align_sharp = false) {
+  MapRun out;
+  out.designer = std::make_unique<FieldDesigner>(m.V, m.F);
+  r.prescription.N = 4;
+  out.outcome = solve_request(*out.designer, m.F, r);
+  const Topology& t = out.designer->topology();
+  if (r.align_boundary)
+    for (int e = 0; e < t.num_edges; ++e)
+      if (t.is_boundary_edge(e)) o.aligned_edges.push_back(e);
+  if (align_sharp) o.aligned_edges.insert(o.aligned_edges.end(), out.outcome.sharp_edges.begin(), out.outcome.sharp_edges.end());
+  out.param = parametrize(*out.designer, out.outcome.design, o);
+  return out;
+}
+
+double whole_offset(double x) { return std::abs(x - std::round(x)); }
+
+// Independent of the solver's report: across every interior edge, the two faces' (u, v) at both ends differ by
+// one rotation by a multiple of π/2 and one whole translation (off the cut: the identity).
+void expect_seamless(const MapRun& r) {
+  const Topology& t = r.designer->topology();
+  const Eigen::MatrixXd& uv = r.param.uv;
+  auto at = [&](int f, int v) {
+    for (int k = 0; k < 3; ++k)
+      if (t.F(f, k) == v) return Eigen::Vector2d(uv(3 * f + k, 0), uv(3 * f + k, 1));
+    ADD_FAILURE() << "vertex not in face";
+    return Eigen::Vector2d(0, 0);
+  };
+  std::set<int> cut(r.param.cut_edges.begin(), r.param.cut_edges.end());
+  double worst = 0;
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1), a = t.edge_vertices(e, 0), b = t.edge_vertices(e, 1);
+    const Eigen::Vector2d la = at(L, a), lb = at(L, b), ra = at(R, a), rb = at(R, b);
+    // The rotation that carries L's edge vector to R's.
+    double best = 1e300;
+    for (int q = 0; q < 4; ++q) {
+      const double c = std::cos(q * kHalfPi), s = std::sin(q * kHalfPi);
+      const Eigen::Matrix2d J = (Eigen::Matrix2d() << std::round(c), -std::round(s), std::round(s), std::round(c)).finished();
+      const Eigen::Vector2d ta = ra - J * la, tb = rb - J * lb;
+      const double residual = std::max({(ta - tb).lpNorm<Eigen::Infinity>(), whole_offset(ta.x()), whole_offset(ta.y())});
+      if (!cut.count(e) && q != 0) continue;
+      if (!cut.count(e)) EXPECT_LT(ta.lpNorm<Eigen::Infinity>(), 1e-9) << "edge " << e << " is off the cut but its sides differ";
+      best = std::min(best, residual);
+    }
+    worst = std::max(worst, best);
+  }
+  EXPECT_LT(worst, 1e-7);
+  EXPECT_TRUE(r.param.quality.seamless) << param_warning(r.param);
+  EXPECT_LT(r.param.quality.max_transition_residual, 1e-7);
+}
+
+void expect_cones_on_integer_points(const MapRun& r) {
+  const Topology& t = r.designer->topology();
+  for (int v : r.param.cones)
+    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
+      const int f = t.vertex_faces[j];
+      for (int k = 0; k < 3; ++k)
+        if (t.F(f, k) == v) {
+          EXPECT_LT(whole_offset(r.param.uv(3 * f + k, 0)), 1e-7) << "cone " << v;
+          EXPECT_LT(whole_offset(r.param.uv(3 * f + k, 1)), 1e-7) << "cone " << v;
+        }
+    }
+  EXPECT_LT(r.param.quality.max_cone_angle_error, 1e-7);
+}
+
+TEST(Param, CubeGridOnTheCube) {
+  // A flat-sided cube, 4 × 4 cells a side, with its 8 corners +1/4 and the field along the sharp edges: the map
+  // is the cube's own grid, one unit per cell at edge length 0.5.
+  const Mesh m = make_cube_sphere(4, false);
+  FieldRequest req;
+  req.feature_degrees = 60;
+  req.auto_place = true;
+  ParamOptions o;
+  o.edge_length = 0.5;
+  const MapRun r = run(m, req, o, true);
+  EXPECT_EQ(r.param.cones.size(), 8u);
+  for (int n : r.param.cone_index) EXPECT_EQ(n, 1);
+  expect_seamless(r);
+  expect_cones_on_integer_points(r);
+  EXPECT_EQ(r.param.quality.flipped_faces, 0);
+  EXPECT_EQ(r.param.quality.degenerate_faces, 0);
+  EXPECT_LT(r.param.quality.max_alignment_error, 1e-7);
+  EXPECT_NEAR(r.param.quality.unit_squares, 6 * 16, 1e-6);  // 6 sides of 2 × 2 length, 0.5 per unit
+  EXPECT_NEAR(r.param.quality.mean_distortion, 1.0, 1e-6);
+  // Every vertex of the 4 × 4 grid of each side sits on an integer point.
+  for (int c = 0; c < r.param.uv.rows(); ++c) {
+    EXPECT_LT(whole_offset(r.param.uv(c, 0)), 1e-7);
+    EXPECT_LT(whole_offset(r.param.uv(c, 1)), 1e-7);
+  }
+}
+
+TEST(Param, TorusWrapsWithoutCones) {
+  const Mesh m = make_torus(48, 16);
+  ParamOptions o;
+  o.target_faces = 300;
+  const MapRun r = run(m, {}, o);
+  EXPECT_TRUE(r.param.cones.empty());
+  EXPECT_FALSE(r.param.cut_edges.empty());  // the two loops of the handle
+  expect_seamless(r);
+  EXPECT_EQ(r.param.quality.flipped_faces, 0);
+  EXPECT_NEAR(r.param.quality.unit_squares / r.param.quality.target_squares, 1.0, 0.3);
+}
+
+TEST(Param, DiskWithAlignedBoundary) {
+  const Mesh m = make_disk(12, 8);
+  FieldRequest req;
+  req.align_boundary = true;
+  req.auto_place = true;
+  ParamOptions o;
+  o.edge_length = 0.2;
+  const MapRun r = run(m, req, o);
+  expect_seamless(r);
+  expect_cones_on_integer_points(r);
+  EXPECT_GT(r.param.quality.aligned_edges, 0);
+  EXPECT_LT(r.param.quality.max_alignment_error, 1e-7);
+  EXPECT_EQ(r.param.quality.flipped_faces, 0);
+}
+
+TEST(Param, GenusTwoWithAutomaticSingularities) {
+  const Mesh m = make_genus_surface(2, 3);
+  FieldRequest req;
+  req.auto_place = true;
+  ParamOptions o;
+  o.target_faces = 800;
+  const MapRun r = run(m, req, o);
+  expect_seamless(r);
+  expect_cones_on_integer_points(r);
+  int total = 0;
+  for (int n : r.param.cone_index) total += n;
+  EXPECT_EQ(total, 4 * (2 - 2 * 2));
+  EXPECT_LE(r.param.quality.flipped_faces, 0);
+}
+
+TEST(Param, SeveralComponents) {
+  const Mesh m = concatenate({make_torus(36, 12), make_cube_sphere(4, true), make_disk(6, 8)});
+  FieldRequest req;
+  req.auto_place = true;
+  ParamOptions o;
+  o.target_faces = 600;
+  const MapRun r = run(m, req, o);
+  expect_seamless(r);
+  expect_cones_on_integer_points(r);
+}
+
+// The renderer's checkerboard of the map: about half of the surface's pixels take the checker colour (told
+// apart from the front colour by their red/blue ratio, which shading does not change).
+TEST(Param, CheckerboardPicture) {
+  const Mesh m = make_torus(48, 16);
+  ParamOptions o;
+  o.target_faces = 200;
+  const MapRun r = run(m, {}, o);
+  RenderOptions ro;
+  ro.width = 400, ro.height = 300, ro.legend = false, ro.draw_field = false;
+  ro.corner_uv.resize(m.F.rows(), 6);
+  for (int f = 0; f < m.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) ro.corner_uv(f, 2 * k) = r.param.uv(3 * f + k, 0), ro.corner_uv(f, 2 * k + 1) = r.param.uv(3 * f + k, 1);
+  const Image image = render_design(*r.designer, r.outcome.design, ro);
+  int surface = 0, checker = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const Rgb p = image.pixel(x, y);
+      if (p == ro.palette.background || p[2] == 0) continue;
+      ++surface;
+      checker += static_cast<double>(p[0]) / p[2] < 0.78;
+    }
+  ASSERT_GT(surface, 10000);
+  EXPECT_NEAR(static_cast<double>(checker) / surface, 0.5, 0.15);
+  ro.corner_uv.resize(3, 6);
+  EXPECT_THROW(render_design(*r.designer, r.outcome.design, ro), Error);
+}
+
+TEST(Param, RefusesWhatItCannotMap) {
+  const Mesh m = make_torus(12, 6);
+  FieldDesigner d(m.V, m.F);
+  IndexPrescription p;
+  p.N = 6;
+  const Design six = d.design(p);
+  ParamOptions o;
+  o.edge_length = 0.1;
+  try {
+    parametrize(d, six, o);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "param: a seamless parametrization needs a cross field (N = 4), got N = 6");
+  }
+  p.N = 4;
+  const Design four = d.design(p);
+  try {
+    parametrize(d, four, {});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "param: give a positive edge length or target face count (--edge-length H or --target-faces K)");
+  }
+  o.aligned_edges = {d.topology().num_edges};
+  EXPECT_THROW(parametrize(d, four, o), Error);
+}
+
+}  // namespace
+}  // namespace trivcon
