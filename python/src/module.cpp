@@ -65,6 +65,7 @@
 #include "trivcon/field.h"
 #include "trivcon/field_io.h"
 #include "trivcon/generate.h"
+#include "trivcon/param.h"
 #include "trivcon/indices.h"
 #include "trivcon/io.h"
 #include "trivcon/matching.h"
@@ -1142,6 +1143,66 @@ PYBIND11_MODULE(_core, m) {
             write_singularities(path, r.prescription.vertex, r.prescription.N);
           },
           py::arg("path"))
+      .def(
+          "write_uv_obj",
+          [](const DesignResult& r, const std::string& path, const Eigen::MatrixXd& corner_uv) {
+            py::gil_scoped_release release;
+            write_uv_obj(path, r.state->V, r.state->F, corner_uv);
+          },
+          py::arg("path"), py::arg("corner_uv"), "The OBJ of `param -o`: the mesh as given with (u, v) per corner (F x 6).")
+      .def(
+          "parametrize",
+          [](const DesignResultPtr& r, double edge_length, double target_faces, bool align_boundary,
+             const std::vector<std::pair<int, int>>& aligned_pairs) {
+            const Topology& t = r->state->topology();
+            ParamOptions o;
+            o.edge_length = edge_length, o.target_faces = target_faces;
+            if (align_boundary)
+              for (int e = 0; e < t.num_edges; ++e)
+                if (t.is_boundary_edge(e)) o.aligned_edges.push_back(e);
+            for (auto [a, b] : aligned_pairs) {
+              const int e = edge_between(t, a, b);
+              if (e < 0) throw Error("aligned edge (" + std::to_string(a) + ", " + std::to_string(b) + ") is not an edge of the mesh");
+              o.aligned_edges.push_back(e);
+            }
+            auto p = std::make_shared<Parametrization>(
+                interruptible(r->state->threads, [r, o] { return parametrize(*r->state->designer, r->design, o); }));
+            const Eigen::MatrixXd corners = input_corner_uv(*p, t, r->state->F);
+            DoubleArray uv({static_cast<py::ssize_t>(corners.rows()), static_cast<py::ssize_t>(3), static_cast<py::ssize_t>(2)});
+            auto U = uv.mutable_unchecked<3>();
+            for (Eigen::Index f = 0; f < corners.rows(); ++f)
+              for (int k = 0; k < 3; ++k) U(f, k, 0) = corners(f, 2 * k), U(f, k, 1) = corners(f, 2 * k + 1);
+            const auto n = static_cast<py::ssize_t>(p->cut_edges.size());
+            Int64Array cut({n, static_cast<py::ssize_t>(2)}), rotation(n), translation({n, static_cast<py::ssize_t>(2)});
+            auto C = cut.mutable_unchecked<2>();
+            auto R = rotation.mutable_unchecked<1>();
+            auto T = translation.mutable_unchecked<2>();
+            for (py::ssize_t k = 0; k < n; ++k) {
+              const int e = p->cut_edges[k];
+              C(k, 0) = t.edge_vertices(e, 0), C(k, 1) = t.edge_vertices(e, 1);
+              R(k) = p->rotation[e], T(k, 0) = p->translation(e, 0), T(k, 1) = p->translation(e, 1);
+            }
+            const ParamQuality& q = p->quality;
+            py::dict d;
+            d["seamless"] = q.seamless, d["cones"] = q.cones, d["cut_edges"] = q.cut_edges, d["integer_unknowns"] = q.integer_unknowns;
+            d["rounding_rounds"] = q.rounding_rounds, d["factorizations"] = q.factorizations, d["stiffening_rounds"] = q.stiffening_rounds;
+            d["folds_real_valued"] = q.folds_real_valued, d["folds_rounded"] = q.folds_rounded, d["cones_moved"] = q.cones_moved;
+            d["flipped_faces"] = q.flipped_faces, d["degenerate_faces"] = q.degenerate_faces, d["first_flipped"] = q.first_flipped;
+            d["max_transition_residual"] = q.max_transition_residual, d["max_cone_offset"] = q.max_cone_offset;
+            d["max_cone_angle_error"] = q.max_cone_angle_error, d["aligned_edges"] = q.aligned_edges;
+            d["unaligned_edges"] = q.unaligned_edges, d["max_alignment_error"] = q.max_alignment_error;
+            d["mean_distortion"] = q.mean_distortion, d["max_distortion"] = q.max_distortion, d["unit_squares"] = q.unit_squares;
+            d["target_squares"] = q.target_squares, d["non_unimodular"] = q.non_unimodular;
+            py::dict seconds;
+            seconds["cut"] = q.seconds_cut, seconds["setup"] = q.seconds_setup, seconds["rounding"] = q.seconds_rounding;
+            seconds["stiffening"] = q.seconds_stiffening, seconds["check"] = q.seconds_check;
+            d["seconds"] = seconds;
+            return py::make_tuple(uv, cut, rotation, translation, int64_vector(p->cones), int64_vector(p->cone_index), p->edge_length, d,
+                                  param_warning(*p));
+          },
+          py::arg("edge_length"), py::arg("target_faces"), py::arg("align_boundary"), py::arg("aligned_edges"),
+          "The integer-grid map (trivcon/param.h): (uv (F, 3, 2) in the input's corner order, cut edges (n, 2), their rotations, "
+          "translations (n, 2), cone vertices, their numerators (index n/4), edge length, quality dict, warning).")
       .def(
           "render",
           [](const DesignResultPtr& r, const std::optional<std::vector<std::pair<int, int>>>& singular, const RenderArgs& args) {

@@ -68,6 +68,7 @@ __all__ = [
     "FieldDesigner",
     "Result",
     "AutoResult",
+    "Parametrization",
     "read_mesh",
     "write_mesh",
     "field_indices",
@@ -871,6 +872,7 @@ class FieldDesigner(_Cached):
         auto = AutoResult(a, self) if a is not None else None
         designer = self if core is self._d else FieldDesigner._of_core(core, self)
         result = Result(designer, r, auto)
+        result._align_boundary = bool(align_boundary)
         if degrees is not None or edge_pairs:
             result.sharp_edges = _frozen(sharp)
         if split_large_turns:
@@ -976,7 +978,7 @@ class Result(_Cached):
 
     def __getstate__(self):
         state = {"designer": self._designer, "core": self._r.get_state(), "auto": self.auto}
-        for key in ("parent_face", "split_rounds", "split_converged", "sharp_edges"):
+        for key in ("parent_face", "split_rounds", "split_converged", "sharp_edges", "_align_boundary"):
             if key in self.__dict__:
                 state[key] = self.__dict__[key]
         return state
@@ -988,6 +990,8 @@ class Result(_Cached):
         self._cache = {}
         if "sharp_edges" in state:
             self.sharp_edges = state["sharp_edges"]
+        if "_align_boundary" in state:
+            self._align_boundary = state["_align_boundary"]
         if "parent_face" in state:  # after split_large_turns
             self.parent_face = _frozen(_np.array(state["parent_face"], dtype=_np.int64))
             self.split_rounds, self.split_converged = state["split_rounds"], state["split_converged"]
@@ -1195,12 +1199,78 @@ class Result(_Cached):
         """Write the singularities used, as --sing-out does (readable by `trivcon solve -s`)."""
         self._r.write_singularities(str(path))
 
+    def parametrize(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None):
+        """The seamless integer-grid map of this cross field (N = 4), as `trivcon param`: a Parametrization.
+
+        target_faces: about this many unit squares; or edge_length: one unit of (u, v) in the mesh's units.
+        align_boundary: put every boundary edge the field runs along on an integer iso-line (default: as
+          this field was solved, solve(align_boundary=...)). aligned_edges: (n, 2) vertex pairs of more edges
+          to put on iso-lines (default: the sharp edges the solve followed, Result.sharp_edges).
+        The mathematics and what is checked: docs/param.md. Raises trivcon.Error for N other than 4, a
+        missing or non-positive scale, or an aligned edge that is not an edge of the mesh.
+        """
+        if self.N != 4:
+            raise Error(f"param: a seamless parametrization needs a cross field (N = 4), got N = {self.N}")
+        if (target_faces is None) == (edge_length is None):
+            raise Error("parametrize: give exactly one of target_faces and edge_length")
+        scale = target_faces if edge_length is None else edge_length
+        if isinstance(scale, bool) or not isinstance(scale, _numbers.Real) or not _math.isfinite(scale) or scale <= 0:
+            raise Error(f"parametrize: {'target_faces' if edge_length is None else 'edge_length'} must be a positive number, not {scale!r}")
+        if align_boundary is None:
+            align_boundary = self.__dict__.get("_align_boundary", False)
+        if aligned_edges is None:
+            pairs = self.__dict__.get("sharp_edges", _np.zeros((0, 2), dtype=_np.int64))
+        else:
+            pairs = _array(aligned_edges, "aligned_edges")
+            if pairs.size and (pairs.ndim != 2 or pairs.shape[1] != 2 or pairs.dtype.kind not in "iu"):
+                raise Error(f"aligned_edges: expected (n, 2) vertex ids, got an array of shape {pairs.shape} and type {pairs.dtype}")
+        edge_pairs = [(int(a), int(b)) for a, b in _np.asarray(pairs).reshape(-1, 2)]
+        out = self._r.parametrize(float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs)
+        return Parametrization(self, *out)
+
     def render(self, size=(1200, 900), view=(30, 20), up="y", style="hedgehog", spacing=11, flat=False, legend=True,
                singularities=None, supersampling=3):
         """An (h, w, 3) uint8 picture of this field, as trivcon.render; singularities default to the ones
         prescribed (as `trivcon solve --png`)."""
         args = _render_args(size, view, up, style, spacing, flat, legend, supersampling)
         return self._r.render(_singular_pairs(singularities, self.N), args)
+
+
+class Parametrization:
+    """A seamless integer-grid map (Result.parametrize; the conventions of trivcon/param.h, docs/param.md).
+
+      uv           float64 (F, 3, 2): (u, v) of each corner of each input face, in the input's corner order
+      cut_edges    int64 (n, 2): the cut's edges as vertex pairs (i < j); rotations int64 (n,): r in [0, 4),
+                   translations int64 (n, 2): across cut edge (i, j) from its L face to its R face, the sides
+                   differ by the rotation by r quarter turns and then the translation
+      cones        int64 (k,): the singular vertices; cone_index int64 (k,): n per cone (index n / 4)
+      edge_length  the mesh length of one unit of (u, v)
+      quality      dict: seamless, flipped_faces, degenerate_faces, max_transition_residual, max_cone_offset,
+                   max_cone_angle_error, max_alignment_error, mean_distortion, unit_squares, target_squares,
+                   seconds, ... (the `param` object of `trivcon param --report`)
+      warning      "" or what is wrong with the map (folds, with what to change)
+    write_obj(path) writes what `trivcon param -o` writes.
+    """
+
+    def __init__(self, result, uv, cut, rotations, translations, cones, cone_index, edge_length, quality, warning):
+        self._result = result
+        self.uv, self.cut_edges, self.rotations, self.translations = (_frozen(a) for a in (uv, cut, rotations, translations))
+        self.cones, self.cone_index = _frozen(cones), _frozen(cone_index)
+        self.edge_length, self.quality, self.warning = edge_length, quality, warning
+
+    @property
+    def seamless(self):
+        """Transitions whole, cones on integer points, aligned edges on iso-lines (to 1e-6)."""
+        return self.quality["seamless"]
+
+    def write_obj(self, path):
+        """Write the OBJ of `trivcon param -o`: the mesh as given, one vt per corner."""
+        self._result._r.write_uv_obj(str(path), _np.ascontiguousarray(self.uv.reshape(-1, 6)))
+
+    def __repr__(self):
+        q = self.quality
+        return (f"Parametrization({self.uv.shape[0]} faces, edge length {self.edge_length:.4g}, {q['unit_squares']:.0f} unit squares, "
+                f"seamless={q['seamless']}, {q['flipped_faces']} flipped, {q['degenerate_faces']} degenerate)")
 
 
 class AutoResult(_Cached):

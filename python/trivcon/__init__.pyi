@@ -236,6 +236,13 @@ class Result:
     def write_matching(self, path: _Path) -> None: ...
     def write_lines(self, path: _Path) -> None: ...
     def write_singularities(self, path: _Path) -> None: ...
+    def parametrize(
+        self,
+        target_faces: Optional[float] = ...,
+        edge_length: Optional[float] = ...,
+        align_boundary: Optional[bool] = ...,
+        aligned_edges: Optional[npt.ArrayLike] = ...,
+    ) -> Parametrization: ...
     def render(
         self,
         size: Tuple[int, int] = ...,
@@ -248,6 +255,33 @@ class Result:
         singularities: Optional[_Indices] = ...,
         supersampling: int = ...,
     ) -> _ImageArray: ...
+
+class Parametrization:
+    uv: _FloatArray
+    cut_edges: _IntArray
+    rotations: _IntArray
+    translations: _IntArray
+    cones: _IntArray
+    cone_index: _IntArray
+    edge_length: float
+    quality: Dict[str, Any]
+    warning: str
+    def __init__(
+        self,
+        result: Result,
+        uv: Any,
+        cut: Any,
+        rotations: Any,
+        translations: Any,
+        cones: Any,
+        cone_index: Any,
+        edge_length: float,
+        quality: Dict[str, Any],
+        warning: str,
+    ) -> None: ...
+    @property
+    def seamless(self) -> bool: ...
+    def write_obj(self, path: _Path) -> None: ...
 
 class AutoResult:
     def __init__(self, a: Any, designer: Optional[FieldDesigner] = ...) -> None: ...
