@@ -121,6 +121,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"folds_real_valued", q.folds_real_valued},
           {"folds_rounded", q.folds_rounded},
           {"cones_moved", q.cones_moved},
+          {"integers_moved", q.integers_moved},
           {"flipped_faces", q.flipped_faces},
           {"degenerate_faces", q.degenerate_faces},
           {"first_flipped", q.first_flipped},

@@ -50,6 +50,7 @@ struct ParamQuality {
   int folds_real_valued = 0;  // folded faces of the first, real-valued map (before stiffening)
   int folds_rounded = 0;      // folded faces right after the rounding (before stiffening again)
   int cones_moved = 0;        // singularities moved to a neighbouring integer point against a fold or a shared point
+  int integers_moved = 0;     // other integers (iso-lines, translations) moved by ±1 against a fold
   int flipped_faces = 0;      // faces whose (u, v) triangle is inverted
   int degenerate_faces = 0;   // faces whose (u, v) triangle has (nearly) zero area
   std::vector<int> first_flipped;  // up to 10 ids of flipped or degenerate faces

@@ -545,6 +545,14 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     }
     return false;
   };
+  // The response of the solution to a unit change of fixed value j (one solve with the current factorization).
+  auto response = [&](int j) {
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(nY);
+    for (Eigen::SparseMatrix<double>::InnerIterator it(K, j); it; ++it)
+      if (!fixed[it.row()]) r[it.row()] = -it.value();
+    r[j] = 1;
+    return solver->solve(r);
+  };
   std::vector<char> tried(nCone, 0);
   for (int k = 0; k < nCone; ++k) {
     const int v = out.cones[k];
@@ -554,13 +562,6 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     const double u0 = value[ju], v0 = value[jv];
     // The solution is affine in the two values: y + dx·g_u + dy·g_v, with g_j the response to a unit change of
     // fixed value j (two solves with the current factorization, instead of one per candidate).
-    auto response = [&](int j) {
-      Eigen::VectorXd r = Eigen::VectorXd::Zero(nY);
-      for (Eigen::SparseMatrix<double>::InnerIterator it(K, j); it; ++it)
-        if (!fixed[it.row()]) r[it.row()] = -it.value();
-      r[j] = 1;
-      return solver->solve(r);
-    };
     const Eigen::VectorXd y0 = y, gu = response(ju), gv = response(jv);
     std::pair<int, double> best{std::numeric_limits<int>::max(), std::numeric_limits<double>::infinity()};
     Eigen::Vector2d step(0, 0);
@@ -576,6 +577,43 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     corner_uv();
     if (step.squaredNorm() > 0) ++q.cones_moved;
     k = -1;  // a move changes the others' rings: look again from the first untried one
+  }
+  // Then the other integers a folded or degenerate face depends on (an iso-line rounded onto its neighbour, a
+  // translation): each, once, tries ±1, kept when it leaves fewer folds (the solution is affine in it: one solve).
+  {
+    const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = P;
+    std::vector<char> is_cone_value(nY, 0), seen(nY, 0);
+    for (int k = 0; k < nCone; ++k)
+      for (int c = 0; c < 2; ++c)
+        if (!elim.eliminated(cone0 + 2 * k + c)) is_cone_value[free_index[cone0 + 2 * k + c]] = 1;
+    int budget = 400;  // candidate integers tried in all
+    for (int f = 0; f < nF && budget > 0; ++f) {
+      if (!folded(f)) continue;
+      std::vector<int> candidates;
+      for (int i = 0; i < 3; ++i)
+        for (int c = 0; c < 2; ++c)
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, 2 * wedge[3 * f + i] + c); it; ++it) {
+            const int j = static_cast<int>(it.col());
+            if (fixed[j] && !is_cone_value[j] && !seen[j]) seen[j] = 1, candidates.push_back(j);
+          }
+      for (int j : candidates) {
+        if (budget-- <= 0 || !folded(f)) break;
+        const Eigen::VectorXd y0 = y, gj = response(j);
+        const std::pair<int, double> here{count_folds(), energy(y0)};
+        std::pair<int, double> best = here;
+        int step = 0;
+        for (int d : {-1, 1}) {
+          y = y0 + d * gj;
+          corner_uv();
+          const std::pair<int, double> score{count_folds(), energy(y)};
+          if (score.first < best.first) best = score, step = d;
+        }
+        y = y0 + step * gj;
+        value[j] += step;
+        corner_uv();
+        if (step != 0) ++q.integers_moved;
+      }
+    }
   }
   q.folds_rounded = count_folds();
   q.seconds_rounding = linalg::seconds_since(t2);
