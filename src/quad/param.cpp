@@ -701,6 +701,12 @@ std::string param_warning(const Parametrization& param) {
     s << ")";
     if (q.max_cone_angle_error > 1e-6) s << ", folding around singularities (cone angles off by up to " << q.max_cone_angle_error << " rad)";
     s << " after " << q.stiffening_rounds << " stiffening rounds: a larger edge length, or singularities further apart, usually removes them";
+    for (size_t k = 0; k < param.cones.size(); ++k)
+      if (param.cone_index[k] >= 4) {
+        s << "; singular vertex " << param.cones[k] << " has index " << param.cone_index[k] << "/4 >= 1: its (u, v) angle 2pi(1 - k) <= 0 "
+          << "cannot be made without folding (a quad mesh needs indices below 1)";
+        break;
+      }
   }
   return s.str();
 }
