@@ -72,12 +72,8 @@ void append_little_endian(std::string& out, T value) {
   out.append(reinterpret_cast<const char*>(bytes), sizeof bytes);
 }
 
-}  // namespace
-
-void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
-  check_writable(path, V, F);
-  std::string text = "# trivcon mesh: " + std::to_string(V.rows()) + " vertices, " + std::to_string(F.rows()) + " faces\n";
-  text.reserve(text.size() + 64 * V.rows() + 24 * F.rows());
+// The `v x y z` lines of an OBJ.
+void append_obj_vertices(std::string& text, const MatrixX3d& V) {
   for (Eigen::Index v = 0; v < V.rows(); ++v) {
     text += 'v';
     for (int axis = 0; axis < 3; ++axis) {
@@ -86,6 +82,15 @@ void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) 
     }
     text += '\n';
   }
+}
+
+}  // namespace
+
+void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
+  check_writable(path, V, F);
+  std::string text = "# trivcon mesh: " + std::to_string(V.rows()) + " vertices, " + std::to_string(F.rows()) + " faces\n";
+  text.reserve(text.size() + 64 * V.rows() + 24 * F.rows());
+  append_obj_vertices(text, V);
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     text += 'f';
     for (int c = 0; c < 3; ++c) {
@@ -105,14 +110,7 @@ void write_uv_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& 
   std::string text = "# trivcon seamless parametrization: " + std::to_string(V.rows()) + " vertices, " + std::to_string(F.rows()) +
                      " faces, one vt per corner\n";
   text.reserve(text.size() + 64 * V.rows() + 90 * F.rows());
-  for (Eigen::Index v = 0; v < V.rows(); ++v) {
-    text += 'v';
-    for (int axis = 0; axis < 3; ++axis) {
-      text += ' ';
-      append_coordinate(text, V(v, axis));
-    }
-    text += '\n';
-  }
+  append_obj_vertices(text, V);
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int c = 0; c < 3; ++c) {
       text += "vt ";
