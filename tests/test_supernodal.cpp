@@ -492,7 +492,7 @@ TEST(Supernodal, TreeSplitIntoAnyNumberOfParts) {
   }
 }
 
-// With `refine` (the parallel substitution's split): the same contract of independent, balanced parts, and a
+// With `deepen` (the parallel substitution's split): the same contract of independent, balanced parts, and a
 // critical path (the top's work, done on one thread, plus the heaviest part's) never longer than without.
 TEST(Supernodal, RefinedTreeSplitShortensTheCriticalPath) {
   using linalg::split_tree;
@@ -509,10 +509,10 @@ TEST(Supernodal, RefinedTreeSplitShortensTheCriticalPath) {
     std::vector<double> work;
     random_forest(rng, parent, work);
     for (int parts : {2, 3}) {
-      const linalg::TreeSplit plain = split_tree(parent, work, 100, parts), refined = split_tree(parent, work, 100, parts, true);
+      const linalg::TreeSplit plain = split_tree(parent, work, 100, parts), deepened = split_tree(parent, work, 100, parts, true);
       const BelowTop below_plain = expect_valid_split(parent, work, 100, plain, parts);
-      const BelowTop below_refined = expect_valid_split(parent, work, 100, refined, parts);
-      const double a = critical_path(work, plain, below_plain), b = critical_path(work, refined, below_refined);
+      const BelowTop below_deepened = expect_valid_split(parent, work, 100, deepened, parts);
+      const double a = critical_path(work, plain, below_plain), b = critical_path(work, deepened, below_deepened);
       EXPECT_LE(b, a + 1e-9);
       shorter += b < a - 1e-9;
     }
@@ -522,12 +522,12 @@ TEST(Supernodal, RefinedTreeSplitShortensTheCriticalPath) {
   // two of them share a thread (critical path 1 + 60); going down the 40 (2 over two 19s) gives 3 + 54.
   const std::vector<int> parent{2, 2, 5, 5, 5, -1};
   const std::vector<double> work{19, 19, 2, 35, 25, 1};
-  const linalg::TreeSplit plain = split_tree(parent, work, 1, 2), refined = split_tree(parent, work, 1, 2, true);
-  const BelowTop a = expect_valid_split(parent, work, 1, plain), b = expect_valid_split(parent, work, 1, refined);
+  const linalg::TreeSplit plain = split_tree(parent, work, 1, 2), deepened = split_tree(parent, work, 1, 2, true);
+  const BelowTop a = expect_valid_split(parent, work, 1, plain), b = expect_valid_split(parent, work, 1, deepened);
   EXPECT_EQ(plain.top, (std::vector<int>{5}));
   EXPECT_DOUBLE_EQ(critical_path(work, plain, a), 61);
-  EXPECT_EQ(refined.top, (std::vector<int>{2, 5}));
-  EXPECT_DOUBLE_EQ(critical_path(work, refined, b), 57);
+  EXPECT_EQ(deepened.top, (std::vector<int>{2, 5}));
+  EXPECT_DOUBLE_EQ(critical_path(work, deepened, b), 57);
 }
 
 // The elimination trees of mesh Laplacians, with the work measure and threshold linalg::factorize

@@ -15,7 +15,7 @@
 // columns are read as a stream (forward: first to last; backward: last to first, so that the whole
 // backward pass is one descending stream the processor prefetches), with plain loops (BLAS's per-call cost
 // is more than most supernodes' work). The split is balanced by entries and goes down the tree while that
-// shortens top + heaviest part (split_tree's `refine`). It is several times faster than cholmod_solve
+// shortens top + heaviest part (split_tree's `deepen`). It is several times faster than cholmod_solve
 // (BENCHMARKS.md, "Figures that were in code comments").
 // solve and solve_in_factor_order are not for concurrent calls on one object (their work vectors are shared).
 #pragma once

@@ -263,7 +263,7 @@ class Numeric {
 
 }  // namespace
 
-TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& own_work, double min_split, int parts, bool refine) {
+TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& own_work, double min_split, int parts, bool deepen) {
   if (parts < 1) parts = 1;
   const int count = static_cast<int>(parent.size());
   std::vector<double> work = own_work;  // of each subtree (a parent comes after its children)
@@ -290,7 +290,7 @@ TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& 
     open_work -= work[s];
     for (int c : children[s]) open.push_back(c), std::push_heap(open.begin(), open.end(), lighter), open_work += work[c];
   }
-  if (refine && parts > 1) {
+  if (deepen && parts > 1) {
     // Further down while that shortens top + heaviest part: each step moves the heaviest subtree's root to
     // the top; the best prefix of these steps is kept (64 steps in a row without a better one end the search).
     auto heaviest_part = [&](std::vector<int> roots) {

@@ -24,7 +24,7 @@ namespace trivcon::linalg {
 // subtree is split at its root while it holds more than 1/parts of the work below the top and more than
 // `min_split`, then the subtrees go, largest first, to the part with the least work so far. Each list is
 // in increasing supernode order (descendants first). parts ≥ 1; with 1 everything is in part[0].
-// With `refine`, the splitting then goes further down while that shortens the critical path, the work of the
+// With `deepen`, the splitting then goes further down while that shortens the critical path, the work of the
 // top plus that of the heaviest part (for a top done on one thread: the parallel substitution of
 // src/linalg/substitution.h); the largest subtree left is then smaller still.
 struct TreeSplit {
@@ -32,7 +32,7 @@ struct TreeSplit {
   std::vector<std::vector<int>> part;
 };
 TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& work, double min_split, int parts = 2,
-                     bool refine = false);
+                     bool deepen = false);
 
 // CHOLMOD's supernodal factor, read in place: supernode s holds the columns first(s) … first(s) + cols(s)
 // − 1; its rows (its own columns first, then rows of its ancestors) are row(s, 0 … height(s) − 1), its
