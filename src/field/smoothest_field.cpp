@@ -16,6 +16,7 @@
 #include "linalg/cholmod.h"
 #include "linalg/ordering.h"
 #include "linalg/parallel.h"
+#include "linalg/inverse_iteration.h"
 #include "linalg/substitution.h"
 #include "linalg/supernodal.h"
 #include "linalg/timing.h"
@@ -132,76 +133,143 @@ SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, c
   return std::move(candidate[dissect ? 1 : 0]);
 }
 
-// The smoothest field's complex values per face (see docs/auto.md, "The eigen-solve").
-std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o,
-                                      const std::vector<Complex>* guidance, AutoTimings& time, std::string& ordering_used) {
-  auto t0 = Clock::now();
+// The smoothest field's system (docs/auto.md, "The field"): the unknown faces (those not fixed), the upper
+// triangle of the Hermitian A + εM over them in compressed columns (values as (real, imaginary) pairs), and the
+// right-hand side of the fixed faces' values.
+struct SmoothestSystem {
+  std::vector<Complex> u;                 // per face: the fixed faces' values, 0 elsewhere
+  std::vector<int> unknown, face_of;      // face -> unknown (or −1), unknown -> face
+  std::vector<char> dirichlet_component;  // per component: 1 when it has fixed faces
+  Eigen::VectorXd diag;                   // per face: Σ w over its interior edges
+  double eps = 0;                         // the shift
+  std::vector<int> outer, inner;
+  std::vector<double> values;
+  std::vector<double> dirichlet;          // b_g = −Σ A_gf u_f over fixed neighbours f, per unknown (real, imaginary)
+  int size() const { return static_cast<int>(face_of.size()); }
+};
+
+SmoothestSystem assemble_smoothest_system(const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o) {
   const int N = o.N;
-  std::vector<Complex> u(t.num_faces, Complex(0, 0));
-  std::vector<int> unknown(t.num_faces, -1), face_of;
-  std::vector<char> dirichlet_component(t.components.size(), 0);
+  SmoothestSystem S;
+  S.u.assign(t.num_faces, Complex(0, 0));
+  S.unknown.assign(t.num_faces, -1);
+  S.dirichlet_component.assign(t.components.size(), 0);
   for (auto [f, angle] : o.fixed) {
     if (f < 0 || f >= t.num_faces) throw Error("automatic singularities: fixed face " + std::to_string(f) + " out of range");
     if (!std::isfinite(angle)) throw Error("automatic singularities: fixed face " + std::to_string(f) + " has a non-finite angle");
-    u[f] = std::polar(1.0, N * angle);
-    dirichlet_component[t.face_component[f]] = 1;
+    S.u[f] = std::polar(1.0, N * angle);
+    S.dirichlet_component[t.face_component[f]] = 1;
   }
   for (int f = 0; f < t.num_faces; ++f)
-    if (!o.fixed.count(f)) unknown[f] = static_cast<int>(face_of.size()), face_of.push_back(f);
-  const int n = static_cast<int>(face_of.size());
-  if (n == 0) return u;
-
-  // The shift ε of docs/auto.md and the upper triangle of the Hermitian A + εM in compressed columns
-  // (n × n complex, values as (real, imaginary) pairs).
-  Eigen::VectorXd diag = Eigen::VectorXd::Zero(t.num_faces);
+    if (!o.fixed.count(f)) S.unknown[f] = static_cast<int>(S.face_of.size()), S.face_of.push_back(f);
+  const int n = S.size();
+  if (n == 0) return S;
+  S.diag = Eigen::VectorXd::Zero(t.num_faces);
   for (int e = 0; e < t.num_edges; ++e)
-    if (!t.is_boundary_edge(e)) diag[t.edge_faces(e, 0)] += k.w[e], diag[t.edge_faces(e, 1)] += k.w[e];
+    if (!t.is_boundary_edge(e)) S.diag[t.edge_faces(e, 0)] += k.w[e], S.diag[t.edge_faces(e, 1)] += k.w[e];
   // The ratio of the sums, not the mean of the ratios: a zero-area face has the floor mass and an ordinary
   // diagonal, so its ratio is ~1e12 times the others', and a mean over faces would make the shift swamp A
   // on any mesh with a few such faces (the inverse iteration then barely moves from its random start).
-  const double eps = 1e-8 * diag.sum() / k.mass.sum();
-  std::vector<int> outer(n + 1, 0), inner;
-  std::vector<double> values;
-  inner.reserve(static_cast<size_t>(n) * 3), values.reserve(static_cast<size_t>(n) * 6);
+  S.eps = 1e-8 * S.diag.sum() / k.mass.sum();
+  S.outer.assign(n + 1, 0);
+  S.inner.reserve(static_cast<size_t>(n) * 3), S.values.reserve(static_cast<size_t>(n) * 6);
   std::vector<std::pair<int, Complex>> column;
   for (int j = 0; j < n; ++j) {
-    const int f = face_of[j];
+    const int f = S.face_of[j];
     column.clear();
     for (int c = 0; c < 3; ++c) {
       const int e = t.face_edges(f, c);
       if (t.is_boundary_edge(e)) continue;
       const int h = t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
-      if (h != f && unknown[h] >= 0 && unknown[h] < j) column.emplace_back(unknown[h], off_diagonal(t, g, k, N, e, h));
+      if (h != f && S.unknown[h] >= 0 && S.unknown[h] < j) column.emplace_back(S.unknown[h], off_diagonal(t, g, k, N, e, h));
     }
     std::sort(column.begin(), column.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (auto [i, a] : column) inner.push_back(i), values.push_back(a.real()), values.push_back(a.imag());
-    inner.push_back(j), values.push_back(diag[f] + eps * k.mass[f]), values.push_back(0.0);
-    outer[j + 1] = static_cast<int>(inner.size());
+    for (auto [i, a] : column) S.inner.push_back(i), S.values.push_back(a.real()), S.values.push_back(a.imag());
+    S.inner.push_back(j), S.values.push_back(S.diag[f] + S.eps * k.mass[f]), S.values.push_back(0.0);
+    S.outer[j + 1] = static_cast<int>(S.inner.size());
   }
-  // Right-hand side from the fixed faces: b_g = −Σ A_gf u_f over fixed neighbours f.
-  Eigen::VectorXd dirichlet = Eigen::VectorXd::Zero(2 * n);
+  S.dirichlet.assign(2 * static_cast<size_t>(n), 0.0);
   for (int e = 0; e < t.num_edges; ++e) {
     if (t.is_boundary_edge(e)) continue;
-    for (int s = 0; s < 2; ++s) {
-      const int row = t.edge_faces(e, s), col = t.edge_faces(e, 1 - s);
-      if (unknown[row] < 0 || unknown[col] >= 0) continue;
-      const Complex b = -off_diagonal(t, g, k, N, e, row) * u[col];
-      dirichlet[2 * unknown[row]] += b.real(), dirichlet[2 * unknown[row] + 1] += b.imag();
+    for (int side = 0; side < 2; ++side) {
+      const int row = t.edge_faces(e, side), col = t.edge_faces(e, 1 - side);
+      if (S.unknown[row] < 0 || S.unknown[col] >= 0) continue;
+      const Complex b = -off_diagonal(t, g, k, N, e, row) * S.u[col];
+      S.dirichlet[2 * S.unknown[row]] += b.real(), S.dirichlet[2 * S.unknown[row] + 1] += b.imag();
     }
   }
+  return S;
+}
+
+// Curvature alignment (docs/auto.md): the field x found so far is replaced, on each component with curvature,
+// by the solution of (A − t·λ̂ M) u = M q + b_D toward the guidance q; with t ≠ 0 the factor L is refactored.
+void align_to_guidance(const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o, const std::vector<Complex>& guidance,
+                       SmoothestSystem& S, cholmod_factor& L, cholmod_common& c, const linalg::Substitution<Complex>& substitution,
+                       std::vector<double>& x) {
+  const int N = o.N, n = S.size(), components = static_cast<int>(t.components.size());
+  // Per component: the Rayleigh quotient λ̂ of the field found so far (the smoothest field's eigenvalue, or the
+  // energy of the Dirichlet solution) and the guidance's scale (area-weighted mean |q| = 1).
+  auto value = [&](int f) { return S.unknown[f] >= 0 ? Complex(x[2 * S.unknown[f]], x[2 * S.unknown[f] + 1]) : S.u[f]; };
+  std::vector<double> energy(components, 0), norm(components, 0), zsum(components, 0), msum(components, 0);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const int L_ = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    energy[t.face_component[L_]] += k.w[e] * std::norm(value(R) - std::polar(1.0, N * g.rho[e]) * value(L_));
+  }
+  std::vector<Complex> q(t.num_faces);  // M q, before scaling
+  for (int f = 0; f < t.num_faces; ++f) {
+    const int comp = t.face_component[f];
+    norm[comp] += k.mass[f] * std::norm(value(f)), msum[comp] += k.mass[f];
+    const Complex z = guidance[f];
+    const double a = std::abs(z);
+    q[f] = a > 0 ? a * std::pow(z / a, N / 2) : Complex(0, 0);
+    zsum[comp] += a;
+  }
+  std::vector<char> guided(components, 0);
+  for (int comp = 0; comp < components; ++comp) guided[comp] = zsum[comp] > 0 && std::isfinite(zsum[comp]);
+  if (o.curvature_t != 0) {
+    // A − λ_t M with λ_t = t λ̂ per component (the shift ε kept), refactored on the same analysis.
+    for (int j = 0; j < n; ++j) {
+      const int f = S.face_of[j], comp = t.face_component[f];
+      const double lambda = norm[comp] > 0 ? energy[comp] / norm[comp] : 0.0;
+      S.values[2 * (S.outer[j + 1] - 1)] = S.diag[f] + (S.eps - o.curvature_t * lambda) * k.mass[f];
+    }
+    if (linalg::factorize_complex(L, S.outer, S.inner, S.values, c) < n)
+      throw Error("automatic singularities: curvature alignment with t = " + std::to_string(o.curvature_t) +
+                  " makes the system indefinite (t must be below 1, and a little below 1 can already exceed the smallest "
+                  "eigenvalue's estimate): use a smaller t");
+  }
+  Eigen::VectorXd b(2 * n);
+  for (int j = 0; j < n; ++j) {
+    const int f = S.face_of[j], comp = t.face_component[f];
+    const Complex mq = guided[comp] ? q[f] * (msum[comp] / zsum[comp]) : Complex(0, 0);
+    b[2 * j] = mq.real() + S.dirichlet[2 * j], b[2 * j + 1] = mq.imag() + S.dirichlet[2 * j + 1];
+  }
+  substitution.solve(reinterpret_cast<Complex*>(b.data()));
+  for (int j = 0; j < n; ++j)  // components without curvature (flat, umbilic) keep the smoothest field
+    if (guided[t.face_component[S.face_of[j]]]) x[2 * j] = b[2 * j], x[2 * j + 1] = b[2 * j + 1];
+}
+
+// The smoothest field's complex values per face (see docs/auto.md, "The eigen-solve"): the system, its
+// factorization, the inverse iteration (src/linalg/inverse_iteration.h), the curvature alignment.
+std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o,
+                                      const std::vector<Complex>* guidance, AutoTimings& time, std::string& ordering_used) {
+  auto t0 = Clock::now();
+  SmoothestSystem S = assemble_smoothest_system(t, g, k, o);
+  const int n = S.size();
+  if (n == 0) return S.u;
   time.assemble = seconds_since(t0);
   check_cancelled();  // trivcon/cancel.h: here, after the analysis, per iteration
 
   t0 = Clock::now();
-  const SymbolicFactor symbolic = analyse_smoothest_matrix(V, t, face_of, outer, inner);
+  const SymbolicFactor symbolic = analyse_smoothest_matrix(V, t, S.face_of, S.outer, S.inner);
   check_cancelled();
   cholmod_common& c = **symbolic.context;
   cholmod_factor* const L = symbolic.factor.get();
   ordering_used = symbolic.ordering;
   // The numeric factor by trivcon's own supernodal code (src/linalg/supernodal.h, the same that factors the
-  // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another,
-  // and took several times as long (BENCHMARKS.md, "The cost of --auto at 400k faces").
-  if (const int minor = linalg::factorize_complex(*L, outer, inner, values, c); minor < n)
+  // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another.
+  if (const int minor = linalg::factorize_complex(*L, S.outer, S.inner, S.values, c); minor < n)
     throw Error("automatic singularities: the smoothest-field matrix is not positive definite (column " + std::to_string(minor) +
                 " of " + std::to_string(n) + "): a non-finite or degenerate weight");
   // The solves below on both cores (src/linalg/substitution.h): CHOLMOD's own, on one core, were several times slower.
@@ -210,109 +278,44 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
 
   t0 = Clock::now();
   const int components = static_cast<int>(t.components.size());
-  auto normalise = [&](Eigen::VectorXd& x) {  // ‖x‖_M = 1 on every component without fixed faces
+  linalg::InverseIterationProblem problem;
+  problem.mass.resize(n), problem.group.resize(n);
+  for (int j = 0; j < n; ++j) problem.mass[j] = k.mass[S.face_of[j]], problem.group[j] = t.face_component[S.face_of[j]];
+  problem.normalised.resize(components);
+  for (int comp = 0; comp < components; ++comp) problem.normalised[comp] = !S.dirichlet_component[comp];
+  problem.affine = S.dirichlet;
+  problem.iterations = o.iterations;
+  problem.what = "automatic singularities";
+  // A fixed start, ‖x‖_M = 1 on every component without fixed faces: the result is deterministic.
+  std::vector<double> x(2 * static_cast<size_t>(n));
+  std::mt19937 random(20131);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (double& v : x) v = uniform(random);
+  {
     std::vector<double> norm(components, 0);
-    for (int j = 0; j < n; ++j)
-      norm[t.face_component[face_of[j]]] += k.mass[face_of[j]] * (x[2 * j] * x[2 * j] + x[2 * j + 1] * x[2 * j + 1]);
+    for (int j = 0; j < n; ++j) norm[problem.group[j]] += problem.mass[j] * (x[2 * j] * x[2 * j] + x[2 * j + 1] * x[2 * j + 1]);
     for (int j = 0; j < n; ++j) {
-      const int comp = t.face_component[face_of[j]];
-      if (dirichlet_component[comp]) continue;
+      const int comp = problem.group[j];
+      if (!problem.normalised[comp]) continue;
       if (!(norm[comp] > 0) || !std::isfinite(norm[comp]))
         throw Error("automatic singularities: the inverse iteration lost the field on component " + std::to_string(comp) + " (norm " +
                     std::to_string(norm[comp]) + ")");
-      x.segment<2>(2 * j) /= std::sqrt(norm[comp]);
-    }
-  };
-  Eigen::VectorXd x(2 * n);
-  std::mt19937 random(20131);  // a fixed start: the result is deterministic
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  for (int i = 0; i < 2 * n; ++i) x[i] = uniform(random);
-  normalise(x);
-  {
-    // The iterations in the factor's order (no permutation per solve; mass, component and Dirichlet values
-    // permuted once): x ← s (A + εM)⁻¹ (M x + b_D), s = 1 / ‖·‖_M per component, applied with the next mass
-    // product (and at the end) instead of a pass of its own.
-    const std::vector<int>& perm = substitution.permutation();
-    std::vector<Complex> xf(n), bf(n), df(n);
-    std::vector<double> mf(n), scale(components, 1.0), norm(components);
-    std::vector<int> cf(n);
-    for (int q = 0; q < n; ++q) {
-      const int j = perm[q], comp = t.face_component[face_of[j]];
-      xf[q] = Complex(x[2 * j], x[2 * j + 1]), df[q] = Complex(dirichlet[2 * j], dirichlet[2 * j + 1]);
-      cf[q] = comp, mf[q] = dirichlet_component[comp] ? 0.0 : k.mass[face_of[j]];
-    }
-    for (int it = 0; it < std::max(1, o.iterations); ++it) {
-      check_cancelled();
-      for (int q = 0; q < n; ++q) bf[q] = (mf[q] * scale[cf[q]]) * xf[q] + df[q];
-      substitution.solve_in_factor_order(bf.data());
-      xf.swap(bf);
-      std::fill(norm.begin(), norm.end(), 0.0);
-      for (int q = 0; q < n; ++q) norm[cf[q]] += mf[q] * std::norm(xf[q]);
-      for (int comp = 0; comp < components; ++comp) {
-        if (dirichlet_component[comp]) continue;
-        if (!(norm[comp] > 0) || !std::isfinite(norm[comp]))
-          throw Error("automatic singularities: the inverse iteration lost the field on component " + std::to_string(comp) + " (norm " +
-                      std::to_string(norm[comp]) + ")");
-        scale[comp] = 1 / std::sqrt(norm[comp]);
-      }
-    }
-    for (int q = 0; q < n; ++q) {
-      const Complex v = xf[q] * scale[cf[q]];
-      x[2 * perm[q]] = v.real(), x[2 * perm[q] + 1] = v.imag();
+      x[2 * j] /= std::sqrt(norm[comp]), x[2 * j + 1] /= std::sqrt(norm[comp]);
     }
   }
-  Eigen::VectorXd b(2 * n);
+  linalg::inverse_iteration(substitution, problem, x);
   time.iterate = seconds_since(t0);
   if (guidance) {
     t0 = Clock::now();
-    // Per component: the Rayleigh quotient λ̂ of the field found so far (the smoothest field's eigenvalue, or the
-    // energy of the Dirichlet solution) and the guidance's scale (area-weighted mean |q| = 1).
-    auto value = [&](int f) { return unknown[f] >= 0 ? Complex(x[2 * unknown[f]], x[2 * unknown[f] + 1]) : u[f]; };
-    std::vector<double> energy(components, 0), norm(components, 0), zsum(components, 0), msum(components, 0);
-    for (int e = 0; e < t.num_edges; ++e) {
-      if (t.is_boundary_edge(e)) continue;
-      const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
-      energy[t.face_component[L]] += k.w[e] * std::norm(value(R) - std::polar(1.0, N * g.rho[e]) * value(L));
-    }
-    std::vector<Complex> q(t.num_faces);  // M q, before scaling
-    for (int f = 0; f < t.num_faces; ++f) {
-      const int comp = t.face_component[f];
-      norm[comp] += k.mass[f] * std::norm(value(f)), msum[comp] += k.mass[f];
-      const Complex z = (*guidance)[f];
-      const double a = std::abs(z);
-      q[f] = a > 0 ? a * std::pow(z / a, N / 2) : Complex(0, 0);
-      zsum[comp] += a;
-    }
-    std::vector<char> guided(components, 0);
-    for (int comp = 0; comp < components; ++comp) guided[comp] = zsum[comp] > 0 && std::isfinite(zsum[comp]);
-    if (o.curvature_t != 0) {
-      // A − λ_t M with λ_t = t λ̂ per component (the shift ε kept), refactored on the same analysis.
-      for (int j = 0; j < n; ++j) {
-        const int f = face_of[j], comp = t.face_component[f];
-        const double lambda = norm[comp] > 0 ? energy[comp] / norm[comp] : 0.0;
-        values[2 * (outer[j + 1] - 1)] = diag[f] + (eps - o.curvature_t * lambda) * k.mass[f];
-      }
-      if (linalg::factorize_complex(*L, outer, inner, values, c) < n)
-        throw Error("automatic singularities: curvature alignment with t = " + std::to_string(o.curvature_t) +
-                    " makes the system indefinite (t must be below 1, and a little below 1 can already exceed the smallest "
-                    "eigenvalue's estimate): use a smaller t");
-    }
-    for (int j = 0; j < n; ++j) {
-      const int f = face_of[j], comp = t.face_component[f];
-      const Complex mq = guided[comp] ? q[f] * (msum[comp] / zsum[comp]) : Complex(0, 0);
-      b[2 * j] = mq.real() + dirichlet[2 * j], b[2 * j + 1] = mq.imag() + dirichlet[2 * j + 1];
-    }
-    substitution.solve(reinterpret_cast<Complex*>(b.data()));
-    for (int j = 0; j < n; ++j)  // components without curvature (flat, umbilic) keep the smoothest field
-      if (guided[t.face_component[face_of[j]]]) x[2 * j] = b[2 * j], x[2 * j + 1] = b[2 * j + 1];
+    align_to_guidance(t, g, k, o, *guidance, S, *L, c, substitution, x);
     time.align = seconds_since(t0);
   }
   for (int j = 0; j < n; ++j) {
     if (!std::isfinite(x[2 * j]) || !std::isfinite(x[2 * j + 1]))
-      throw Error("automatic singularities: the smoothest field is not finite at face " + std::to_string(face_of[j]));
-    u[face_of[j]] = Complex(x[2 * j], x[2 * j + 1]);
+      throw Error("automatic singularities: the smoothest field is not finite at face " + std::to_string(S.face_of[j]));
+    S.u[S.face_of[j]] = Complex(x[2 * j], x[2 * j + 1]);
   }
-  return u;
+  return S.u;
 }
 
 }  // namespace
