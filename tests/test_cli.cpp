@@ -365,8 +365,10 @@ TEST(CliBadInput, MissingEmptyGarbage) {
     }
   // A directory and an unknown extension.
   expect_clean_error(run_cli("info " + q(dir)), {"unknown mesh format"}, "directory");
+  write_text(dir + "/mesh.vtk", "# vtk DataFile Version 2.0\n");
+  expect_clean_error(run_cli("info " + q(dir + "/mesh.vtk")), {"mesh.vtk", "unknown mesh format"}, "vtk");
   write_text(dir + "/mesh.stl", "solid x\n");
-  expect_clean_error(run_cli("info " + q(dir + "/mesh.stl")), {"mesh.stl", "unknown mesh format"}, "stl");
+  expect_clean_error(run_cli("info " + q(dir + "/mesh.stl")), {"mesh.stl", "file ends before 'endsolid'"}, "stl");
 }
 
 TEST(CliBadInput, TruncatedFiles) {
