@@ -21,7 +21,8 @@
 //   "face 7 has a repeated vertex (3, 3, 9)", "vertex index 40 out of range in face 7 (mesh has 39
 //   vertices)", "non-manifold edge (12, 40) shared by 3 faces (2, 5, 9)", "non-manifold vertex 17: its
 //   faces form 2 separate fans", "non-orientable component 0 (containing face 0): faces 3 and 8 cannot
-//   be oriented consistently across edge (4, 5)", "non-finite coordinate in vertex 12".
+//   be oriented consistently across edge (4, 5); the orientation flips once along the cycle of faces 8 -> 7 ->
+//   ... -> 3 -> 8 (12 faces, each sharing an edge with the next)" (up to 24 faces listed), "non-finite coordinate in vertex 12".
 #pragma once
 #include <Eigen/Core>
 #include <string>

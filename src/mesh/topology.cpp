@@ -117,6 +117,24 @@ void check_manifold_vertices(const MatrixX3i& F_in, int num_vertices, const std:
       throw Error("non-manifold vertex " + std::to_string(v) + ": its faces form " + std::to_string(fans[v]) + " separate fans");
 }
 
+// The cycle of faces, each sharing an edge with the next, closed by the clash between f and g: along it the
+// orientation must flip once. The paths from f and g up the breadth-first tree to their common ancestor.
+std::string orientation_cycle(const std::vector<int>& reached_from, int f, int g) {
+  std::vector<int> up_f{f}, up_g{g};
+  while (reached_from[up_f.back()] >= 0) up_f.push_back(reached_from[up_f.back()]);
+  while (reached_from[up_g.back()] >= 0) up_g.push_back(reached_from[up_g.back()]);
+  while (up_f.size() > 1 && up_g.size() > 1 && up_f[up_f.size() - 2] == up_g[up_g.size() - 2]) up_f.pop_back(), up_g.pop_back();
+  std::vector<int> cycle(up_g.begin(), up_g.end());        // g ... ancestor
+  cycle.insert(cycle.end(), up_f.rbegin() + 1, up_f.rend());  // ... f
+  cycle.push_back(g);
+  std::string text = "the orientation flips once along the cycle of faces ";
+  const size_t shown = cycle.size() <= 24 ? cycle.size() : 20;
+  for (size_t i = 0; i < shown; ++i) text += (i ? " -> " : "") + std::to_string(cycle[i]);
+  if (shown < cycle.size()) text += " -> ... -> " + std::to_string(cycle.back());
+  return text + " (" + std::to_string(cycle.size() - 1) + " faces, each sharing an edge with the next)";
+}
+
+
 // Components and orientation: breadth-first over faces; flip[g] says whether g must be reversed to agree
 // with its component's first face (the majority's orientation is kept). Fills t.face_component and
 // t.components (one per connected set of faces, first_face set).
@@ -135,6 +153,7 @@ void orient_components(const MatrixX3i& F_in, const std::vector<int>& edge_count
   t.face_component.assign(nF, -1);
   std::vector<int> queue;
   queue.reserve(nF);
+  std::vector<int> reached_from(nF, -1);  // the breadth-first tree of faces (for the message of a clash)
   for (int root = 0; root < nF; ++root) {
     if (t.face_component[root] >= 0) continue;
     const int c = static_cast<int>(t.components.size());
@@ -153,13 +172,14 @@ void orient_components(const MatrixX3i& F_in, const std::vector<int>& edge_count
         if (t.face_component[g] < 0) {
           t.face_component[g] = c;
           flip[g] = want;
+          reached_from[g] = f;
           queue.push_back(g);
         } else if (flip[g] != want) {
           const int a = F_in(f, k), b = F_in(f, (k + 1) % 3);
           throw Error("non-orientable component " + std::to_string(c) + " (containing face " + std::to_string(root) + "): faces " +
                       std::to_string(std::min(f, g)) + " and " + std::to_string(std::max(f, g)) +
                       " cannot be oriented consistently across edge (" + std::to_string(std::min(a, b)) + ", " +
-                      std::to_string(std::max(a, b)) + ")");
+                      std::to_string(std::max(a, b)) + "); " + orientation_cycle(reached_from, f, g));
         }
       }
     }
