@@ -127,7 +127,7 @@ void register_edit(CLI::App& app) {
   static EditOptions o;
   auto* cmd =
       app.add_subcommand("edit", "Interactive editor: a local web page to place singularities and fixed directions, re-solved live");
-  cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply .stl, optionally .gz")->required();
+  cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
   o.prescription.add_to(cmd, true);
   cmd->add_option("--fix", o.fixes,
                   "Fixed direction at start: F:x,y,z (world, projected to the face), F:angle=A (radians, face frame), or a file with "

@@ -13,7 +13,7 @@ void register_info(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Read and validate a mesh; print its size and topology per component");
   static std::string path;
   static bool json = false, with_cycles = false;
-  cmd->add_option("mesh", path, "Mesh file: .obj .off .ply .stl, optionally .gz")->required();
+  cmd->add_option("mesh", path, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
   cmd->add_flag("--json", json, "Print JSON (format documented in README.md)");
   cmd->add_flag("--cycles", with_cycles, "Also list the generators and boundary loops whose index solve can set");
   cmd->callback([&] {

@@ -110,7 +110,7 @@ void run_param(const ParamCommand& o) {
 void register_param(CLI::App& app) {
   static ParamCommand o;
   auto* cmd = app.add_subcommand("param", "Seamless integer-grid parametrization of the cross field (N = 4): an OBJ with one vt per corner");
-  cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply .stl, optionally .gz")->required();
+  cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
   o.field.add_to(cmd, true);
   auto* target = cmd->add_option("--target-faces", o.target_faces, "About this many unit squares (quads) over the surface")
                      ->check(CLI::PositiveNumber);

@@ -118,7 +118,7 @@ void run_render(const RenderCommand& c) {
 void register_render(CLI::App& app) {
   static RenderCommand c;
   auto* cmd = app.add_subcommand("render", "Draw a field on its surface to a PNG (hedgehog glyphs or streamlines)");
-  cmd->add_option("mesh", c.mesh, "Mesh file: .obj .off .ply .stl, optionally .gz")->required();
+  cmd->add_option("mesh", c.mesh, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
   auto* field = cmd->add_option("--field", c.field, "Field: trivcon's .txt or .ply, Directional's .rawfield or QuadWild's .rosy");
   auto* uv = cmd->add_option("--uv", c.uv,
                              "OBJ with (u, v) per corner (trivcon param -o): draw its unit squares as a checkerboard on the surface");

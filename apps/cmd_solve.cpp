@@ -251,7 +251,7 @@ void run_solve(const SolveOptions& o) {
 void register_solve(CLI::App& app) {
   static SolveOptions o;
   auto* cmd = app.add_subcommand("solve", "Compute the smoothest field with exactly the prescribed singularities");
-  cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply .stl, optionally .gz")->required();
+  cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
   o.field.add_to(cmd);
   auto* batch =
       cmd->add_option("--sing-batch", o.sing_batch,

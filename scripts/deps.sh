@@ -10,7 +10,7 @@
 #                              puppeteer-core, at the versions of web/package-lock.json) when web/node_modules is not current
 set -euo pipefail
 packages=(build-essential cmake pkg-config zlib1g-dev libeigen3-dev libsuitesparse-dev libopenblas-dev libmetis-dev
-          libcli11-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libstb-dev)
+          libcli11-dev nlohmann-json3-dev libtinygltf-dev libgtest-dev libgmock-dev libbenchmark-dev libstb-dev)
 web=0
 for extra in "$@"; do
   case "$extra" in

@@ -785,7 +785,7 @@ TEST(Files, ReadMeshDispatchesOnTheExtension) {
   EXPECT_EQ(trivcon::read_mesh((dir / "a.ply").string()).format, "ply-ascii");
   const std::string vtk = (dir / "a.vtk").string();
   EXPECT_EQ(error_of([&] { trivcon::read_mesh(vtk); }),
-            "cannot read '" + vtk + "': unknown mesh format (supported: .obj, .off, .ply, .stl, each optionally followed by .gz)");
+            "cannot read '" + vtk + "': unknown mesh format (supported: .obj, .off, .ply, .stl, .gltf, .glb, each optionally followed by .gz)");
   EXPECT_THAT(error_of([&] { trivcon::read_mesh((dir / "a.gz").string()); }), HasSubstr("unknown mesh format"));
   // Errors inside a file name the path as given.
   write_bytes(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");

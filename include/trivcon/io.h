@@ -32,7 +32,7 @@ struct MeshData : Mesh {
   std::string format;                    // "obj", "off", "ply-ascii", "ply-binary-le", "ply-binary-be"
 };
 
-// Reads by extension: .obj .off .ply .stl, each optionally followed by .gz (case-insensitive).
+// Reads by extension: .obj .off .ply .stl .gltf .glb, each optionally followed by .gz (case-insensitive).
 MeshData read_mesh(const std::string& path);
 
 // Format-specific readers on an in-memory buffer (already decompressed); `name` is used in messages.
@@ -42,6 +42,9 @@ MeshData read_ply(const std::string& buffer, const std::string& name);
 // STL, ASCII or binary (binary when the size matches its header's triangle count): corners welded into vertices
 // by exact position, numbered in order of first appearance; format "stl-ascii" or "stl-binary".
 MeshData read_stl(const std::string& buffer, const std::string& name);
+// glTF 2.0, .gltf (`name`'s folder resolves external buffers) or .glb (by its magic): every triangle primitive of
+// the default scene's nodes, transforms applied, each its own block of vertices; format "gltf" or "glb".
+MeshData read_gltf(const std::string& buffer, const std::string& name);
 
 // Whole file into memory, gunzipping when the path ends in .gz. Errors name the file.
 std::string read_file_bytes(const std::string& path);

@@ -38,7 +38,7 @@ import time
 
 __all__ = ["run", "solve_mesh", "find_meshes", "format_table", "main"]
 
-MESH_SUFFIXES = (".obj", ".off", ".ply")
+MESH_SUFFIXES = (".obj", ".off", ".ply", ".stl", ".gltf", ".glb")
 FIELD_FORMATS = ("txt", "rawfield", "ply")
 COLUMNS = ("mesh", "status", "vertices", "faces", "chi", "N", "singularities", "field_exact", "large_turn_edges", "energy", "residual",
            "seconds", "message")
@@ -364,7 +364,7 @@ def main(argv=None):
         description="Solve many meshes with trivcon on a Dask cluster (a local one by default): automatic singularities, "
         "or one singularity file per mesh. Prints a summary table; exit status 0 when every mesh solved, verified and "
         "its field is exact (status ok).")
-    parser.add_argument("meshes", nargs="+", help="mesh files (.obj .off .ply .stl, optionally .gz) or folders of them")
+    parser.add_argument("meshes", nargs="+", help="mesh files (.obj .off .ply .stl .gltf .glb, optionally .gz) or folders of them")
     parser.add_argument("--out", required=True, help="output folder: NAME.field.txt, NAME.sing, summary.txt, summary.json "
                         "(and NAME.mesh.obj, NAME.parent_face.txt with --split-large-turns)")
     parser.add_argument("-N", "--symmetry", type=int, default=4, help="symmetry N (default 4: cross fields)")

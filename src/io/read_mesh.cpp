@@ -1,5 +1,5 @@
 // src/io/read_mesh.cpp: reading a mesh file by its extension (trivcon/io.h): the whole file into memory,
-// gunzipped when it ends in .gz, then the reader of its format (src/io/read_obj.cpp, read_off.cpp, read_ply.cpp, read_stl.cpp).
+// gunzipped when it ends in .gz, then the reader of its format (src/io/read_obj.cpp, read_off.cpp, read_ply.cpp, read_stl.cpp, read_gltf.cpp).
 #include "trivcon/io.h"
 
 #include <algorithm>
@@ -56,7 +56,9 @@ MeshData read_mesh(const std::string& path) {
   if (ends_with_ignoring_case(stem, ".off")) return read_off(read_file_bytes(path), path);
   if (ends_with_ignoring_case(stem, ".ply")) return read_ply(read_file_bytes(path), path);
   if (ends_with_ignoring_case(stem, ".stl")) return read_stl(read_file_bytes(path), path);
-  throw Error("cannot read '" + path + "': unknown mesh format (supported: .obj, .off, .ply, .stl, each optionally followed by .gz)");
+  if (ends_with_ignoring_case(stem, ".gltf") || ends_with_ignoring_case(stem, ".glb")) return read_gltf(read_file_bytes(path), path);
+  throw Error("cannot read '" + path +
+              "': unknown mesh format (supported: .obj, .off, .ply, .stl, .gltf, .glb, each optionally followed by .gz)");
 }
 
 }  // namespace trivcon
