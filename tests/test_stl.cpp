@@ -97,6 +97,8 @@ TEST(Stl, Errors) {
   const std::string nan = "solid d\nfacet normal 0 0 1\nouter loop\nvertex 0 0 nan\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid\n";
   EXPECT_EQ(error_of([&] { read_stl(nan, "n.stl"); }), "n.stl:8: triangle 0 has a coordinate that is not finite");
   EXPECT_EQ(error_of([&] { read_stl("solid x\n", "s.stl"); }), "s.stl:1: file ends before 'endsolid'");
+  EXPECT_EQ(error_of([&] { read_stl("solid x\nendsolid x\n", "z.stl"); }), "z.stl: no faces");
+  EXPECT_EQ(error_of([&] { read_stl(std::string(84, '\0'), "z.stl"); }), "z.stl: no faces");
 }
 
 }  // namespace

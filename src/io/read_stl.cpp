@@ -92,6 +92,12 @@ MeshData read_binary_stl(const std::string& buffer, const std::string& name, std
   return mesh;
 }
 
+// Every reader refuses a mesh without faces.
+MeshData with_faces(MeshData mesh, const std::string& name) {
+  if (mesh.F.rows() == 0) fail(name, "no faces");
+  return mesh;
+}
+
 MeshData read_ascii_stl(const std::string& buffer, const std::string& name) {
   MeshData mesh;
   mesh.format = "stl-ascii";
@@ -145,11 +151,11 @@ MeshData read_stl(const std::string& buffer, const std::string& name) {
     std::memcpy(&count, buffer.data() + 80, 4);
     if (buffer.size() == 84 + 50ull * count) {
       if (count > static_cast<std::uint64_t>(kMaxCount) / 3) fail(name, "too many triangles (" + std::to_string(count) + ")");
-      return read_binary_stl(buffer, name, count);
+      return with_faces(read_binary_stl(buffer, name, count), name);
     }
   }
   std::size_t start = buffer.find_first_not_of(" \t\r\n");
-  if (start != std::string::npos && buffer.compare(start, 5, "solid") == 0) return read_ascii_stl(buffer, name);
+  if (start != std::string::npos && buffer.compare(start, 5, "solid") == 0) return with_faces(read_ascii_stl(buffer, name), name);
   if (buffer.size() >= 84) {
     std::uint32_t count;
     std::memcpy(&count, buffer.data() + 80, 4);
