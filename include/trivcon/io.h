@@ -29,7 +29,8 @@ namespace trivcon {
 struct MeshData : Mesh {
   std::vector<int> polygon_of_triangle;  // file polygon of each triangle
   int polygon_count = 0;                 // polygons in the file
-  std::string format;                    // "obj", "off", "ply-ascii", "ply-binary-le", "ply-binary-be"
+  std::string format;                    // "obj", "off", "ply-ascii", "ply-binary-le", "ply-binary-be", "stl-ascii",
+                                         // "stl-binary", "gltf", "glb"
 };
 
 // Reads by extension: .obj .off .ply .stl .gltf .glb, each optionally followed by .gz (case-insensitive).

@@ -102,3 +102,19 @@ def test_render_and_png(tmp_path):
         r.render(size=(0, 10))
     with pytest.raises(trivcon.Error, match="render: up axis must be x, y or z, not 'w'"):
         r.render(up="w")
+
+
+def test_stl_and_gltf_read(tmp_path):
+    """STL (welded) and glTF read as the C++ reader does: the cube's 8 corners from 12 binary STL triangles."""
+    import struct
+    V, F = trivcon.make_cube_sphere(1, False)
+    data = b"binary".ljust(80, b"\0") + struct.pack("<I", len(F))
+    for f in F:
+        data += struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *V[v]) for v in f) + b"\0\0"
+    (tmp_path / "cube.stl").write_bytes(data)
+    V2, F2, info = trivcon.read_mesh(tmp_path / "cube.stl", info=True)
+    assert info["format"] == "stl-binary" and V2.shape == (8, 3) and F2.shape == (12, 3)
+    assert np.array_equal(V2[F2], V[F].astype(np.float32).astype(np.float64))
+    with pytest.raises(trivcon.Error, match="not a readable glTF 2.0 file"):
+        (tmp_path / "bad.gltf").write_text("{}")
+        trivcon.read_mesh(tmp_path / "bad.gltf")

@@ -423,13 +423,15 @@ _atexit.register(_wait_for_abandoned_work)
 
 
 def read_mesh(path, info=False):
-    """Read a triangle mesh: OBJ, OFF or PLY (ascii or binary), each optionally gzipped (.obj.gz, ...).
+    """Read a triangle mesh: OBJ, OFF, PLY (ascii or binary), STL (ascii or binary, corners welded by exact
+    position) or glTF 2.0 (.gltf, .glb: the default scene's triangle primitives, transforms applied), each
+    optionally gzipped (.obj.gz, ...).
 
     Returns (V, F): V float64 (n, 3), F int64 (m, 3), in the file's order with the file's ids (0-based);
     polygons are fan-triangulated in order, (a,b,c), (a,c,d), ...; unreferenced vertices are kept.
     With info=True returns (V, F, info), info a dict with "format" ("obj", "off", "ply-ascii",
-    "ply-binary-le", "ply-binary-be"), "polygon_count" and "polygon_of_triangle" (int64 (m,): the file
-    polygon each triangle comes from). Errors (trivcon.Error) name the file and line or byte offset.
+    "ply-binary-le", "ply-binary-be", "stl-ascii", "stl-binary", "gltf", "glb"), "polygon_count" and
+    "polygon_of_triangle" (int64 (m,): the file polygon each triangle comes from). Errors (trivcon.Error) name the file and line or byte offset.
     """
     V, F, polygon_of_triangle, polygon_count, fmt = _core.read_mesh(str(path))
     if info:
