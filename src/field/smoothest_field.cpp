@@ -171,6 +171,8 @@ SmoothestSystem assemble_smoothest_system(const Topology& t, const Geometry& g, 
   // diagonal, so its ratio is ~1e12 times the others', and a mean over faces would make the shift swamp A
   // on any mesh with a few such faces (the inverse iteration then barely moves from its random start).
   S.eps = 1e-8 * S.diag.sum() / k.mass.sum();
+  // No interior edge at all (e.g. lone triangles): every field is equally smooth; the shift alone makes it definite.
+  if (!(S.eps > 0)) S.eps = 1;
   S.outer.assign(n + 1, 0);
   S.inner.reserve(static_cast<size_t>(n) * 3), S.values.reserve(static_cast<size_t>(n) * 6);
   std::vector<std::pair<int, Complex>> column;
