@@ -21,19 +21,34 @@ struct CheckOptions {
   PrescriptionOptions prescription;
   std::string matching;  // --matching
   bool json = false;
+  bool no_repair = false;
 };
 
 void run_check(CheckOptions& o) {
-  const MeshData mesh = load_mesh(o.mesh);
+  const LoadedMesh loaded = load_mesh(o.mesh, !o.no_repair, o.json);
+  const MeshData& mesh = loaded.mesh;
+  const RepairedMesh* repair = loaded.repaired();
+  if (repair && !o.matching.empty())
+    throw Error(o.mesh + " was repaired, and a matching file names edges by the vertices of the mesh it was written for: check on "
+                "the repaired mesh (solve --mesh-out), or give --no-repair");
   check_finite(mesh.V);
   const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
   check_coordinate_range(mesh.V, t);
   const Geometry g = compute_geometry(mesh.V, t);
   const Cycles cycles = compute_cycles(t);
-  const MatrixX3d directions = o.prescription.read_field_file(o.field, t.num_faces, o.prescription.N);
+  // The field file has a row per input face.
+  const MatrixX3d directions =
+      rows_on_mesh(loaded, o.prescription.read_field_file(o.field, repair ? repair->input_faces : t.num_faces, o.prescription.N));
   // Without a prescription, check only lists the field's singularities.
   const bool compare = !o.prescription.empty();
-  const IndexPrescription p = o.prescription.build();
+  IndexPrescription p = o.prescription.build();
+  if (repair) {
+    std::map<int, int> vertex;
+    for (const auto& [v, n] : p.vertex) vertex[repaired_vertex(*repair, v, "singular vertex")] = n;
+    p.vertex = std::move(vertex);
+  }
+  // Ids printed: the input's (a copy repair appended is named by the vertex it copies).
+  const auto id = [repair](int v) { return repair ? repair->vertex_origin[v] : v; };
   if (compare) validate_prescription(t, static_cast<int>(cycles.generators.size()), p);
   const Field field = field_from_directions(g, directions, p.N);
   // With --matching the directions are paired as the file says; otherwise by the closest (principal) matching.
@@ -42,9 +57,9 @@ void run_check(CheckOptions& o) {
   nlohmann::ordered_json found = nlohmann::ordered_json::array(), differ = nlohmann::ordered_json::array();
   for (int v = 0; v < t.num_vertices; ++v) {
     const int want = p.vertex.count(v) ? p.vertex.at(v) : 0;
-    if (idx.vertex[v] != 0) found.push_back({{"vertex", v}, {"index", format_index(idx.vertex[v], p.N)}});
+    if (idx.vertex[v] != 0) found.push_back({{"vertex", id(v)}, {"index", format_index(idx.vertex[v], p.N)}});
     if (compare && idx.vertex[v] != want)
-      differ.push_back({{"vertex", v}, {"found", format_index(idx.vertex[v], p.N)}, {"prescribed", format_index(want, p.N)}});
+      differ.push_back({{"vertex", id(v)}, {"found", format_index(idx.vertex[v], p.N)}, {"prescribed", format_index(want, p.N)}});
   }
   nlohmann::ordered_json j;
   j["N"] = p.N;
@@ -85,6 +100,7 @@ void register_check(CLI::App& app) {
                     "Matching file (.matching, as solve --matching-out writes): pair the faces' directions as it says instead of by the "
                     "closest direction");
   check->add_flag("--json", c.json, "Print JSON");
+  add_repair_flag(check, c.no_repair);
   check->callback([] { run_check(c); });
 }
 

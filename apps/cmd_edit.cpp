@@ -27,6 +27,7 @@ struct EditOptions {
   PrescriptionOptions prescription;
   std::vector<std::string> fixes;
   bool align_boundary = false;
+  bool no_repair = false;
   std::optional<double> feature_degrees;  // --align-features
   std::string host = "127.0.0.1";
   int port = 8642;
@@ -57,16 +58,28 @@ void run_edit(const EditOptions& o) {
   sigaction(SIGTERM, &action, nullptr);
 
   const auto t0 = Clock::now();
-  MeshData mesh = load_mesh(o.mesh);
+  LoadedMesh loaded = load_mesh(o.mesh, !o.no_repair, false);
+  MeshData mesh = std::move(loaded.mesh);
   server::EditorOptions options;
+  if (loaded.repair) {
+    options.repair = std::make_shared<const RepairedMesh>(std::move(*loaded.repair));
+    options.input = std::make_shared<const MeshData>(std::move(loaded.input));
+  }
   options.read_seconds = seconds_since(t0);
   options.mesh_path = o.mesh;
   options.host = o.host;
   options.initial = o.prescription.build();
+  if (options.repair) {  // the file's ids, on the repaired mesh
+    std::map<int, int> vertex;
+    for (const auto& [v, n] : options.initial.vertex) vertex[repaired_vertex(*options.repair, v, "singular vertex")] = n;
+    options.initial.vertex = std::move(vertex);
+  }
   options.align_boundary = o.align_boundary;
   options.feature_degrees = o.feature_degrees;
   auto designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F);
-  add_fix_options(o.fixes, designer->topology(), designer->geometry(), options.initial.fixed);
+  FaceIdMap face_id;
+  if (options.repair) face_id = [&options](int f) { return repaired_face(*options.repair, f, "face"); };
+  add_fix_options(o.fixes, designer->topology(), designer->geometry(), options.initial.fixed, face_id);
   const int faces = designer->topology().num_faces, vertices = designer->topology().num_vertices;
   try {
     IndexPrescription p = options.initial;
@@ -133,6 +146,7 @@ void register_edit(CLI::App& app) {
                   "Fixed direction at start: F:x,y,z (world, projected to the face), F:angle=A (radians, face frame), or a file with "
                   "'FACE x y z' / 'FACE angle=A' lines; repeatable");
   cmd->add_flag("--align-boundary", o.align_boundary, "Start with every boundary face fixed to its boundary edge's direction");
+  add_repair_flag(cmd, o.no_repair);
   cmd->add_option("--align-features", o.feature_degrees,
                   "Start with the faces beside every sharp edge (dihedral angle above DEG degrees) fixed to its direction")
       ->check(CLI::Range(0.0, 180.0));

@@ -12,17 +12,20 @@ namespace trivcon::cli {
 void register_info(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Read and validate a mesh; print its size and topology per component");
   static std::string path;
-  static bool json = false, with_cycles = false;
+  static bool json = false, with_cycles = false, no_repair = false;
   cmd->add_option("mesh", path, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
   cmd->add_flag("--json", json, "Print JSON (format documented in README.md)");
   cmd->add_flag("--cycles", with_cycles, "Also list the generators and boundary loops whose index solve can set");
+  add_repair_flag(cmd, no_repair);
   cmd->callback([&] {
-    const MeshData mesh = load_mesh(path);
+    const LoadedMesh loaded = load_mesh(path, !no_repair, true);  // the summary says what repair did
+    const MeshData& mesh = loaded.mesh;
     check_finite(mesh.V);
     const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
     check_coordinate_range(mesh.V, t);
     const Geometry g = compute_geometry(mesh.V, t);
     nlohmann::ordered_json j = mesh_summary(path, mesh, t, g);
+    if (loaded.repair) j["repair"] = repair_summary_json(*loaded.repair);
     Cycles cycles;
     if (with_cycles) {
       cycles = compute_cycles(t);
@@ -33,6 +36,7 @@ void register_info(CLI::App& app) {
       return;
     }
     std::cout << "mesh " << path << " (" << mesh.format << ")\n"
+              << (loaded.repair ? repair_summary(*loaded.repair) + " (counts below: the repaired mesh)\n" : "")
               << "vertices " << t.num_vertices << ", faces " << t.num_faces << ", edges " << t.num_edges << ", Euler characteristic "
               << t.euler_characteristic() << "\n"
               << "components " << t.components.size() << ", boundary loops " << t.boundary_loops.size() << "\n";

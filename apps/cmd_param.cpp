@@ -25,6 +25,7 @@ struct ParamCommand {
   FieldOptions field;
   double target_faces = 0, edge_length = 0;
   bool quiet = false;
+  bool no_repair = false;
 };
 
 std::string fmt(double v) {
@@ -35,10 +36,12 @@ std::string fmt(double v) {
 
 void run_param(const ParamCommand& o) {
   const auto t0 = Clock::now();
-  const MeshData mesh = load_mesh(o.mesh);
+  const LoadedMesh loaded = load_mesh(o.mesh, !o.no_repair, o.quiet);
+  const MeshData& mesh = loaded.mesh;
+  const RepairedMesh* repair = loaded.repaired();
   const double read_seconds = seconds_since(t0);
   FieldDesigner designer(mesh.V, mesh.F, o.field.solver_options());
-  FieldRequest request = o.field.request(designer);
+  FieldRequest request = o.field.request(designer, repair);
   // With --auto, a ± pair closer than one unit of the map cannot sit on two integer points without folding it:
   // unless --auto-cancel says otherwise, pairs within one quad edge cancel.
   double area = 0;
@@ -61,9 +64,15 @@ void run_param(const ParamCommand& o) {
 
   const auto t1 = Clock::now();
   StagedOutputs staged;
-  staged.write(o.output, [&](const std::string& path) { write_uv_obj(path, mesh.V, mesh.F, input_corner_uv(param, t, mesh.F)); });
+  staged.write(o.output, [&](const std::string& path) {  // the input's faces, repaired or not
+    const Eigen::MatrixXd uv = input_corner_uv(param, t, mesh.F);
+    if (repair)
+      write_uv_obj(path, loaded.input.V, loaded.input.F, corner_rows_on_input(*repair, loaded.input.F, uv));
+    else
+      write_uv_obj(path, mesh.V, mesh.F, uv);
+  });
   if (!o.sing_out.empty())
-    staged.write(o.sing_out, [&](const std::string& path) { write_singularities(path, out.prescription.vertex, 4); });
+    staged.write(o.sing_out, [&](const std::string& path) { write_singularities(path, input_singularities(out.prescription.vertex, repair), 4); });
   if (!o.report.empty()) {
     nlohmann::ordered_json report = {{"mesh", o.mesh},
                                      {"vertices", t.num_vertices},
@@ -76,6 +85,7 @@ void run_param(const ParamCommand& o) {
                                      {"field", {{"verified", out.verified}, {"energy", out.design.connection.energy}}},
                                      {"param", param_report(param)},
                                      {"seconds", {{"read", read_seconds}, {"write", seconds_since(t1)}}}};
+    if (repair) report["repair"] = repair_summary_json(*repair);
     for (size_t i = 0; i < param.cones.size(); ++i)
       report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
     staged.write(o.report, [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& s) { s << report.dump(2) << "\n"; }); });
@@ -121,6 +131,7 @@ void register_param(CLI::App& app) {
   cmd->add_option("--sing-out", o.sing_out, "Singularity file of the singularities used ('VERTEX INDEX' lines, readable by -s)");
   cmd->add_option("--report", o.report, "JSON report: the field, the map's integers and quality, time per stage");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");
+  add_repair_flag(cmd, o.no_repair);
   cmd->callback([target, length] {
     if (target->count() == 0 && length->count() == 0)
       throw CLI::ValidationError("--target-faces / --edge-length", "give the scale of the map: one of them");

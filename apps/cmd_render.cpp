@@ -20,7 +20,7 @@ struct RenderCommand {
   int N = 0;  // 0: the field file's
   std::vector<std::string> sing_files, sings;
   double spacing = 11;
-  bool flat = false, no_legend = false;
+  bool flat = false, no_legend = false, no_repair = false;
   FeatureOptions features;  // sharp edges to draw
 };
 
@@ -55,14 +55,17 @@ void parse_view(const std::string& text, RenderOptions& o) {
 }
 
 void run_render(const RenderCommand& c) {
-  const MeshData mesh = load_mesh(c.mesh);
+  const LoadedMesh loaded = load_mesh(c.mesh, !c.no_repair, false);
+  const MeshData& mesh = loaded.mesh;
+  const RepairedMesh* repair = loaded.repaired();
   check_finite(mesh.V);
   const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));
   check_coordinate_range(mesh.V, t);
   const Geometry g = compute_geometry(mesh.V, t);
   int file_N = 0;
   // Without --field (a checkerboard of --uv alone): a zero field, not drawn.
-  const MatrixX3d directions = c.field.empty() ? MatrixX3d(g.frame_x) : read_field(c.field, t.num_faces, &file_N);
+  const MatrixX3d directions = c.field.empty() ? MatrixX3d(g.frame_x)
+                                               : rows_on_mesh(loaded, read_field(c.field, repair ? repair->input_faces : t.num_faces, &file_N));
   const int N = c.N > 0 ? c.N : std::max(1, file_N);
   const Field field = field_from_directions(g, directions, N);
 
@@ -77,7 +80,8 @@ void run_render(const RenderCommand& c) {
     p.N = N;
     for (const std::string& f : c.sing_files) read_singularities(f, p);
     for (const std::string& s : c.sings) add_vertex_index(s, p);
-    for (auto [v, n] : p.vertex) {
+    for (const auto& [input_v, n] : p.vertex) {
+      const int v = repair ? repaired_vertex(*repair, input_v, "singular vertex") : input_v;
       if (v < 0 || v >= t.num_vertices)
         throw Error("singular vertex " + std::to_string(v) + " out of range (mesh has " + std::to_string(t.num_vertices) + " vertices)");
       singularities.emplace_back(v, n);
@@ -94,7 +98,9 @@ void run_render(const RenderCommand& c) {
   o.legend = !c.no_legend;
   o.sharp_edges = c.features.edges(mesh.V, t, g);
   if (!c.uv.empty()) {  // the file's corners in the input's order, the renderer's in the topology's
-    const Eigen::MatrixXd input = read_corner_uv(c.uv, mesh.F);
+    // The file has the input's faces; on a repaired mesh each face reads its input face's corners.
+    const Eigen::MatrixXd input =
+        repair ? corner_rows_on_repaired(*repair, loaded.input.F, read_corner_uv(c.uv, loaded.input.F)) : read_corner_uv(c.uv, mesh.F);
     o.corner_uv.resize(t.num_faces, 6);
     for (int f = 0; f < t.num_faces; ++f)
       for (int k = 0; k < 3; ++k)
@@ -135,6 +141,7 @@ void register_render(CLI::App& app) {
   cmd->add_option("--streamlines-out", c.streamlines_out, "Also write the streamlines as OBJ polylines");
   cmd->add_flag("--flat", c.flat, "Flat shading (one normal per face)");
   cmd->add_flag("--no-legend", c.no_legend, "Leave out the legend");
+  add_repair_flag(cmd, c.no_repair);
   c.features.add_to(cmd, "drawn as lines");
   cmd->callback([field, uv] {
     if (field->count() == 0 && uv->count() == 0) throw CLI::RequiredError("--field or --uv");

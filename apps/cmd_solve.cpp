@@ -23,6 +23,7 @@
 #include "trivcon/generate.h"
 #include "trivcon/matching.h"
 #include "trivcon/field_io.h"
+#include "trivcon/repair.h"
 
 namespace trivcon::cli {
 
@@ -34,6 +35,7 @@ struct SolveOptions {
   std::string sing_batch;
   OutputPaths out;
   bool quiet = false;
+  bool no_repair = false;                // --no-repair
   double tolerance = kDefaultTolerance;  // --tolerance
 };
 
@@ -78,9 +80,11 @@ void report_features(const SolveOptions& o, const FieldDesigner& designer, const
 
 // Writes one design's outputs, prints its summary; returns whether verification passed.
 // `extra` holds report entries of the whole run (the "auto" or "sing_from_field" object), added to the report.
+// `loaded`: the input and its repair, when the design is on that repair (not on a refined mesh).
 bool solve_one(const SolveOptions& o, const MeshData& mesh, const FieldDesigner& designer, const IndexPrescription& prescription,
                const Design& d, const std::string& name, double read_seconds, const nlohmann::ordered_json& extra,
-               const std::vector<int>& sharp) {
+               const std::vector<int>& sharp, const LoadedMesh* loaded = nullptr) {
+  const RepairedMesh* repair = loaded ? loaded->repaired() : nullptr;
   const Connection& c = d.connection;
 
   // Verification: constraint residuals relative to the right-hand sides, transport, fixed faces, indices.
@@ -90,7 +94,7 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, const FieldDesigner&
 
   auto t1 = Clock::now();
   StagedOutputs staged;
-  stage_design_outputs(staged, o.out, name, mesh, designer, prescription, d, sharp);
+  stage_design_outputs(staged, o.out, name, mesh, designer, prescription, d, sharp, repair, repair ? &loaded->input : nullptr);
   const ReportRun run{o.mesh, name, o.field.weights, o.field.solver, o.field.align_boundary, read_seconds, seconds_since(t1), ok};
   if (!o.out.report.empty()) {
     nlohmann::ordered_json report = solve_report(run, mesh, designer, prescription, d);
@@ -135,6 +139,16 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, const FieldDesigner&
               << " of them differing from the prescription (report: large_turns, field_exact); give it --matching-out, or refine the mesh "
                  "there (--split-large-turns)\n";
   }
+  if (repair) {  // a singularity at a fan's copy: the singularity file can only name the input vertex
+    int copies = 0, first = -1;
+    for (const auto& [v, n] : prescription.vertex)
+      if (v >= repair->input_vertices && copies++ == 0) first = v;
+    if (copies > 0)
+      std::cerr << "trivcon: warning" << (name.empty() ? "" : " for " + name) << ": " << copies
+                << " singularities are at vertices repair appended for a fan (first: " << first << ", a copy of input vertex "
+                << repair->vertex_origin[first] << "); the singularity file names the input vertex, the report and the repaired mesh "
+                << "(--mesh-out) the copy\n";
+  }
   if (!ok)
     std::cerr << "trivcon: verification failed" << (name.empty() ? "" : " for " + name) << ": residual " << residual
               << ", transport mismatch " << d.transport_mismatch << ", fixed faces off by " << d.max_fixed_error << ", "
@@ -144,12 +158,27 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, const FieldDesigner&
 
 void run_solve(const SolveOptions& o) {
   auto t0 = Clock::now();
-  const MeshData mesh = load_mesh(o.mesh);
+  const LoadedMesh loaded = load_mesh(o.mesh, !o.no_repair, o.quiet);
+  const MeshData& mesh = loaded.mesh;
+  const RepairedMesh* repair = loaded.repaired();
+  if (repair && o.out.mesh.empty() && (!o.out.connection.empty() || !o.out.matching.empty()))
+    throw Error(o.mesh + " was repaired, and the connection and matching files name edges by the vertices of the repaired mesh: " +
+                "write it with --mesh-out (or give --no-repair)");
   const double read_seconds = seconds_since(t0);
   FieldDesigner designer(mesh.V, mesh.F, o.field.solver_options());
-  FieldRequest request = o.field.request(designer);
+  FieldRequest request = o.field.request(designer, repair);
   std::vector<BatchItem> batch;
   if (!o.sing_batch.empty()) batch = read_batch(o.sing_batch, request.prescription);
+  if (repair)
+    for (BatchItem& item : batch) {
+      std::map<int, int> vertex;
+      try {
+        for (const auto& [v, n] : item.prescription.vertex) vertex[repaired_vertex(*repair, v, "singular vertex")] = n;
+      } catch (const Error& e) {
+        throw Error("batch item '" + item.name + "': " + e.what());
+      }
+      item.prescription.vertex = std::move(vertex);
+    }
   if (!batch.empty() && request.split_large_turns)
     throw Error("--split-large-turns refines the mesh for one prescription: not with --sing-batch");
   // Set up for the fixed faces now (the one factorization), so that the mesh's line shows its time.
@@ -157,6 +186,7 @@ void run_solve(const SolveOptions& o) {
   designer.set_fixed_faces(constraints.fixed_faces);
 
   nlohmann::ordered_json extra = nlohmann::ordered_json::object();
+  if (repair) extra["repair"] = repair_summary_json(*repair);
   std::string features_summary;
   if (request.features_given()) report_features(o, designer, constraints, request.prescription.N, extra, features_summary);
   const Topology& t = designer.topology();
@@ -187,7 +217,7 @@ void run_solve(const SolveOptions& o) {
     bool ok = true;
     for (const BatchItem& item : batch)
       ok &= solve_one(o, mesh, designer, item.prescription, request_design(designer, item.prescription, request.roots), item.name,
-                      read_seconds, extra, constraints.sharp_edges);
+                      read_seconds, extra, constraints.sharp_edges, &loaded);
     if (!ok) exit_code = kVerificationFailed;
     return;
   }
@@ -242,7 +272,7 @@ void run_solve(const SolveOptions& o) {
     }
   }
   if (!solve_one(o, out.refined ? refined_mesh : mesh, out.designer(designer), out.prescription, out.design, "", read_seconds, extra,
-                 out.sharp_edges))
+                 out.sharp_edges, out.refined ? nullptr : &loaded))
     exit_code = kVerificationFailed;
 }
 
@@ -267,7 +297,8 @@ void register_solve(CLI::App& app) {
   cmd->add_option("--connection-out", o.out.connection, "Connection file: 'i j x' per interior edge");
   cmd->add_option("--lines-out", o.out.lines, "OBJ with a short segment per face and direction");
   cmd->add_option("--mesh-out", o.out.mesh,
-                  "The mesh the field belongs to (.ply binary, else .obj): with --split-large-turns the refined one");
+                  "The mesh the field was solved on (.ply binary, else .obj): the repaired one when the input needed repair (its faces "
+                  "the input's in order without the dropped ones, split vertices appended), with --split-large-turns the refined one");
   cmd->add_option("--matching-out", o.out.matching,
                   "Matching file (Directional's .matching: 'N E', then 'L R i j m' per interior edge): the 2pi/N steps our connection "
                   "pairs the faces' directions with, so that tools read exactly the prescribed singularities");
@@ -275,6 +306,7 @@ void register_solve(CLI::App& app) {
   cmd->add_option("--png", o.out.png, "Picture of the field (as `trivcon render` with its defaults)");
   cmd->add_option("--report", o.out.report, "JSON report: sizes, topology, indices used, energy, residuals, timings");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");
+  add_repair_flag(cmd, o.no_repair);
   cmd->add_option("--tolerance", o.tolerance,
                   "Verification limit on the holonomy residuals, transport and fixed faces, relative to max(1, right-hand sides) "
                   "(default 1e-9); a solve that misses it exits 3 and says why")

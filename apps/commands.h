@@ -3,9 +3,11 @@
 // through `exit_code`.
 #pragma once
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 
 #include "trivcon/io.h"
+#include "trivcon/repair.h"
 
 namespace trivcon::cli {
 
@@ -30,5 +32,26 @@ void register_edit(CLI::App& app);  // only with TRIVCON_EDITOR (CMake option)
 
 // Reads a mesh file; messages name the file.
 MeshData load_mesh(const std::string& path);
+
+// A mesh file as a command works on it: by default repaired (trivcon/repair.h) when it needs it, so that every
+// mesh users have is taken; ids the user gives and every output stay the input file's.
+struct LoadedMesh {
+  MeshData mesh;                       // what the command works on: the input, or its repair
+  MeshData input;                      // the input as read, when repair changed it (else empty: `mesh` is the input)
+  std::optional<RepairedMesh> repair;  // when repair changed the mesh
+  const RepairedMesh* repaired() const { return repair ? &*repair : nullptr; }
+  const MeshData& as_read() const { return repair ? input : mesh; }
+};
+
+// Reads `path`; with `repair`, repairs it when it needs it and warns on stderr (unless `quiet`) with
+// repair_summary. Without, a face with a repeated vertex is the reader's error (what the topology refuses is
+// refused later, with its message).
+LoadedMesh load_mesh(const std::string& path, bool repair, bool quiet);
+
+// Adds --no-repair to `cmd`.
+void add_repair_flag(CLI::App* cmd, bool& no_repair);
+
+// Per-face rows of the input (a field file) as rows of the mesh worked on.
+MatrixX3d rows_on_mesh(const LoadedMesh& mesh, const MatrixX3d& input_rows);
 
 }  // namespace trivcon::cli

@@ -76,12 +76,14 @@ SolverOptions FieldOptions::solver_options() const {
   return options;
 }
 
-FieldRequest FieldOptions::request(const FieldDesigner& designer) const {
+FieldRequest FieldOptions::request(const FieldDesigner& designer, const RepairedMesh* repaired) const {
   FieldRequest r;
   r.prescription = prescription.build();
   if (root_angles.size() > root_faces.size()) throw Error("--root-angle given without a matching --root-face");
   for (size_t i = 0; i < root_faces.size(); ++i) r.roots.emplace_back(root_faces[i], i < root_angles.size() ? root_angles[i] : 0.0);
-  add_fix_options(fixes, designer.topology(), designer.geometry(), r.prescription.fixed);
+  FaceIdMap face_id;
+  if (repaired) face_id = [repaired](int f) { return repaired_face(*repaired, f, "face"); };
+  add_fix_options(fixes, designer.topology(), designer.geometry(), r.prescription.fixed, face_id);
   r.align_boundary = align_boundary;
   if (features.degrees_option->count() > 0) r.feature_degrees = features.degrees;
   if (features.file_option->count() > 0) r.feature_edges = read_feature_edges(features.file, designer.topology());
@@ -94,8 +96,11 @@ FieldRequest FieldOptions::request(const FieldDesigner& designer) const {
   r.auto_options.cancel_distance = auto_cancel;
   if (!align.empty()) r.auto_options.align_curvature = true, r.auto_options.curvature_t = *alignment_strength(align);  // checked by CLI11
   r.split_large_turns = split_large_turns;
+  if (repaired) move_request_to_repaired(r, designer.topology(), *repaired);
   if (!sing_from_field.empty()) {
-    const MatrixX3d directions = prescription.read_field_file(sing_from_field, designer.topology().num_faces, r.prescription.N);
+    MatrixX3d directions =
+        prescription.read_field_file(sing_from_field, repaired ? repaired->input_faces : designer.topology().num_faces, r.prescription.N);
+    if (repaired) directions = rows_on_repaired(*repaired, directions);
     const Field field = field_from_directions(designer.geometry(), directions, r.prescription.N);
     const FieldIndices idx = field_indices(designer.topology(), designer.geometry(), designer.cycles(), field);
     for (int v = 0; v < designer.topology().num_vertices; ++v)

@@ -34,8 +34,10 @@ struct FieldOptions {
   void add_to(CLI::App* cmd, bool fixed_N = false);
   SolverOptions solver_options() const;
   // The request on `designer`'s mesh: specs parsed, files read (-s, --fix, --features, --sing-from-field);
-  // the vertex singularities of --sing-from-field are filled in. Throws trivcon::Error.
-  FieldRequest request(const FieldDesigner& designer) const;
+  // the vertex singularities of --sing-from-field are filled in. With `repaired` (the designer's mesh is that
+  // repair of the input), every id given is the input's and is moved onto it (move_request_to_repaired).
+  // Throws trivcon::Error.
+  FieldRequest request(const FieldDesigner& designer, const RepairedMesh* repaired = nullptr) const;
 };
 
 // The strength T of --align curvature[:T] (0 when not given), or nothing when the text is not of that form.

@@ -56,10 +56,15 @@ StagedOutputs::~StagedOutputs() {
 
 void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const std::string& name, const MeshData& mesh,
                           const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d,
-                          const std::vector<int>& sharp) {
+                          const std::vector<int>& sharp, const RepairedMesh* repair, const MeshData* input) {
   const Geometry& g = designer.geometry();
   if (!paths.field.empty())
-    staged.write(output_path(paths.field, name), [&](const std::string& path) { write_field(path, mesh.V, mesh.F, g, d.field); });
+    staged.write(output_path(paths.field, name), [&](const std::string& path) {
+      if (repair)
+        write_field(path, input->V, input->F, g, d.field, repair->face_of_input);
+      else
+        write_field(path, mesh.V, mesh.F, g, d.field);
+    });
   if (!paths.connection.empty())
     staged.write(output_path(paths.connection, name),
                  [&](const std::string& path) { write_connection(path, designer.topology(), d.connection.x, prescription.N); });
@@ -80,12 +85,12 @@ void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const
     staged.write(output_path(paths.lines, name), [&](const std::string& path) { write_field_lines(path, mesh.V, mesh.F, g, d.field); });
   if (!paths.singularities.empty())
     staged.write(output_path(paths.singularities, name),
-                 [&](const std::string& path) { write_singularities(path, prescription.vertex, prescription.N); });
+                 [&](const std::string& path) { write_singularities(path, input_singularities(prescription.vertex, repair), prescription.N); });
   if (!paths.sharp.empty())
     staged.write(output_path(paths.sharp, name), [&](const std::string& path) {
       std::vector<char> convex;
       for (int e : sharp) convex.push_back(is_convex_edge(designer.V(), designer.topology(), g, e));
-      write_sharp(path, mesh.F, designer.topology(), sharp, convex);
+      write_sharp(path, mesh.F, designer.topology(), sharp, convex, repair ? repair->input_face : std::vector<int>{});
     });
   if (!paths.png.empty()) {  // the prescription's singularities, drawn with the default view of `trivcon render`
     std::vector<std::pair<int, int>> singular(prescription.vertex.begin(), prescription.vertex.end());
@@ -94,6 +99,14 @@ void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const
     staged.write(output_path(paths.png, name),
                  [&](const std::string& path) { write_png(path, render_field(mesh.V, designer.topology(), g, d.field, singular, ro)); });
   }
+}
+
+std::map<int, int> input_singularities(const std::map<int, int>& vertex, const RepairedMesh* repair) {
+  if (!repair) return vertex;
+  std::map<int, int> out;
+  for (const auto& [v, n] : vertex) out[repair->vertex_origin[v]] += n;
+  for (auto it = out.begin(); it != out.end();) it = it->second == 0 ? out.erase(it) : std::next(it);
+  return out;
 }
 
 }  // namespace trivcon::cli

@@ -3,12 +3,14 @@
 // one was written.
 #pragma once
 #include <functional>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "trivcon/design.h"
 #include "trivcon/io.h"
+#include "trivcon/repair.h"
 
 namespace trivcon::cli {
 
@@ -39,8 +41,14 @@ class StagedOutputs {
 // Stages the field, connection, lines, sharp edges (`sharp`: edge ids, trivcon/features.h; also drawn in
 // the picture) and picture of design `d` of `prescription` (item `name` of a batch, or ""); the report is
 // staged by its caller.
+// With `repair` (the design is on that repair of `input`), per-face and per-vertex outputs are the input's: a field
+// row per input face (a duplicate's that of the face it duplicates), singularities and .sharp faces by input ids;
+// --mesh-out writes the repaired mesh, and the connection and matching (edges by vertex pairs) are that mesh's.
 void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const std::string& name, const MeshData& mesh,
                           const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d,
-                          const std::vector<int>& sharp = {});
+                          const std::vector<int>& sharp = {}, const RepairedMesh* repair = nullptr, const MeshData* input = nullptr);
+
+// A prescription's singular vertices by the input's ids (copies made by repair named by the vertex they copy).
+std::map<int, int> input_singularities(const std::map<int, int>& vertex, const RepairedMesh* repair);
 
 }  // namespace trivcon::cli

@@ -48,12 +48,12 @@ bool is_fix_spec(const std::string& s) {
 }  // namespace
 
 void add_fix_options(const std::vector<std::string>& fixes, const Topology& topology, const Geometry& geometry,
-                     std::map<int, double>& fixed) {
+                     std::map<int, double>& fixed, const FaceIdMap& face_id) {
   for (const auto& f : fixes) {
     if (is_fix_spec(f))
-      add_fixed_direction(f, topology, geometry, fixed);
+      add_fixed_direction(f, topology, geometry, fixed, face_id);
     else
-      read_fixed_directions(f, topology, geometry, fixed);
+      read_fixed_directions(f, topology, geometry, fixed, face_id);
   }
 }
 

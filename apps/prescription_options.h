@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "trivcon/constraints.h"
 #include "trivcon/common.h"
 #include "trivcon/geometry.h"
 #include "trivcon/indices.h"
@@ -32,7 +33,8 @@ struct PrescriptionOptions {
 
 // The --fix arguments of `solve` and `edit`: "F:x,y,z" / "F:angle=A" specs and files of such lines, added to
 // `fixed` (face → angle in its frame; trivcon/constraints.h; throws trivcon::Error naming the argument).
+// Face ids are the input's: `face_id` maps them onto a repaired mesh (trivcon/constraints.h).
 void add_fix_options(const std::vector<std::string>& fixes, const Topology& topology, const Geometry& geometry,
-                     std::map<int, double>& fixed);
+                     std::map<int, double>& fixed, const FaceIdMap& face_id = nullptr);
 
 }  // namespace trivcon::cli

@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <utility>
 
 #include "commands.h"
 #include "trivcon/blas.h"
@@ -11,6 +12,37 @@
 namespace trivcon::cli {
 int exit_code = 0;
 MeshData load_mesh(const std::string& path) { return read_mesh(path); }
+
+LoadedMesh load_mesh(const std::string& path, bool repair, bool quiet) {
+  LoadedMesh out;
+  out.mesh = read_mesh(path);
+  if (!repair) {
+    if (!out.mesh.repeated_vertex.empty()) throw Error(out.mesh.repeated_vertex);
+    return out;
+  }
+  RepairedMesh r = repair_mesh(out.mesh.V, out.mesh.F);
+  if (!r.changed()) return out;
+  out.input = std::move(out.mesh);
+  out.mesh.V = r.V, out.mesh.F = r.F;
+  out.mesh.format = out.input.format;
+  out.mesh.polygon_count = out.input.polygon_count;
+  out.mesh.polygon_of_triangle.resize(r.input_face.size());
+  for (size_t q = 0; q < r.input_face.size(); ++q)
+    out.mesh.polygon_of_triangle[q] = out.input.polygon_of_triangle.empty() ? r.input_face[q] : out.input.polygon_of_triangle[r.input_face[q]];
+  if (!quiet) std::cerr << "trivcon: warning: " << path << " " << repair_summary(r) << " (--no-repair refuses it instead)\n";
+  out.repair = std::move(r);
+  return out;
+}
+
+void add_repair_flag(CLI::App* cmd, bool& no_repair) {
+  cmd->add_flag("--no-repair", no_repair,
+                "Refuse a mesh that is not manifold (faces with a repeated vertex, duplicate faces, edges with more than two faces, "
+                "vertices where sheets touch) instead of repairing it");
+}
+
+MatrixX3d rows_on_mesh(const LoadedMesh& m, const MatrixX3d& input_rows) {
+  return m.repair ? rows_on_repaired(*m.repair, input_rows) : input_rows;
+}
 }  // namespace trivcon::cli
 
 int main(int argc, char** argv) {

@@ -5,7 +5,10 @@
 #include <stdexcept>
 
 #include "fuzz_target.h"
+#include "trivcon/error.h"
 #include "trivcon/generate.h"
+#include "trivcon/repair.h"
+#include "trivcon/topology.h"
 
 namespace trivcon::fuzz {
 
@@ -53,9 +56,20 @@ void check_mesh(const MeshData& mesh) {
     TRIVCON_FUZZ_CHECK(polygon == previous || (t > 0 && polygon == previous + 1));
     previous = polygon;
     for (int k = 0; k < 3; ++k) TRIVCON_FUZZ_CHECK(mesh.F(t, k) >= 0 && mesh.F(t, k) < mesh.V.rows());
-    TRIVCON_FUZZ_CHECK(mesh.F(t, 0) != mesh.F(t, 1) && mesh.F(t, 1) != mesh.F(t, 2) && mesh.F(t, 0) != mesh.F(t, 2));
+    // A face with a repeated vertex is read, and the first is named.
+    if (mesh.F(t, 0) == mesh.F(t, 1) || mesh.F(t, 1) == mesh.F(t, 2) || mesh.F(t, 0) == mesh.F(t, 2))
+      TRIVCON_FUZZ_CHECK(!mesh.repeated_vertex.empty());
   }
   TRIVCON_FUZZ_CHECK(previous == mesh.polygon_count - 1);
+  // Repair takes whatever was read: a manifold mesh with maps back, or a trivcon::Error.
+  try {
+    const RepairedMesh r = repair_mesh(mesh.V, mesh.F);
+    TRIVCON_FUZZ_CHECK(static_cast<Eigen::Index>(r.input_face.size()) == r.F.rows());
+    TRIVCON_FUZZ_CHECK(static_cast<Eigen::Index>(r.face_of_input.size()) == mesh.F.rows());
+    TRIVCON_FUZZ_CHECK(static_cast<Eigen::Index>(r.vertex_origin.size()) == r.V.rows());
+    build_topology(r.F, static_cast<int>(r.V.rows()));  // may refuse only what repair leaves: non-orientable
+  } catch (const Error&) {
+  }
 }
 
 }  // namespace trivcon::fuzz

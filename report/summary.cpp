@@ -68,4 +68,23 @@ nlohmann::ordered_json cycles_summary(const Topology& t, const Geometry& g, cons
   return j;
 }
 
+nlohmann::ordered_json repair_summary_json(const RepairedMesh& r) {
+  nlohmann::ordered_json copies = nlohmann::ordered_json::array();
+  for (size_t v = r.input_vertices; v < r.vertex_origin.size(); ++v) copies.push_back({v, r.vertex_origin[v]});
+  nlohmann::ordered_json duplicates = nlohmann::ordered_json::array(), cut = nlohmann::ordered_json::array(),
+                         split = nlohmann::ordered_json::array();
+  for (const auto& [f, of] : r.duplicates) duplicates.push_back({f, of});
+  for (const auto& [i, j] : r.cut_edges) cut.push_back({i, j});
+  for (const auto& [v, fans] : r.split_vertices) split.push_back({v, fans});
+  return {{"summary", repair_summary(r)},
+          {"input_vertices", r.input_vertices},
+          {"input_faces", r.input_faces},
+          {"degenerate_faces", r.degenerate_faces},
+          {"duplicate_faces", duplicates},
+          {"cut_edges", cut},
+          {"unpaired_faces", r.unpaired_faces},
+          {"split_vertices", split},
+          {"appended_vertices", copies}};
+}
+
 }  // namespace trivcon::cli

@@ -8,12 +8,17 @@
 #include "trivcon/cycles.h"
 #include "trivcon/geometry.h"
 #include "trivcon/io.h"
+#include "trivcon/repair.h"
 #include "trivcon/topology.h"
 
 namespace trivcon::cli {
 
 nlohmann::ordered_json mesh_summary(const std::string& path, const MeshData& mesh, const Topology& topology, const Geometry& geometry);
 nlohmann::ordered_json cycles_summary(const Topology& topology, const Geometry& geometry, const Cycles& cycles);
+// The "repair" entry (trivcon/repair.h), all ids the input's: what was dropped, cut and split, and the vertices
+// appended (each with the input vertex it copies); ids at or above the input's vertex count in other entries
+// are those copies.
+nlohmann::ordered_json repair_summary_json(const RepairedMesh& repaired);
 
 using Clock = std::chrono::steady_clock;
 inline double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }

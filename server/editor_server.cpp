@@ -784,6 +784,7 @@ struct EditorServer::Impl {
     const Topology& t = designer->topology();
     ojson j = cli::mesh_summary(options.mesh_path, mesh, t, designer->geometry());
     j["cycles"] = cli::cycles_summary(t, designer->geometry(), designer->cycles());
+    if (options.repair) j["repair"] = repair_summary(*options.repair);
     j["N"] = options.initial.N;
     return j;
   }
@@ -1162,13 +1163,23 @@ struct EditorServer::Impl {
                   } catch (const Error& e) {
                     throw BadRequest{400, e.what()};
                   }
-                  write_singularities_to(out, r.prescription.vertex, r.prescription.N);
+                  std::map<int, int> vertex = r.prescription.vertex;  // by the file's ids
+                  if (options.repair) {
+                    vertex.clear();
+                    for (const auto& [v, n] : r.prescription.vertex) vertex[options.repair->vertex_origin[v]] += n;
+                    for (auto it = vertex.begin(); it != vertex.end();) it = it->second == 0 ? vertex.erase(it) : std::next(it);
+                  }
+                  write_singularities_to(out, vertex, r.prescription.N);
                   name = "singularities.txt";
                 } else {
                   const Solved s = solve(r);
                   if (stopping) throw BadRequest{503, "the editor is stopping"};  // no file to write for nobody
                   name = "field." + format;
-                  write_field_to(out, name, mesh.V, mesh.F, designer->geometry(), s.field);
+                  if (options.repair)  // a row per face of the file
+                    write_field_to(out, name, options.input->V, options.input->F, designer->geometry(), s.field,
+                                   options.repair->face_of_input);
+                  else
+                    write_field_to(out, name, mesh.V, mesh.F, designer->geometry(), s.field);
                 }
                 res.set_header("Content-Disposition", "attachment; filename=\"" + name + "\"");
                 res.set_content(out.str(), format == "ply" ? "application/octet-stream" : "text/plain; charset=utf-8");

@@ -22,6 +22,7 @@
 #include "trivcon/design.h"
 #include "trivcon/indices.h"
 #include "trivcon/io.h"
+#include "trivcon/repair.h"
 
 namespace trivcon::server {
 
@@ -34,6 +35,12 @@ struct EditorOptions {
   IndexPrescription initial;          // the session the page starts with (-N, -s, --sing, --fix angles)
   bool align_boundary = false;        // --align-boundary at start
   std::optional<double> feature_degrees;  // --align-features DEG at start
+  // When the mesh given is a repair of the file (trivcon/repair.h): the map and the file's own mesh. The page
+  // works on the repaired mesh (its ids: the file's, then the copies repair appended); a downloaded field has a
+  // row per face of the file, downloaded singularities name the file's vertices; the mesh's info says what
+  // repair did ("repair").
+  std::shared_ptr<const RepairedMesh> repair;
+  std::shared_ptr<const MeshData> input;
   // Connections: each is served on a thread of its own, up to max_connections at once (more wait for one to
   // end). A request's line and headers must arrive within header_seconds of its first byte, its body within
   // body_seconds after them; a read or write that makes no progress for io_idle_seconds fails; an idle

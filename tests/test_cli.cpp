@@ -335,7 +335,7 @@ TEST(CliSharedMeshes, BrokenMeshesFailCleanly) {
       {"mobius.obj", "non-orientable component 0 ("},
   };
   for (const auto& [file, message] : broken) {
-    const CommandResult r = run_cli("info " + q(test::shared_mesh(file)) + " --json");
+    const CommandResult r = run_cli("info --no-repair " + q(test::shared_mesh(file)) + " --json");
     expect_clean_error(r, {message}, file);
   }
 }
@@ -405,9 +405,9 @@ TEST(CliBadInput, TruncatedFiles) {
 TEST(CliBadInput, InvalidMeshes) {
   const std::string dir = test::temp_dir("cli_invalid");
   write_text(dir + "/nm.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n");
-  expect_clean_error(run_cli("info " + q(dir + "/nm.obj")), {"non-manifold edge (0, 1) shared by 3 faces (0, 1, 2)"}, "nm edge");
+  expect_clean_error(run_cli("info --no-repair " + q(dir + "/nm.obj")), {"non-manifold edge (0, 1) shared by 3 faces (0, 1, 2)"}, "nm edge");
   write_text(dir + "/bowtie.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n");
-  expect_clean_error(run_cli("info " + q(dir + "/bowtie.obj")), {"non-manifold vertex 0: its faces form 2 separate fans"}, "bow tie");
+  expect_clean_error(run_cli("info --no-repair " + q(dir + "/bowtie.obj")), {"non-manifold vertex 0: its faces form 2 separate fans"}, "bow tie");
   const std::string mobius = save(dir, "mobius", mobius_strip(9));
   expect_clean_error(run_cli("info " + q(mobius)), {"non-orientable component 0 (", "cannot be oriented consistently across edge ("},
                      "mobius");
@@ -416,11 +416,13 @@ TEST(CliBadInput, InvalidMeshes) {
   write_text(dir + "/range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
   expect_clean_error(run_cli("info " + q(dir + "/range.obj")), {"range.obj:4:", "out of range"}, "index out of range");
   write_text(dir + "/repeat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 1 2\n");
-  expect_clean_error(run_cli("info " + q(dir + "/repeat.obj")), {"repeat.obj:4:", "repeated vertex"}, "repeated vertex");
+  expect_clean_error(run_cli("info --no-repair " + q(dir + "/repeat.obj")), {"repeat.obj:4:", "repeated vertex"}, "repeated vertex");
+  expect_clean_error(run_cli("info " + q(dir + "/repeat.obj")), {"no faces left: every face has a repeated vertex (first: face 0, (0, 0, 1))"},
+                     "repeated vertex, repaired");
   // The same through solve and check.
-  expect_clean_error(run_cli("solve " + q(dir + "/nm.obj")), {"non-manifold edge (0, 1)"}, "solve nm");
+  expect_clean_error(run_cli("solve --no-repair " + q(dir + "/nm.obj")), {"non-manifold edge (0, 1)"}, "solve nm");
   expect_clean_error(run_cli("solve " + q(mobius)), {"non-orientable component 0 ("}, "solve mobius");
-  expect_clean_error(run_cli("check " + q(dir + "/nm.obj") + " " + q(dir + "/none.txt")), {"non-manifold edge (0, 1)"}, "check nm");
+  expect_clean_error(run_cli("check --no-repair " + q(dir + "/nm.obj") + " " + q(dir + "/none.txt")), {"non-manifold edge (0, 1)"}, "check nm");
 }
 
 // ----------------------------------------------------------------------------------------------

@@ -98,7 +98,7 @@ TEST(Repair, DuplicatesInEitherOrderAreDropped) {
 
 TEST(Repair, RefusesWhatItDoesNotRepair) {
   MatrixX3d V = MatrixX3d::Zero(3, 3);
-  EXPECT_EQ(error_of([&] { repair_mesh(V, faces({{0, 1, 1}})); }), "face 0 has a repeated vertex (0, 1, 1)");
+  EXPECT_EQ(error_of([&] { repair_mesh(V, faces({{0, 1, 1}})); }), "no faces left: every face has a repeated vertex (first: face 0, (0, 1, 1))");
   EXPECT_EQ(error_of([&] { repair_mesh(V, faces({{0, 1, 3}})); }), "vertex index 3 out of range in face 0 (mesh has 3 vertices)");
 }
 

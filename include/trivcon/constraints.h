@@ -12,6 +12,7 @@
 // other and of the cycle rows, so every fixed face holds exactly and no singularity is added.
 #pragma once
 #include <Eigen/Core>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -37,9 +38,13 @@ std::vector<FixedPath> fixed_face_paths(const Topology& topology, const std::vec
 
 // Adds fixed directions from a file: one "FACE x y z" (world direction) or "FACE angle=A" (radians, in the
 // face's frame) per line, '#' comments; and from "F:x,y,z" or "F:angle=A" specs (--fix). Face ids are
-// checked against the mesh; a face given twice is an error.
-void read_fixed_directions(const std::string& path, const Topology& topology, const Geometry& geometry, std::map<int, double>& fixed);
-void add_fixed_direction(const std::string& spec, const Topology& topology, const Geometry& geometry, std::map<int, double>& fixed);
+// checked against the mesh; a face given twice is an error. `face_id`, when given, maps an id as written to the
+// mesh's face (e.g. an input's face on its repair, repaired_face in trivcon/repair.h) and checks it instead.
+using FaceIdMap = std::function<int(int)>;
+void read_fixed_directions(const std::string& path, const Topology& topology, const Geometry& geometry, std::map<int, double>& fixed,
+                           const FaceIdMap& face_id = nullptr);
+void add_fixed_direction(const std::string& spec, const Topology& topology, const Geometry& geometry, std::map<int, double>& fixed,
+                         const FaceIdMap& face_id = nullptr);
 
 // --align-boundary: every face with a boundary edge, fixed to the direction of that edge as the
 // boundary loop runs (surface on the left); the longest such edge where a face has several.

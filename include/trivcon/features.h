@@ -73,9 +73,10 @@ struct SharpFaceEdge {
   int edge;    // 0, 1, 2: from the face's vertex `edge` to vertex `edge` + 1 in the given F
 };
 // Writes QuadWild's .sharp for `edges` (interior edge ids) atomically; `F` is the mesh's faces as given (the
-// file's order; the Topology was built from it), `convex` one flag per listed edge.
+// file's order; the Topology was built from it), `convex` one flag per listed edge. With `input_face` (a repaired
+// mesh's RepairedMesh::input_face), the faces written are the input's.
 void write_sharp(const std::string& path, const MatrixX3i& F, const Topology& topology, const std::vector<int>& edges,
-                 const std::vector<char>& convex);
+                 const std::vector<char>& convex, const std::vector<int>& input_face = {});
 // Reads a .sharp file: checks the count, the faces (in [0, F)) and edges (0..2); errors name file:line.
 std::vector<SharpFaceEdge> read_sharp(const std::string& path, int num_faces);
 

@@ -31,11 +31,15 @@
 
 namespace trivcon {
 
-// Writes by extension: .rawfield, .rosy, .ply, anything else the text format.
-void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& geometry, const Field& field);
+// Writes by extension: .rawfield, .rosy, .ply, anything else the text format. With `face_of_row` (one entry per
+// row of F), row i is the field of face face_of_row[i] of the geometry: a field solved on a repaired mesh written
+// for the input's faces (RepairedMesh::face_of_input, trivcon/repair.h); a row of −1 (a degenerate input face
+// with no neighbour) is the zero vector.
+void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& geometry, const Field& field,
+                 const std::vector<int>& face_of_row = {});
 // The same bytes written to a stream (the editor's downloads); `path` only picks the format, by its extension.
 void write_field_to(std::ostream& out, const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& geometry,
-                    const Field& field);
+                    const Field& field, const std::vector<int>& face_of_row = {});
 // Reads a field written by write_field, a Directional .rawfield or a QuadWild .rosy: world directions (F × 3, the first
 // direction per face) and N (0 when the file does not say). `num_faces` must match.
 MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file = nullptr);

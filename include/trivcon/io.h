@@ -7,8 +7,10 @@
 //   order into (a,b,c), (a,c,d), ...; `polygon_of_triangle` maps each triangle back to the file's
 //   polygon. Polygons are counted 0-based in file order.
 // - Readers only parse: they check syntax, counts, index ranges (an index outside [0, V) is an
-//   error), repeated corners within a polygon, and that every coordinate is finite. Topology
-//   (manifoldness, orientation) is checked by trivcon/topology.h.
+//   error) and that every coordinate is finite. A polygon with a repeated corner is read (its
+//   triangles with a repeated vertex are what repair drops, trivcon/repair.h) and the first one is
+//   named in MeshData::repeated_vertex. Topology (manifoldness, orientation) is checked by
+//   trivcon/topology.h.
 // - Errors are trivcon::Error with the file name and the 1-based line (text formats) or byte
 //   offset (binary PLY), e.g. "mesh.obj:12: face index 40 out of range (file has 39 vertices)".
 // - Writers write to a temporary file beside the target and rename it into place, so a failed write
@@ -31,6 +33,9 @@ struct MeshData : Mesh {
   int polygon_count = 0;                 // polygons in the file
   std::string format;                    // "obj", "off", "ply-ascii", "ply-binary-le", "ply-binary-be", "stl-ascii",
                                          // "stl-binary", "gltf", "glb"
+  // The first polygon with a repeated corner, as the error a front end that does not repair gives, with the file
+  // and line (or byte): e.g. "m.obj:5: face 1 has a repeated vertex (0, 0, 1)"; "" when there is none.
+  std::string repeated_vertex;
 };
 
 // Reads by extension: .obj .off .ply .stl .gltf .glb, each optionally followed by .gz (case-insensitive).

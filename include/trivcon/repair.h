@@ -1,6 +1,8 @@
 // trivcon/repair.h: a mesh as users have it made manifold, with maps back to the input.
 //
 // What repair_mesh does, in this order:
+// - faces with a repeated vertex (a, a, b) are dropped: they have no direction; each maps to a face sharing its
+//   edge (a, b), else one sharing a vertex (for the field a per-face output gives it), else to −1;
 // - exact duplicate faces (the same three vertices in any order) are dropped; each maps to the face it
 //   duplicates (the first one in file order);
 // - an edge with more than two faces is cut: its faces are paired into manifold sheets, consistently oriented
@@ -10,8 +12,8 @@
 //   holding the vertex's first corner in file order keeps the vertex's id, each other fan gets a new vertex,
 //   appended after the input's vertices in order of first appearance.
 // Faces stay in file order (duplicates left out) with their corners in the input's order; the re-orientation of
-// orientable components is build_topology's (trivcon/topology.h). Faces with a repeated vertex, indices out of
-// range and non-orientable components are not repaired: build_topology's errors name them.
+// orientable components is build_topology's (trivcon/topology.h). Indices out of range and non-orientable
+// components are not repaired: build_topology's errors name them.
 #pragma once
 #include <string>
 #include <utility>
@@ -24,18 +26,22 @@ namespace trivcon {
 struct RepairedMesh {
   MatrixX3d V;                    // the input's vertices (same ids), then the split vertices' copies
   MatrixX3i F;                    // the input's faces in order, duplicates left out
-  std::vector<int> face_of_input;  // per input face: its face in F (for a duplicate, the face it duplicates)
+  std::vector<int> face_of_input;  // per input face: its face in F (for a duplicate, the face it duplicates; for a
+                                   // degenerate face, the one above or −1)
   std::vector<int> input_face;     // per face of F: its input face
   std::vector<int> vertex_origin;  // per vertex of V: the input vertex it copies (itself for ids < input count)
+  int input_vertices = 0, input_faces = 0;  // the input's counts
   // What was done (ids of the input).
+  std::vector<int> degenerate_faces;                   // dropped faces with a repeated vertex, increasing
   std::vector<std::pair<int, int>> duplicates;         // (dropped face, the face it duplicates), increasing
   std::vector<std::pair<int, int>> cut_edges;          // (i, j), i < j: edges that had more than two faces
   std::vector<std::pair<int, int>> split_vertices;     // (vertex, fans): vertices split into that many
   std::vector<int> unpaired_faces;                     // faces left as boundary beside a cut edge
-  bool changed() const { return !duplicates.empty() || !cut_edges.empty() || !split_vertices.empty(); }
+  bool changed() const { return !degenerate_faces.empty() || !duplicates.empty() || !cut_edges.empty() || !split_vertices.empty(); }
 };
 
-// Throws trivcon::Error for an index out of range or a face with a repeated vertex (as build_topology does).
+// Throws trivcon::Error for an index out of range (as build_topology does), and for sheets that meet again around
+// both ends of a cut edge (which splitting cannot separate), naming the edge.
 RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F);
 
 // One sentence with the counts and the first ids ("" when nothing was done), e.g. "repaired: 2 duplicate faces
@@ -46,5 +52,25 @@ std::string repair_summary(const RepairedMesh& repaired);
 // For a vertex of the input that was split: the first face (input id) of each of its fans, in fan order; empty
 // when it was not split. For the message of a singularity prescribed there.
 std::vector<int> fan_faces(const RepairedMesh& repaired, int input_vertex);
+
+// Ids a user states in the input's numbering, on the repaired mesh. Each throws trivcon::Error for an id out of the
+// input's range; `what` starts the message ("singular vertex", "fixed face", ...).
+// - A vertex keeps its id; one that repair split into several fans is an error naming the first face of each fan:
+//   which sheet is meant cannot be told from the input's id (place it on the repaired mesh instead, written by
+//   --mesh-out, where each fan has its own id).
+// - A face goes to face_of_input (a duplicate to the face it duplicates); a dropped degenerate face is an error.
+int repaired_vertex(const RepairedMesh& repaired, int input_vertex, const std::string& what);
+int repaired_face(const RepairedMesh& repaired, int input_face, const std::string& what);
+// Per-face rows of the input (a field file) as rows of the repaired mesh.
+MatrixX3d rows_on_repaired(const RepairedMesh& repaired, const MatrixX3d& input_rows);
+// Per-corner rows of the repaired mesh (F × 3w: w numbers per corner, corners in F's order, e.g. a map's (u, v))
+// for the input's faces `input_F`: each input face takes the row of face_of_input, its corners matched by vertex
+// (a duplicate may list them in another order); a degenerate face's corners take those of the face it maps to at
+// the same vertex, else its first corner's; a face mapped to −1 gets zeros.
+Eigen::MatrixXd corner_rows_on_input(const RepairedMesh& repaired, const MatrixX3i& input_F, const Eigen::MatrixXd& rows);
+// The inverse: per-corner rows of the input's faces as rows of the repaired mesh's, corners matched by vertex.
+Eigen::MatrixXd corner_rows_on_repaired(const RepairedMesh& repaired, const MatrixX3i& input_F, const Eigen::MatrixXd& input_rows);
+// The vertices of the repaired mesh that copy input vertex v (v itself first), for edges named by input vertices.
+std::vector<int> vertex_copies(const RepairedMesh& repaired, int input_vertex);
 
 }  // namespace trivcon

@@ -23,6 +23,7 @@
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/features.h"
+#include "trivcon/repair.h"
 #include "trivcon/split_large_turns.h"
 
 namespace trivcon {
@@ -81,6 +82,14 @@ struct FieldOutcome {
   // The designer the design belongs to.
   const FieldDesigner& designer(const FieldDesigner& input) const { return refined ? *refined : input; }
 };
+
+// A request stated in the input file's ids (vertices, faces, edges between input vertices), moved onto its repair
+// (trivcon/repair.h) whose topology is `topology`: singular vertices keep their ids (a split one is an error,
+// repaired_vertex), roots go to face_of_input, and a listed feature edge between two input vertices marks every
+// copy of it (the sheets of a cut edge each get theirs). Fixed directions are not here: their angles are in a
+// face's frame, so they are read onto the repaired mesh's faces directly (read_fixed_directions's face map).
+// Throws trivcon::Error for an id out of the input's range.
+void move_request_to_repaired(FieldRequest& request, const Topology& topology, const RepairedMesh& repaired);
 
 // The whole request: constraints, set-up (set_fixed_faces, only when they changed), auto placement,
 // validation (check_aligned_index_sums, validate_prescription: the CLI's messages), design, splitting.

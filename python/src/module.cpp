@@ -59,6 +59,7 @@
 #include "trivcon/split_large_turns.h"
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
+#include "trivcon/repair.h"
 #include "trivcon/request.h"
 #include "trivcon/features.h"
 #include "trivcon/error.h"
@@ -335,6 +336,10 @@ struct DesignerState {
   std::vector<int> fixed_faces;   // those the solver is factored for
   std::vector<int> sorted_edges;  // every edge, sorted by (i, j)
   int threads = 0;                // of its calls (0: the module's default)
+  // When the mesh given needed repair (trivcon/repair.h): V and F above are the repair; these the input.
+  std::shared_ptr<const RepairedMesh> repair;
+  MatrixX3d input_V;
+  MatrixX3i input_F;
   std::mutex mutex;
 
   const Topology& topology() const { return designer->topology(); }
@@ -384,10 +389,19 @@ int checked_threads(int threads) {
 }
 
 // A designer on (V, F); factored now when `factor` (the constructor), else on its first solve (unpickling).
-DesignerPtr build_designer(MatrixX3d V, MatrixX3i F, const SolverOptions& options, int threads, bool factor) {
-  return interruptible(threads, [V = std::move(V), F = std::move(F), options, threads, factor]() mutable {
+// With `repair`, a mesh that needs it is repaired first (the designer is on the repair).
+DesignerPtr build_designer(MatrixX3d V, MatrixX3i F, const SolverOptions& options, int threads, bool factor, bool repair = false) {
+  return interruptible(threads, [V = std::move(V), F = std::move(F), options, threads, factor, repair]() mutable {
     auto s = std::make_shared<DesignerState>();
     s->threads = threads;
+    if (repair) {
+      RepairedMesh r = repair_mesh(V, F);
+      if (r.changed()) {
+        s->input_V = std::move(V), s->input_F = std::move(F);
+        V = r.V, F = r.F;
+        s->repair = std::make_shared<const RepairedMesh>(std::move(r));
+      }
+    }
     s->V = std::move(V);
     s->F = std::move(F);
     s->designer = std::make_unique<FieldDesigner>(s->V, s->F, options);
@@ -398,9 +412,9 @@ DesignerPtr build_designer(MatrixX3d V, MatrixX3i F, const SolverOptions& option
 }
 
 DesignerPtr make_designer(MatrixX3d V, MatrixX3i F, const std::string& weights, const std::string& solver, const std::string& factorization,
-                          double weight_floor, int threads) {
+                          double weight_floor, int threads, bool repair) {
   const SolverOptions options = solver_options(weights, solver, factorization, weight_floor);
-  return build_designer(std::move(V), std::move(F), options, checked_threads(threads), true);
+  return build_designer(std::move(V), std::move(F), options, checked_threads(threads), true, repair);
 }
 
 // Pickling (the package's FieldDesigner.__getstate__): the mesh as given and every solver option, including
@@ -417,6 +431,11 @@ py::dict designer_state(const DesignerState& s) {
   d["weight_floor"] = o.weight_floor;
   d["edge_weight_scale"] = o.edge_weight_scale;
   d["threads"] = s.threads;
+  if (s.repair) {  // the input as given: restoring repairs it again (the same repair: it is deterministic)
+    d["V"] = py::array_t<double>({static_cast<py::ssize_t>(s.input_V.rows()), static_cast<py::ssize_t>(3)}, s.input_V.data());
+    d["F"] = py::array_t<std::int32_t>({static_cast<py::ssize_t>(s.input_F.rows()), static_cast<py::ssize_t>(3)}, s.input_F.data());
+    d["repair"] = true;
+  }
   return d;
 }
 
@@ -424,7 +443,8 @@ DesignerPtr restore_designer(const py::dict& d) {
   SolverOptions o = solver_options(d["weights"].cast<std::string>(), d["solver"].cast<std::string>(),
                                    d["factorization"].cast<std::string>(), d["weight_floor"].cast<double>());
   o.edge_weight_scale = d["edge_weight_scale"].cast<std::vector<double>>();
-  return build_designer(d["V"].cast<MatrixX3d>(), d["F"].cast<MatrixX3i>(), o, checked_threads(d["threads"].cast<int>()), false);
+  return build_designer(d["V"].cast<MatrixX3d>(), d["F"].cast<MatrixX3i>(), o, checked_threads(d["threads"].cast<int>()), false,
+                        d.contains("repair") && d["repair"].cast<bool>());
 }
 
 void check_face(const Topology& t, int f, const std::string& what) {
@@ -691,9 +711,9 @@ PYBIND11_MODULE(_core, m) {
       [](const std::string& path) {
         const MeshData mesh = interruptible(0, [path] { return read_mesh(path); });
         return py::make_tuple(double_matrix3(mesh.V), int64_matrix(mesh.F), int64_vector(mesh.polygon_of_triangle), mesh.polygon_count,
-                              mesh.format);
+                              mesh.format, mesh.repeated_vertex);
       },
-      py::arg("path"), "(V, F, polygon_of_triangle, polygon_count, format) of a mesh file (trivcon/io.h).");
+      py::arg("path"), "(V, F, polygon_of_triangle, polygon_count, format, repeated_vertex) of a mesh file (trivcon/io.h).");
   m.def(
       "write_mesh",
       [](const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
@@ -841,7 +861,7 @@ PYBIND11_MODULE(_core, m) {
   // --- FieldDesigner.
   py::class_<DesignerState, DesignerPtr>(m, "Designer", "trivcon::FieldDesigner on (V, F), factored at construction.")
       .def(py::init(&make_designer), py::arg("V"), py::arg("F"), py::arg("weights"), py::arg("solver"), py::arg("factorization"),
-           py::arg("weight_floor") = 0.0, py::arg("threads") = 0)
+           py::arg("weight_floor") = 0.0, py::arg("threads") = 0, py::arg("repair") = false)
       .def_static("restore", &restore_designer, py::arg("state"), "A designer of get_state()'s dict, factored on its first solve.")
       .def("get_state", &designer_state, "The mesh as given and the solver options (for pickling).")
       .def_property(
@@ -849,6 +869,23 @@ PYBIND11_MODULE(_core, m) {
           [](DesignerState& s, int threads) { s.threads = checked_threads(threads); })
       .def_property_readonly("V", [](const DesignerState& s) { return double_matrix3(s.V); })
       .def_property_readonly("F_input", [](const DesignerState& s) { return int64_matrix(s.F); })
+      .def_property_readonly("repair",
+                             [](const DesignerState& s) -> py::object {
+                               if (!s.repair) return py::none();
+                               const RepairedMesh& r = *s.repair;
+                               py::dict d;
+                               d["summary"] = repair_summary(r);
+                               d["input_vertices"] = r.input_vertices, d["input_faces"] = r.input_faces;
+                               d["face_of_input"] = r.face_of_input, d["input_face"] = r.input_face;
+                               d["vertex_origin"] = r.vertex_origin, d["degenerate_faces"] = r.degenerate_faces;
+                               d["duplicate_faces"] = r.duplicates, d["cut_edges"] = r.cut_edges;
+                               d["split_vertices"] = r.split_vertices, d["unpaired_faces"] = r.unpaired_faces;
+                               return d;
+                             })
+      .def("repaired_vertex",
+           [](const DesignerState& s, int v, const std::string& what) { return s.repair ? repaired_vertex(*s.repair, v, what) : v; })
+      .def("repaired_face", [](const DesignerState& s, int f, const std::string& what) { return s.repair ? repaired_face(*s.repair, f, what) : f; })
+      .def("vertex_copies", [](const DesignerState& s, int v) { return s.repair ? vertex_copies(*s.repair, v) : std::vector<int>{v}; })
       .def_property_readonly("F", [](const DesignerState& s) { return int64_matrix(s.topology().F); })
       .def_property_readonly("num_vertices", [](const DesignerState& s) { return s.topology().num_vertices; })
       .def_property_readonly("num_faces", [](const DesignerState& s) { return s.topology().num_faces; })
@@ -1110,7 +1147,10 @@ PYBIND11_MODULE(_core, m) {
           "write_field",
           [](const DesignResult& r, const std::string& path) {
             py::gil_scoped_release release;
-            write_field(path, r.state->V, r.state->F, r.state->geometry(), r.design.field);
+            if (r.state->repair)  // a row per input face, as the CLI writes it
+              write_field(path, r.state->input_V, r.state->input_F, r.state->geometry(), r.design.field, r.state->repair->face_of_input);
+            else
+              write_field(path, r.state->V, r.state->F, r.state->geometry(), r.design.field);
           },
           py::arg("path"))
       .def(
@@ -1140,16 +1180,26 @@ PYBIND11_MODULE(_core, m) {
           "write_singularities",
           [](const DesignResult& r, const std::string& path) {
             py::gil_scoped_release release;
-            write_singularities(path, r.prescription.vertex, r.prescription.N);
+            std::map<int, int> vertex = r.prescription.vertex;
+            if (r.state->repair) {  // the input's ids (a copy repair appended names the vertex it copies)
+              vertex.clear();
+              for (const auto& [v, n] : r.prescription.vertex) vertex[r.state->repair->vertex_origin[v]] += n;
+              for (auto it = vertex.begin(); it != vertex.end();) it = it->second == 0 ? vertex.erase(it) : std::next(it);
+            }
+            write_singularities(path, vertex, r.prescription.N);
           },
           py::arg("path"))
       .def(
           "write_uv_obj",
           [](const DesignResult& r, const std::string& path, const Eigen::MatrixXd& corner_uv) {
             py::gil_scoped_release release;
-            write_uv_obj(path, r.state->V, r.state->F, corner_uv);
+            if (r.state->repair)  // the input's faces, as `param -o` writes them
+              write_uv_obj(path, r.state->input_V, r.state->input_F, corner_rows_on_input(*r.state->repair, r.state->input_F, corner_uv));
+            else
+              write_uv_obj(path, r.state->V, r.state->F, corner_uv);
           },
-          py::arg("path"), py::arg("corner_uv"), "The OBJ of `param -o`: the mesh as given with (u, v) per corner (F x 6).")
+          py::arg("path"), py::arg("corner_uv"),
+          "The OBJ of `param -o`: the mesh as given (before repair) with (u, v) per corner (corner_uv: F x 6 of the designer's faces).")
       .def(
           "parametrize",
           [](const DesignResultPtr& r, double edge_length, double target_faces, bool align_boundary,

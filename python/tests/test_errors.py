@@ -95,12 +95,12 @@ def test_library_mesh_errors(sphere):
     raises("vertex index 42 out of range in face 7 (mesh has 42 vertices)", trivcon.FieldDesigner, V, G)
     G = F.copy()
     G[3, 1] = G[3, 0]
-    raises(f"face 3 has a repeated vertex ({G[3, 0]}, {G[3, 0]}, {G[3, 2]})", trivcon.FieldDesigner, V, G)
+    raises(f"face 3 has a repeated vertex ({G[3, 0]}, {G[3, 0]}, {G[3, 2]})", trivcon.FieldDesigner, V, G, repair=False)
     W = V.copy()
     W[12, 1] = np.nan
     raises("non-finite coordinate in vertex 12", trivcon.FieldDesigner, W, F)
     with pytest.raises(trivcon.Error, match=r"^non-manifold edge \("):
-        trivcon.FieldDesigner(V, np.vstack([F, F[:1]]))
+        trivcon.FieldDesigner(V, np.vstack([F, F[:1]]), repair=False)
 
 
 def test_index_errors(sphere):
@@ -174,8 +174,8 @@ def test_file_errors_match_the_cli(tmp_path, cli):
         f.write("v 5 5 5\nf %d %d 43\n" % (F[0][0] + 1, F[0][1] + 1))
     V2, F2 = trivcon.read_mesh(str(nm))
     with pytest.raises(trivcon.Error) as e:
-        trivcon.FieldDesigner(V2, F2)
-    p = cli("solve", nm, "--sing", "0:2", check=False)
+        trivcon.FieldDesigner(V2, F2, repair=False)
+    p = cli("solve", nm, "--no-repair", "--sing", "0:2", check=False)
     assert p.returncode == 1 and p.stderr.strip() == f"trivcon: error: {e.value}"
     # A prescription error: --sing 0:1/3 -N 4 against singularities={0: "1/3"}, past the "where" prefix.
     d = trivcon.FieldDesigner(V, F)

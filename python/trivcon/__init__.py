@@ -431,11 +431,14 @@ def read_mesh(path, info=False):
     polygons are fan-triangulated in order, (a,b,c), (a,c,d), ...; unreferenced vertices are kept.
     With info=True returns (V, F, info), info a dict with "format" ("obj", "off", "ply-ascii",
     "ply-binary-le", "ply-binary-be", "stl-ascii", "stl-binary", "gltf", "glb"), "polygon_count" and
-    "polygon_of_triangle" (int64 (m,): the file polygon each triangle comes from). Errors (trivcon.Error) name the file and line or byte offset.
+    "polygon_of_triangle" (int64 (m,): the file polygon each triangle comes from) and "repeated_vertex" (the first
+    polygon with a repeated corner, as a message with the file and line, or ""; such faces are read, and
+    FieldDesigner's repair drops them). Errors (trivcon.Error) name the file and line or byte offset.
     """
-    V, F, polygon_of_triangle, polygon_count, fmt = _core.read_mesh(str(path))
+    V, F, polygon_of_triangle, polygon_count, fmt, repeated = _core.read_mesh(str(path))
     if info:
-        return V, F, {"format": fmt, "polygon_count": polygon_count, "polygon_of_triangle": polygon_of_triangle}
+        return V, F, {"format": fmt, "polygon_count": polygon_count, "polygon_of_triangle": polygon_of_triangle,
+                      "repeated_vertex": repeated}
     return V, F
 
 
@@ -598,11 +601,19 @@ def blas_kernels():
 class FieldDesigner(_Cached):
     """A mesh prepared for fields: validated, its geometry and cycles computed, the system factored once.
 
-    FieldDesigner(V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0, threads=None)
+    FieldDesigner(V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0, threads=None,
+                  repair=True)
 
-    V (n, 3) real, F (m, 3) integer, ids as in the file. Validation errors (non-finite coordinate,
-    vertex id out of range, repeated vertex, non-manifold edge or vertex, non-orientable component)
-    raise trivcon.Error with the library's message. weights: "cotan" (clamped cotangent weights,
+    V (n, 3) real, F (m, 3) integer, ids as in the file. A mesh that is not manifold is repaired first
+    (repair=True, the default; as the CLI does, trivcon/repair.h): faces with a repeated vertex and exact
+    duplicate faces dropped, edges with more than two faces cut into sheets, vertices where sheets touch
+    split into one vertex per fan; a UserWarning says what was done. The designer is then the repaired
+    mesh's: V, F, every id it takes and gives are the repaired mesh's (vertices: the input's ids, then the
+    copies appended; faces: the input's in order without the dropped ones), and `repair` maps them to the
+    input's; Result.input_directions and Result's files (write_field, write_singularities, the param OBJ) are
+    the input's, as the CLI writes them. With repair=False such a mesh is refused. Validation errors
+    (non-finite coordinate, vertex id out of range, non-manifold edge or vertex with repair=False,
+    non-orientable component) raise trivcon.Error with the library's message. weights: "cotan" (clamped cotangent weights,
     default) or "unit"; solver: "cholesky" (default) or "qr" (the paper's SuiteSparseQR route);
     factorization: "own" (trivcon's, on several threads) or "cholmod". weight_floor: with cotan
     weights, every interior edge gets at least this fraction of the median weight (0 to 1; default 0,
@@ -621,7 +632,7 @@ class FieldDesigner(_Cached):
     first solve. Its arrays (V, F, edges, ...) are read-only and computed once.
     """
 
-    def __init__(self, V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0, threads=None):
+    def __init__(self, V, F, weights="cotan", solver="cholesky", factorization="own", weight_floor=0.0, threads=None, repair=True):
         V, F = _mesh(V, F)
         for name, value, allowed in (("weights", weights, ("cotan", "unit")), ("solver", solver, ("cholesky", "qr")),
                                      ("factorization", factorization, ("own", "cholmod"))):
@@ -632,7 +643,10 @@ class FieldDesigner(_Cached):
         except (TypeError, ValueError):
             raise Error(f"weight_floor must be a number in [0, 1], not {weight_floor!r}") from None
         threads = _threads(threads)
-        self._d = _core.Designer(V, F, weights, solver, factorization, weight_floor, threads)
+        self._d = _core.Designer(V, F, weights, solver, factorization, weight_floor, threads, bool(repair))
+        if self._d.repair is not None:
+            _warnings.warn(f"trivcon: the mesh was {self._d.repair['summary']} (repair=False refuses it instead)", UserWarning,
+                           stacklevel=2)
         self.weights = weights
         self.weight_floor = weight_floor
         self.solver = solver
@@ -691,6 +705,16 @@ class FieldDesigner(_Cached):
     def F_input(self):
         """The faces as given, int64 (m, 3) (read-only): what write_mesh and the field files pair with V."""
         return self._get("F_input", lambda: self._d.F_input)
+
+    @property
+    def repair(self):
+        """None when the mesh needed no repair (or repair=False); else a dict mapping the repaired mesh to the
+        input: summary (one sentence), input_vertices, input_faces, face_of_input (per input face its face
+        here; a duplicate's the face it duplicates; a dropped degenerate face's a neighbour, or -1),
+        input_face (per face here its input face), vertex_origin (per vertex here the input vertex it
+        copies), degenerate_faces, duplicate_faces ((dropped, original) pairs), cut_edges, split_vertices
+        ((vertex, fans) pairs), unpaired_faces, all in the input's ids."""
+        return self._d.repair
 
     @property
     def num_vertices(self):
@@ -1169,8 +1193,24 @@ class Result(_Cached):
         """Seconds of the solve, the field propagation and the verification."""
         return self._r.seconds
 
+    @property
+    def input_directions(self):
+        """float64 (input faces, 3): `directions` per face of the mesh as given before repair (FieldDesigner.repair:
+        a duplicate face reads the face it duplicates, a dropped degenerate face a neighbour's, or zeros);
+        `directions` itself when the mesh was not repaired (read-only). What write_field writes."""
+        def compute():
+            r = self._designer.repair
+            if r is None or "parent_face" in self.__dict__:
+                return self.directions
+            rows = _np.asarray(r["face_of_input"], dtype=_np.int64)
+            out = _np.zeros((rows.shape[0], 3))
+            out[rows >= 0] = self.directions[rows[rows >= 0]]
+            return _frozen(out)
+        return self._get("input_directions", compute)
+
     def write_field(self, path):
-        """Write the field exactly as --field-out does (.txt, .rawfield or .ply by extension)."""
+        """Write the field exactly as --field-out does (.txt, .rawfield or .ply by extension): a row per face of
+        the mesh as given (input_directions) when it was repaired."""
         self._r.write_field(str(path))
 
     def write_mesh(self, path):

@@ -35,6 +35,7 @@ import json
 import os
 import sys
 import time
+import warnings
 
 __all__ = ["run", "solve_mesh", "find_meshes", "format_table", "main"]
 
@@ -80,7 +81,7 @@ def find_meshes(paths):
 
 
 def _jobs(meshes, out, N, sing_dir, auto_cancel, align_boundary, weights, field_format, connection, png, split_large_turns=False,
-          threads=None):
+          threads=None, repair=True):
     jobs, names = [], {}
     for mesh in meshes:
         name = mesh_name(mesh)
@@ -106,6 +107,7 @@ def _jobs(meshes, out, N, sing_dir, auto_cancel, align_boundary, weights, field_
             "png": png,
             "split_large_turns": split_large_turns,
             "threads": threads,
+            "repair": repair,
         })
     return jobs
 
@@ -126,7 +128,8 @@ def solve_mesh(job):
     its message the library's error message. Keys of job: mesh, name, out, N, sing_file (None: automatic),
     auto_cancel, align_boundary, weights, field_format, connection, png, and optionally split_large_turns
     (refine where the connection turns by pi/N or more; writes the refined mesh and its parent faces too)
-    and threads (the designer's, None: trivcon's default).
+    threads (the designer's, None: trivcon's default) and repair (default True: a mesh that is not manifold is
+    repaired, FieldDesigner(repair=...), and the row's "repair" says what was done).
     """
     import trivcon
 
@@ -135,7 +138,11 @@ def solve_mesh(job):
     try:
         V, F = trivcon.read_mesh(job["mesh"])
         row["vertices"], row["faces"] = int(V.shape[0]), int(F.shape[0])
-        d = trivcon.FieldDesigner(V, F, weights=job["weights"], threads=job.get("threads"))
+        with warnings.catch_warnings():  # what repair did goes into the row
+            warnings.simplefilter("ignore", UserWarning)
+            d = trivcon.FieldDesigner(V, F, weights=job["weights"], threads=job.get("threads"), repair=job.get("repair", True))
+        if d.repair is not None:
+            row["repair"] = d.repair["summary"]
         row["chi"] = d.euler_characteristic
         split = bool(job.get("split_large_turns"))
         if job["sing_file"] is not None:
@@ -163,6 +170,9 @@ def solve_mesh(job):
         if job["connection"]:
             outputs.append(base + ".connection.txt")
             r.write_connection(outputs[-1])
+            if d.repair is not None and not split:  # its edges are the repaired mesh's vertex pairs: that mesh beside it
+                outputs.append(base + ".mesh.obj")
+                r.write_mesh(outputs[-1])
         if job["png"]:
             outputs.append(base + ".png")
             trivcon.write_png(outputs[-1], r.render(size=(800, 600)))
@@ -279,13 +289,14 @@ def _failed_row(job, message):
 
 def run(meshes, out, N=4, sing_dir=None, auto_cancel=0.0, align_boundary=False, weights="cotan", field_format="txt",
         connection=False, png=False, scheduler=None, workers=None, threads_per_worker=1, progress=True, stream=None, timeout=30,
-        split_large_turns=False, threads=None):
+        split_large_turns=False, threads=None, repair=True):
     """Solve every mesh on a Dask cluster and write the outputs into `out`; returns the rows, in mesh order.
 
     meshes: mesh files and folders (all their mesh files). sing_dir: a folder with NAME.sing (or NAME.sings)
     per mesh; None: automatic singularities (auto_cancel: their cancel distance in mean edge lengths).
     split_large_turns: refine each mesh where the connection turns by pi/N or more (FieldDesigner.solve's
     split_large_turns) and write NAME.mesh.obj and NAME.parent_face.txt beside the field.
+    repair: repair meshes that are not manifold (FieldDesigner's repair; default True); the row says what was done.
     threads: threads per mesh (None: with a local cluster the cores shared out among its workers, one at
     least; with a scheduler each worker's trivcon default).
     Rows have the keys of COLUMNS (field_exact, large_turn_edges, ...), status one of STATUSES.
@@ -310,7 +321,8 @@ def run(meshes, out, N=4, sing_dir=None, auto_cancel=0.0, align_boundary=False, 
     if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
         raise UsageError(f"--threads must be an integer >= 1, not {threads!r}")
     jobs = _jobs(find_meshes(meshes), out, N, None if sing_dir is None else os.path.abspath(sing_dir), float(auto_cancel),
-                 bool(align_boundary), weights, field_format, bool(connection), bool(png), bool(split_large_turns), threads)
+                 bool(align_boundary), weights, field_format, bool(connection), bool(png), bool(split_large_turns), threads,
+                 bool(repair))
     if not jobs:
         raise UsageError("no meshes given")
 
@@ -385,6 +397,8 @@ def main(argv=None):
     parser.add_argument("--workers", type=int, help="local cluster: worker processes (default: one per core)")
     parser.add_argument("--threads-per-worker", type=int, default=1, help="local cluster: threads per worker (default 1)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--no-repair", action="store_true",
+                        help="refuse meshes that are not manifold instead of repairing them (the row says what repair did)")
     a = parser.parse_args(argv)
     if a.auto_cancel and a.sing_dir:
         parser.error("--auto-cancel applies to automatic singularities, not with --sing-dir")
@@ -398,7 +412,7 @@ def main(argv=None):
         rows = run(a.meshes, a.out, N=a.symmetry, sing_dir=a.sing_dir, auto_cancel=a.auto_cancel, align_boundary=a.align_boundary,
                    weights=a.weights, field_format=a.field_format, connection=a.connection, png=a.png, scheduler=a.scheduler,
                    workers=a.workers, threads_per_worker=a.threads_per_worker, progress=not a.no_progress, timeout=a.timeout,
-                   split_large_turns=a.split_large_turns, threads=a.threads)
+                   split_large_turns=a.split_large_turns, threads=a.threads, repair=not a.no_repair)
     except UsageError as e:
         parser.error(str(e))
     print(format_table(rows))

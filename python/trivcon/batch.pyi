@@ -43,5 +43,6 @@ def run(
     timeout: float = ...,
     split_large_turns: bool = ...,
     threads: Optional[int] = ...,
+    repair: bool = ...,
 ) -> List[Dict[str, Any]]: ...
 def main(argv: Optional[Sequence[str]] = ...) -> int: ...

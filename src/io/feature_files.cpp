@@ -59,7 +59,7 @@ std::vector<int> read_feature_edges(const std::string& path, const Topology& t) 
 }
 
 void write_sharp(const std::string& path, const MatrixX3i& F, const Topology& t, const std::vector<int>& edges,
-                 const std::vector<char>& convex) {
+                 const std::vector<char>& convex, const std::vector<int>& input_face) {
   if (convex.size() != edges.size())
     throw Error("write_sharp: " + std::to_string(convex.size()) + " convexity flags for " + std::to_string(edges.size()) + " edges");
   if (F.rows() != t.num_faces) throw Error("write_sharp: the faces given are not those of the topology");
@@ -74,7 +74,7 @@ void write_sharp(const std::string& path, const MatrixX3i& F, const Topology& t,
       // The edge index in the face as given (a re-oriented face lists its corners in another order).
       int k = 0;
       while (k < 3 && !(std::min(F(f, k), F(f, (k + 1) % 3)) == i && std::max(F(f, k), F(f, (k + 1) % 3)) == j)) ++k;
-      rows.push_back({convex[n] ? 1 : 0, f, k});
+      rows.push_back({convex[n] ? 1 : 0, input_face.empty() ? f : input_face[f], k});
     }
   }
   write_file_atomically(path, [&](std::ostream& out) {

@@ -134,8 +134,15 @@ int field_text_N(const std::string& bytes, const std::string& path) {
 }  // namespace
 
 void write_field_to(std::ostream& out, const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& g,
-                    const Field& field) {
+                    const Field& field, const std::vector<int>& face_of_row) {
   const int nF = static_cast<int>(F.rows());
+  if (!face_of_row.empty() && face_of_row.size() != static_cast<size_t>(nF))
+    throw Error("write_field: " + std::to_string(face_of_row.size()) + " face ids for " + std::to_string(nF) + " faces");
+  // The k-th direction of row f.
+  const auto direction_k = [&](const Geometry& g, const Field& field, int f, int k) -> Eigen::Vector3d {
+    const int face = face_of_row.empty() ? f : face_of_row[f];
+    return face < 0 ? Eigen::Vector3d::Zero() : trivcon::direction_k(g, field, face, k);
+  };
   if (ends_with(path, ".rawfield")) {
     out << std::setprecision(17) << field.N << " " << nF << "\n";
     for (int f = 0; f < nF; ++f) {
@@ -180,8 +187,9 @@ void write_field_to(std::ostream& out, const std::string& path, const MatrixX3d&
   }
 }
 
-void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& g, const Field& field) {
-  write_file_atomically(path, [&](std::ostream& out) { write_field_to(out, path, V, F, g, field); });
+void write_field(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Geometry& g, const Field& field,
+                 const std::vector<int>& face_of_row) {
+  write_file_atomically(path, [&](std::ostream& out) { write_field_to(out, path, V, F, g, field, face_of_row); });
 }
 
 MatrixX3d read_field(const std::string& path, int num_faces, int* N_in_file) {

@@ -1,5 +1,6 @@
 // trivcon/constraints.h: the text of fixed directions: --fix specs and files of 'FACE x y z' / 'FACE angle=A'.
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -15,9 +16,18 @@ namespace trivcon {
 
 namespace {
 
-int parse_face(const std::string& text, const Topology& t, const std::string& where) {
+int parse_face(const std::string& text, const Topology& t, const std::string& where, const FaceIdMap& face_id) {
   long long f = 0;
   if (!io::parse_integer(text, f)) throw Error(where + ": malformed face id '" + text + "'");
+  if (face_id) {
+    if (f < std::numeric_limits<int>::min() || f > std::numeric_limits<int>::max())
+      throw Error(where + ": face " + text + " out of range");
+    try {
+      return face_id(static_cast<int>(f));
+    } catch (const Error& e) {
+      throw Error(where + ": " + e.what());
+    }
+  }
   if (f < 0 || f >= t.num_faces)
     throw Error(where + ": face " + text + " out of range (mesh has " + std::to_string(t.num_faces) + " faces)");
   return static_cast<int>(f);
@@ -48,12 +58,13 @@ void insert_fixed(std::map<int, double>& fixed, int face, double angle, const st
 
 }  // namespace
 
-void read_fixed_directions(const std::string& path, const Topology& t, const Geometry& g, std::map<int, double>& fixed) {
-  io::read_fixed_directions_from(read_file_bytes(path), path, t, g, fixed);
+void read_fixed_directions(const std::string& path, const Topology& t, const Geometry& g, std::map<int, double>& fixed,
+                           const FaceIdMap& face_id) {
+  io::read_fixed_directions_from(read_file_bytes(path), path, t, g, fixed, face_id);
 }
 
 void io::read_fixed_directions_from(const std::string& bytes, const std::string& path, const Topology& t, const Geometry& g,
-                                        std::map<int, double>& fixed) {
+                                        std::map<int, double>& fixed, const FaceIdMap& face_id) {
   std::istringstream in(bytes);
   std::string line;
   for (int line_no = 1; std::getline(in, line); ++line_no) {
@@ -62,16 +73,17 @@ void io::read_fixed_directions_from(const std::string& bytes, const std::string&
     std::vector<std::string> tokens;
     for (std::string tok; fields >> tok;) tokens.push_back(tok);
     if (tokens.empty()) continue;
-    const int face = parse_face(tokens[0], t, where);
+    const int face = parse_face(tokens[0], t, where, face_id);
     insert_fixed(fixed, face, parse_direction({tokens.begin() + 1, tokens.end()}, face, g, where), where);
   }
 }
 
-void add_fixed_direction(const std::string& spec, const Topology& t, const Geometry& g, std::map<int, double>& fixed) {
+void add_fixed_direction(const std::string& spec, const Topology& t, const Geometry& g, std::map<int, double>& fixed,
+                         const FaceIdMap& face_id) {
   const std::string where = "--fix " + spec;
   const size_t colon = spec.find(':');
   if (colon == std::string::npos) throw Error(where + ": expected F:x,y,z or F:angle=A");
-  const int face = parse_face(spec.substr(0, colon), t, where);
+  const int face = parse_face(spec.substr(0, colon), t, where, face_id);
   std::vector<std::string> tokens;
   std::istringstream rest(spec.substr(colon + 1));
   for (std::string tok; std::getline(rest, tok, ',');) tokens.push_back(tok);

@@ -18,11 +18,16 @@ std::string non_finite_message(long long vertex, double value) {
          ")";
 }
 
-std::string polygon_problem(const std::vector<int>& corners, long long face) {
+std::string polygon_problem(const std::vector<int>& corners, long long face, bool allow_repeated) {
   const std::size_t k = corners.size();
   if (k < 3) {
     return "face " + std::to_string(face) + " has " + std::to_string(k) + " corner" + (k == 1 ? "" : "s") + " (at least 3 needed)";
   }
+  return allow_repeated ? std::string() : repeated_vertex_problem(corners, face);
+}
+
+std::string repeated_vertex_problem(const std::vector<int>& corners, long long face) {
+  const std::size_t k = corners.size();
   bool repeated = false;
   if (k <= 16) {  // the common case: no allocation
     for (std::size_t i = 1; i < k && !repeated; ++i) {

@@ -121,7 +121,8 @@ struct Collector {
     }
     auto add = [&](long long a, long long b, long long c) {
       const std::vector<int> corners{base + static_cast<int>(a), base + static_cast<int>(b), base + static_cast<int>(c)};
-      if (const std::string problem = faces.problem(corners); !problem.empty()) fail(name, where + ": " + problem);
+      const auto failure = [&](const std::string& p) { fail(name, where + ": " + p); };
+      if (const std::string problem = faces.problem(corners, failure); !problem.empty()) failure(problem);
       faces.add(corners);
     };
     if (mode == TINYGLTF_MODE_TRIANGLES) {

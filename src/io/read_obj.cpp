@@ -67,7 +67,7 @@ MeshData read_obj(const std::string& buffer, const std::string& name) {
         }
         corners.push_back(static_cast<int>(id));
       }
-      const std::string problem = faces.problem(corners);
+      const std::string problem = faces.problem(corners, [&](const std::string& p) { in.fail(p); });
       if (!problem.empty()) in.fail(problem);
       faces.add(corners);
     }

@@ -95,7 +95,7 @@ MeshData read_off(const std::string& buffer, const std::string& name) {
       corners.push_back(static_cast<int>(index));
     }
     // A face colour may follow; it is not ours.
-    const std::string problem = faces.problem(corners);
+    const std::string problem = faces.problem(corners, [&](const std::string& p) { in.fail(p); });
     if (!problem.empty()) in.fail(problem);
     faces.add(corners);
   }

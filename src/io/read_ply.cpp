@@ -297,7 +297,7 @@ void read_ply_body(Source& source, const std::vector<PlyElement>& elements, cons
             }
             corners.push_back(static_cast<int>(index));
           }
-          const std::string problem = faces.problem(corners);
+          const std::string problem = faces.problem(corners, [&](const std::string& p) { source.fail(p); });
           if (!problem.empty()) source.fail(problem);
           faces.add(corners);
         } else {

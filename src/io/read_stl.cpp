@@ -65,8 +65,11 @@ void add_triangle(FaceCollector& faces, Welder& welder, const std::array<std::ar
       if (!std::isfinite(c)) fail(where, "triangle " + std::to_string(triangle) + " has a coordinate that is not finite");
     ids[k] = welder.add(corner[k]);
   }
-  if (ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2])
+  // Two corners at one position (common in STL exports) make a face with a repeated vertex: kept, like every
+  // reader's, for repair to drop; the first is named for a front end that does not repair.
+  faces.problem(ids, [&](const std::string&) {
     fail(where, "triangle " + std::to_string(triangle) + " has two corners at the same position (a degenerate triangle)");
+  });
   faces.add(ids);
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "trivcon/common.h"
+#include "trivcon/constraints.h"
 #include "trivcon/geometry.h"
 #include "trivcon/indices.h"
 #include "trivcon/topology.h"
@@ -17,7 +18,7 @@ namespace trivcon::io {
 void read_singularities_from(const std::string& bytes, const std::string& path, IndexPrescription& prescription);
 
 void read_fixed_directions_from(const std::string& bytes, const std::string& path, const Topology& topology, const Geometry& geometry,
-                                std::map<int, double>& fixed);
+                                std::map<int, double>& fixed, const FaceIdMap& face_id = nullptr);
 
 MatrixX3d read_field_from(const std::string& bytes, const std::string& path, int num_faces, int* N_in_file);
 

@@ -41,7 +41,7 @@ void check_writable(const std::string& path, const MatrixX3d& V, const MatrixX3i
                std::to_string(V.rows()) + " vertices)");
       }
     }
-    const std::string problem = polygon_problem(corners, f);
+    const std::string problem = polygon_problem(corners, f, true);  // a repeated vertex reads back (for repair to drop)
     if (!problem.empty()) refuse(problem);
   }
 }

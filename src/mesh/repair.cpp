@@ -6,7 +6,7 @@
 #include <map>
 #include <numeric>
 #include <string>
-#include <unordered_map>
+#include <cstdint>
 
 #include "trivcon/error.h"
 
@@ -19,94 +19,107 @@ int find_root(std::vector<int>& parent, int a) {
   return a;
 }
 
-struct PairHash {
-  std::size_t operator()(const std::pair<int, int>& p) const {
-    return std::hash<long long>()((static_cast<long long>(p.first) << 32) ^ static_cast<unsigned>(p.second));
-  }
-};
-
-struct TripleHash {
-  std::size_t operator()(const std::array<int, 3>& t) const {
-    return std::hash<long long>()((static_cast<long long>(t[0]) * 73856093) ^ (static_cast<long long>(t[1]) * 19349663) ^
-                                  (static_cast<long long>(t[2]) * 83492791));
-  }
-};
-
 }  // namespace
 
 RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F) {
+  // Sorted arrays rather than hash maps: a mesh that needs nothing costs a few sorts of its faces and edges.
   const int nV = static_cast<int>(V.rows()), nF = static_cast<int>(F.rows());
   for (int f = 0; f < nF; ++f) {
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= nV)
         throw Error("vertex index " + std::to_string(F(f, k)) + " out of range in face " + std::to_string(f) + " (mesh has " +
                     std::to_string(nV) + " vertices)");
-    if (F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 0) == F(f, 2))
-      throw Error("face " + std::to_string(f) + " has a repeated vertex (" + std::to_string(F(f, 0)) + ", " + std::to_string(F(f, 1)) +
-                  ", " + std::to_string(F(f, 2)) + ")");
   }
   RepairedMesh out;
+  out.input_vertices = nV, out.input_faces = nF;
   out.face_of_input.assign(nF, -1);
 
-  // Duplicates: the same three vertices in any order.
-  std::unordered_map<std::array<int, 3>, int, TripleHash> first_with;
-  std::vector<int> kept;
+  // Faces with a repeated vertex have no direction: dropped. Duplicates: the same three vertices in any order
+  // (faces sorted by their sorted corners, then by id, so the first in file order is the one kept).
+  std::vector<std::array<int, 4>> by_corners;  // sorted corners, face
+  by_corners.reserve(nF);
   for (int f = 0; f < nF; ++f) {
-    std::array<int, 3> key{F(f, 0), F(f, 1), F(f, 2)};
-    std::sort(key.begin(), key.end());
-    const auto [it, inserted] = first_with.emplace(key, f);
-    if (inserted) {
+    if (F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 0) == F(f, 2)) {
+      out.degenerate_faces.push_back(f);
+      continue;
+    }
+    std::array<int, 4> key{F(f, 0), F(f, 1), F(f, 2), f};
+    std::sort(key.begin(), key.begin() + 3);
+    by_corners.push_back(key);
+  }
+  std::sort(by_corners.begin(), by_corners.end());
+  std::vector<char> duplicate(nF, 0);
+  for (size_t i = 1; i < by_corners.size(); ++i)
+    if (std::equal(by_corners[i].begin(), by_corners[i].begin() + 3, by_corners[i - 1].begin())) {
+      int original = i;
+      while (original > 0 && std::equal(by_corners[original - 1].begin(), by_corners[original - 1].begin() + 3, by_corners[i].begin()))
+        --original;
+      duplicate[by_corners[i][3]] = 1;
+      out.duplicates.emplace_back(by_corners[i][3], by_corners[original][3]);
+    }
+  std::sort(out.duplicates.begin(), out.duplicates.end());
+  std::vector<int> kept;
+  kept.reserve(by_corners.size());
+  for (int f = 0; f < nF; ++f)
+    if (!duplicate[f] && out.face_of_input[f] < 0 &&
+        !(F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 0) == F(f, 2))) {
       out.face_of_input[f] = static_cast<int>(kept.size());
       kept.push_back(f);
-    } else {
-      out.duplicates.emplace_back(f, it->second);
     }
-  }
   for (const auto& [f, original] : out.duplicates) out.face_of_input[f] = out.face_of_input[original];
   const int nK = static_cast<int>(kept.size());
+  if (nK == 0 && nF > 0) {
+    const int f = out.degenerate_faces[0];
+    throw Error("no faces left: every face has a repeated vertex (first: face " + std::to_string(f) + ", (" + std::to_string(F(f, 0)) +
+                ", " + std::to_string(F(f, 1)) + ", " + std::to_string(F(f, 2)) + "))");
+  }
 
-  // The faces (kept, in order) around each edge, with the direction in which each holds it.
+  // The faces (kept, in order) around each edge: (edge key, corner 3q + k holding it as its edge k → k+1), sorted,
+  // so each edge's holders are consecutive and in file order.
   struct Holder {
-    int face;   // index into kept
-    int corner; // the corner k holding i → j or j → i as its edge k → k+1
+    int face;      // index into kept
+    int corner;    // the corner k holding i → j or j → i as its edge k → k+1
     bool forward;  // holds i → j (i < j)
   };
-  std::unordered_map<std::pair<int, int>, std::vector<Holder>, PairHash> holders;
-  holders.reserve(3 * static_cast<size_t>(nK));
-  for (int q = 0; q < nK; ++q) {
-    const int f = kept[q];
-    for (int k = 0; k < 3; ++k) {
-      const int a = F(f, k), b = F(f, (k + 1) % 3);
-      holders[{std::min(a, b), std::max(a, b)}].push_back({q, k, a < b});
-    }
-  }
+  auto edge_key = [](int a, int b) {
+    return static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::min(a, b))) << 32 | static_cast<std::uint32_t>(std::max(a, b));
+  };
+  std::vector<std::pair<std::uint64_t, int>> half_edges(3 * static_cast<size_t>(nK));
+  for (int q = 0; q < nK; ++q)
+    for (int k = 0; k < 3; ++k) half_edges[3 * q + k] = {edge_key(F(kept[q], k), F(kept[q], (k + 1) % 3)), 3 * q + k};
+  std::sort(half_edges.begin(), half_edges.end());
+  auto holder = [&](size_t i) {
+    const int q = half_edges[i].second / 3, k = half_edges[i].second % 3;
+    return Holder{q, k, F(kept[q], k) < F(kept[q], (k + 1) % 3)};
+  };
   // Corners (3 per kept face) joined across paired edges: their groups around a vertex are its fans.
   std::vector<int> parent(3 * static_cast<size_t>(nK));
   std::iota(parent.begin(), parent.end(), 0);
-  auto join = [&](const Holder& x, const Holder& y, int i, int j) {
-    // Corner of face x at vertex v: k if F(x, k) == v.
-    for (int v : {i, j}) {
-      int cx = -1, cy = -1;
-      for (int k = 0; k < 3; ++k) {
-        if (F(kept[x.face], k) == v) cx = 3 * x.face + k;
-        if (F(kept[y.face], k) == v) cy = 3 * y.face + k;
-      }
-      const int rx = find_root(parent, cx), ry = find_root(parent, cy);
+  auto join = [&](const Holder& x, const Holder& y) {
+    // Corner k of x is vertex a and k+1 is b; y holds the same edge, either way round.
+    const int fx = kept[x.face], fy = kept[y.face];
+    for (int end = 0; end < 2; ++end) {
+      const int v = F(fx, (x.corner + end) % 3);
+      const int cy = F(fy, y.corner) == v ? y.corner : (y.corner + 1) % 3;
+      const int rx = find_root(parent, 3 * x.face + (x.corner + end) % 3), ry = find_root(parent, 3 * y.face + cy);
       if (rx != ry) parent[std::max(rx, ry)] = std::min(rx, ry);
     }
   };
-  std::vector<std::pair<std::pair<int, int>, const std::vector<Holder>*>> edges;
-  edges.reserve(holders.size());
-  for (const auto& [edge, list] : holders) edges.emplace_back(edge, &list);
-  std::sort(edges.begin(), edges.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (const auto& [edge, list_ptr] : edges) {
-    const std::vector<Holder>& list = *list_ptr;
-    if (list.size() == 2) {
-      join(list[0], list[1], edge.first, edge.second);
+  std::vector<std::pair<size_t, size_t>> cut_ranges;  // [begin, end) in half_edges of each cut edge
+  std::vector<Holder> list;
+  for (size_t begin = 0, end = 0; begin < half_edges.size(); begin = end) {
+    end = begin + 1;
+    while (end < half_edges.size() && half_edges[end].first == half_edges[begin].first) ++end;
+    if (end - begin == 1) continue;
+    if (end - begin == 2) {
+      join(holder(begin), holder(begin + 1));
       continue;
     }
-    if (list.size() < 2) continue;
-    out.cut_edges.push_back(edge);
+    const std::uint64_t key = half_edges[begin].first;
+    out.cut_edges.emplace_back(static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffu));
+    cut_ranges.emplace_back(begin, end);
+    list.clear();
+    for (size_t i = begin; i < end; ++i) list.push_back(holder(i));
     // Pairs: consistently oriented ones first (a forward holder with a backward one), in file order.
     std::vector<char> used(list.size(), 0);
     for (size_t a = 0; a < list.size(); ++a) {
@@ -114,7 +127,7 @@ RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F) {
       for (size_t b = a + 1; b < list.size(); ++b)
         if (!used[b] && list[a].forward != list[b].forward) {
           used[a] = used[b] = 1;
-          join(list[a], list[b], edge.first, edge.second);
+          join(list[a], list[b]);
           break;
         }
     }
@@ -123,7 +136,7 @@ RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F) {
       for (size_t b = a + 1; b < list.size(); ++b)
         if (!used[b]) {
           used[a] = used[b] = 1;
-          join(list[a], list[b], edge.first, edge.second);
+          join(list[a], list[b]);
           break;
         }
       if (!used[a]) out.unpaired_faces.push_back(kept[list[a].face]);
@@ -162,16 +175,38 @@ RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F) {
     if (fans[v] > 1) out.split_vertices.emplace_back(v, fans[v]);
   out.input_face = kept;
 
-  // What splitting cannot separate (sheets that meet again elsewhere around both ends) stays refused.
-  std::unordered_map<std::pair<int, int>, int, PairHash> count;
-  for (int q = 0; q < nK; ++q)
-    for (int k = 0; k < 3; ++k) {
-      const int a = out.F(q, k), b = out.F(q, (k + 1) % 3);
-      if (++count[{std::min(a, b), std::max(a, b)}] == 3)
-        throw Error("repair: the edge (" + std::to_string(out.vertex_origin[std::min(a, b)]) + ", " +
-                    std::to_string(out.vertex_origin[std::max(a, b)]) +
-                    ") has more than two faces whose sheets meet again around both its ends, which cutting it cannot separate");
+  // What splitting cannot separate (sheets that meet again elsewhere around both ends) stays refused: only the
+  // faces of cut edges can still share an edge with more than two of them.
+  for (const auto& [begin, end] : cut_ranges) {
+    std::vector<std::uint64_t> copies;
+    for (size_t i = begin; i < end; ++i) {
+      const Holder h = holder(i);
+      copies.push_back(edge_key(out.F(h.face, h.corner), out.F(h.face, (h.corner + 1) % 3)));
     }
+    std::sort(copies.begin(), copies.end());
+    for (size_t i = 2; i < copies.size(); ++i)
+      if (copies[i] == copies[i - 2]) {
+        const int a = static_cast<int>(copies[i] >> 32), b = static_cast<int>(copies[i] & 0xffffffffu);
+        throw Error("repair: the edge (" + std::to_string(out.vertex_origin[a]) + ", " + std::to_string(out.vertex_origin[b]) +
+                    ") has more than two faces whose sheets meet again around both its ends, which cutting it cannot separate");
+      }
+  }
+  // A degenerate face reads the field of a face sharing its edge, else one sharing a vertex (none: −1).
+  if (!out.degenerate_faces.empty()) {
+    std::vector<int> face_at(nV, -1);  // a kept face at each input vertex
+    for (int q = nK - 1; q >= 0; --q)
+      for (int k = 0; k < 3; ++k) face_at[F(kept[q], k)] = q;
+    for (int f : out.degenerate_faces) {
+      const int a = F(f, 0), b = F(f, 0) == F(f, 1) ? F(f, 2) : F(f, 1);
+      int q = -1;
+      if (a != b) {
+        const auto it = std::lower_bound(half_edges.begin(), half_edges.end(), std::make_pair(edge_key(a, b), -1));
+        if (it != half_edges.end() && it->first == edge_key(a, b)) q = it->second / 3;
+      }
+      for (int k = 0; k < 3 && q < 0; ++k) q = face_at[F(f, k)];
+      out.face_of_input[f] = q;
+    }
+  }
   return out;
 }
 
@@ -179,6 +214,11 @@ std::string repair_summary(const RepairedMesh& r) {
   if (!r.changed()) return "";
   std::string s = "repaired:";
   std::string sep = " ";
+  if (!r.degenerate_faces.empty()) {
+    s += sep + std::to_string(r.degenerate_faces.size()) + " face" + (r.degenerate_faces.size() > 1 ? "s" : "") +
+         " with a repeated vertex dropped (first: face " + std::to_string(r.degenerate_faces[0]) + ")";
+    sep = "; ";
+  }
   if (!r.duplicates.empty()) {
     s += sep + std::to_string(r.duplicates.size()) + " duplicate face" + (r.duplicates.size() > 1 ? "s" : "") + " dropped (first: face " +
          std::to_string(r.duplicates[0].first) + ", a copy of face " + std::to_string(r.duplicates[0].second) + ")";
@@ -206,6 +246,78 @@ std::vector<int> fan_faces(const RepairedMesh& r, int input_vertex) {
     }
   if (first_face.size() < 2) return out;
   for (const auto& [v, f] : first_face) out.push_back(f);
+  return out;
+}
+
+int repaired_vertex(const RepairedMesh& r, int v, const std::string& what) {
+  if (v < 0 || v >= r.input_vertices)
+    throw Error(what + " " + std::to_string(v) + " out of range (mesh has " + std::to_string(r.input_vertices) + " vertices)");
+  const auto split = std::lower_bound(r.split_vertices.begin(), r.split_vertices.end(), std::make_pair(v, 0));
+  if (split != r.split_vertices.end() && split->first == v) {
+    const std::vector<int> fans = fan_faces(r, v);
+    std::string faces;
+    for (size_t k = 0; k < fans.size(); ++k) faces += (k ? ", " : "") + std::to_string(fans[k]);
+    throw Error(what + " " + std::to_string(v) + " is where " + std::to_string(fans.size()) +
+                " sheets of the mesh touch (repair split it into one vertex per fan; first faces of the fans: " + faces +
+                "): which one is meant cannot be told; place it on the repaired mesh (--mesh-out), where each fan has its own vertex");
+  }
+  return v;
+}
+
+int repaired_face(const RepairedMesh& r, int f, const std::string& what) {
+  if (f < 0 || f >= r.input_faces)
+    throw Error(what + " " + std::to_string(f) + " out of range (mesh has " + std::to_string(r.input_faces) + " faces)");
+  if (std::binary_search(r.degenerate_faces.begin(), r.degenerate_faces.end(), f))
+    throw Error(what + " " + std::to_string(f) + " has a repeated vertex and has no direction (repair dropped it)");
+  return r.face_of_input[f];
+}
+
+MatrixX3d rows_on_repaired(const RepairedMesh& r, const MatrixX3d& input_rows) {
+  if (input_rows.rows() != r.input_faces)
+    throw Error("rows_on_repaired: " + std::to_string(input_rows.rows()) + " rows for " + std::to_string(r.input_faces) + " input faces");
+  MatrixX3d out(r.input_face.size(), 3);
+  for (size_t q = 0; q < r.input_face.size(); ++q) out.row(static_cast<Eigen::Index>(q)) = input_rows.row(r.input_face[q]);
+  return out;
+}
+
+Eigen::MatrixXd corner_rows_on_input(const RepairedMesh& r, const MatrixX3i& input_F, const Eigen::MatrixXd& rows) {
+  if (rows.rows() != r.F.rows() || rows.cols() % 3 != 0 || input_F.rows() != r.input_faces)
+    throw Error("corner_rows_on_input: " + std::to_string(rows.rows()) + " x " + std::to_string(rows.cols()) + " rows for " +
+                std::to_string(r.F.rows()) + " faces (3 corners each) and " + std::to_string(input_F.rows()) + " input faces");
+  const Eigen::Index w = rows.cols() / 3;
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(input_F.rows(), rows.cols());
+  for (Eigen::Index f = 0; f < input_F.rows(); ++f) {
+    const int q = r.face_of_input[f];
+    if (q < 0) continue;
+    int first = -1;
+    for (int k = 0; k < 3; ++k) {
+      int j = 0;
+      while (j < 3 && r.vertex_origin[r.F(q, j)] != input_F(f, k)) ++j;
+      if (j == 3) j = first >= 0 ? first : 0;
+      if (first < 0) first = j;
+      out.block(f, k * w, 1, w) = rows.block(q, j * w, 1, w);
+    }
+  }
+  return out;
+}
+
+Eigen::MatrixXd corner_rows_on_repaired(const RepairedMesh& r, const MatrixX3i& input_F, const Eigen::MatrixXd& input_rows) {
+  if (input_rows.rows() != r.input_faces || input_rows.cols() % 3 != 0 || input_F.rows() != r.input_faces)
+    throw Error("corner_rows_on_repaired: " + std::to_string(input_rows.rows()) + " x " + std::to_string(input_rows.cols()) +
+                " rows for " + std::to_string(r.input_faces) + " input faces (3 corners each)");
+  const Eigen::Index w = input_rows.cols() / 3;
+  Eigen::MatrixXd out(r.F.rows(), input_rows.cols());
+  for (Eigen::Index q = 0; q < r.F.rows(); ++q) {
+    const int f = r.input_face[q];  // same corners in the same order (copies at the same positions)
+    for (int k = 0; k < 3; ++k) out.block(q, k * w, 1, w) = input_rows.block(f, k * w, 1, w);
+  }
+  return out;
+}
+
+std::vector<int> vertex_copies(const RepairedMesh& r, int v) {
+  std::vector<int> out{v};
+  for (size_t u = r.input_vertices; u < r.vertex_origin.size(); ++u)
+    if (r.vertex_origin[u] == v) out.push_back(static_cast<int>(u));
   return out;
 }
 

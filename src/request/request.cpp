@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 
 #include "trivcon/error.h"
@@ -87,6 +88,26 @@ AutoResult request_auto(const FieldDesigner& designer, const FieldRequest& reque
   o.N = request.prescription.N;
   o.fixed = constraints.fixed;
   return auto_singularities(designer, o);
+}
+
+void move_request_to_repaired(FieldRequest& r, const Topology& t, const RepairedMesh& repaired) {
+  std::map<int, int> vertex;
+  for (const auto& [v, n] : r.prescription.vertex) vertex[repaired_vertex(repaired, v, "singular vertex")] = n;
+  r.prescription.vertex = std::move(vertex);
+  for (auto& [f, angle] : r.roots) f = repaired_face(repaired, f, "root face");
+  std::vector<int> edges;
+  for (int e : r.feature_edges) {  // given as the repaired topology's edge between the input ids' vertices
+    if (e < 0 || e >= t.num_edges) {
+      edges.push_back(e);  // request_sharp_edges names it
+      continue;
+    }
+    for (int a : vertex_copies(repaired, repaired.vertex_origin[t.edge_vertices(e, 0)]))
+      for (int b : vertex_copies(repaired, repaired.vertex_origin[t.edge_vertices(e, 1)]))
+        if (const int copy = edge_between(t, a, b); copy >= 0) edges.push_back(copy);
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  r.feature_edges = std::move(edges);
 }
 
 FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const FieldRequest& request) {

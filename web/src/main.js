@@ -1021,7 +1021,8 @@ async function start() {
   const phases = { mesh_fetched: (performance.now() - tLoadStart) / 1000 };
   const info = mesh.info;
   $('meshinfo').textContent = `${info.file}: ${info.vertices} vertices, ${info.faces} faces, χ ${info.euler_characteristic}, ` +
-    `${info.components.length} component(s), ${info.cycles.generators.length} generator(s), ${info.cycles.loops.length} boundary loop(s)`;
+    `${info.components.length} component(s), ${info.cycles.generators.length} generator(s), ${info.cycles.loops.length} boundary loop(s)` +
+    (info.repair ? ` (${info.repair})` : '');
   const state = await statePromise;
   buildMesh();
   buildCycleList();
