@@ -21,11 +21,11 @@ struct CheckOptions {
   PrescriptionOptions prescription;
   std::string matching;  // --matching
   bool json = false;
-  bool no_repair = false;
+  MeshOptions mesh_options;  // --no-repair, --weld
 };
 
 void run_check(CheckOptions& o) {
-  const LoadedMesh loaded = load_mesh(o.mesh, !o.no_repair, o.json);
+  const LoadedMesh loaded = load_mesh(o.mesh, o.mesh_options, o.json);
   const MeshData& mesh = loaded.mesh;
   const RepairedMesh* repair = loaded.repaired();
   if (repair && !o.matching.empty())
@@ -100,7 +100,7 @@ void register_check(CLI::App& app) {
                     "Matching file (.matching, as solve --matching-out writes): pair the faces' directions as it says instead of by the "
                     "closest direction");
   check->add_flag("--json", c.json, "Print JSON");
-  add_repair_flag(check, c.no_repair);
+  add_mesh_options(check, c.mesh_options);
   check->callback([] { run_check(c); });
 }
 

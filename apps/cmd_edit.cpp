@@ -27,7 +27,7 @@ struct EditOptions {
   PrescriptionOptions prescription;
   std::vector<std::string> fixes;
   bool align_boundary = false;
-  bool no_repair = false;
+  MeshOptions mesh_options;  // --no-repair, --weld
   std::optional<double> feature_degrees;  // --align-features
   std::string host = "127.0.0.1";
   int port = 8642;
@@ -58,7 +58,7 @@ void run_edit(const EditOptions& o) {
   sigaction(SIGTERM, &action, nullptr);
 
   const auto t0 = Clock::now();
-  LoadedMesh loaded = load_mesh(o.mesh, !o.no_repair, false);
+  LoadedMesh loaded = load_mesh(o.mesh, o.mesh_options, false);
   MeshData mesh = std::move(loaded.mesh);
   server::EditorOptions options;
   if (loaded.repair) {
@@ -146,7 +146,7 @@ void register_edit(CLI::App& app) {
                   "Fixed direction at start: F:x,y,z (world, projected to the face), F:angle=A (radians, face frame), or a file with "
                   "'FACE x y z' / 'FACE angle=A' lines; repeatable");
   cmd->add_flag("--align-boundary", o.align_boundary, "Start with every boundary face fixed to its boundary edge's direction");
-  add_repair_flag(cmd, o.no_repair);
+  add_mesh_options(cmd, o.mesh_options);
   cmd->add_option("--align-features", o.feature_degrees,
                   "Start with the faces beside every sharp edge (dihedral angle above DEG degrees) fixed to its direction")
       ->check(CLI::Range(0.0, 180.0));

@@ -12,13 +12,14 @@ namespace trivcon::cli {
 void register_info(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Read and validate a mesh; print its size and topology per component");
   static std::string path;
-  static bool json = false, with_cycles = false, no_repair = false;
+  static bool json = false, with_cycles = false;
+  static MeshOptions mesh_options;
   cmd->add_option("mesh", path, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
   cmd->add_flag("--json", json, "Print JSON (format documented in README.md)");
   cmd->add_flag("--cycles", with_cycles, "Also list the generators and boundary loops whose index solve can set");
-  add_repair_flag(cmd, no_repair);
+  add_mesh_options(cmd, mesh_options);
   cmd->callback([&] {
-    const LoadedMesh loaded = load_mesh(path, !no_repair, true);  // the summary says what repair did
+    const LoadedMesh loaded = load_mesh(path, mesh_options, true);  // the summary says what repair did
     const MeshData& mesh = loaded.mesh;
     check_finite(mesh.V);
     const Topology t = build_topology(mesh.F, static_cast<int>(mesh.V.rows()));

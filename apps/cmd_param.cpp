@@ -25,7 +25,7 @@ struct ParamCommand {
   FieldOptions field;
   double target_faces = 0, edge_length = 0;
   bool quiet = false;
-  bool no_repair = false;
+  MeshOptions mesh_options;  // --no-repair, --weld
 };
 
 std::string fmt(double v) {
@@ -36,7 +36,7 @@ std::string fmt(double v) {
 
 void run_param(const ParamCommand& o) {
   const auto t0 = Clock::now();
-  const LoadedMesh loaded = load_mesh(o.mesh, !o.no_repair, o.quiet);
+  const LoadedMesh loaded = load_mesh(o.mesh, o.mesh_options, o.quiet);
   const MeshData& mesh = loaded.mesh;
   const RepairedMesh* repair = loaded.repaired();
   const double read_seconds = seconds_since(t0);
@@ -131,7 +131,7 @@ void register_param(CLI::App& app) {
   cmd->add_option("--sing-out", o.sing_out, "Singularity file of the singularities used ('VERTEX INDEX' lines, readable by -s)");
   cmd->add_option("--report", o.report, "JSON report: the field, the map's integers and quality, time per stage");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");
-  add_repair_flag(cmd, o.no_repair);
+  add_mesh_options(cmd, o.mesh_options);
   cmd->callback([target, length] {
     if (target->count() == 0 && length->count() == 0)
       throw CLI::ValidationError("--target-faces / --edge-length", "give the scale of the map: one of them");

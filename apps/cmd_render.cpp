@@ -20,7 +20,8 @@ struct RenderCommand {
   int N = 0;  // 0: the field file's
   std::vector<std::string> sing_files, sings;
   double spacing = 11;
-  bool flat = false, no_legend = false, no_repair = false;
+  bool flat = false, no_legend = false;
+  MeshOptions mesh_options;  // --no-repair, --weld
   FeatureOptions features;  // sharp edges to draw
 };
 
@@ -55,7 +56,7 @@ void parse_view(const std::string& text, RenderOptions& o) {
 }
 
 void run_render(const RenderCommand& c) {
-  const LoadedMesh loaded = load_mesh(c.mesh, !c.no_repair, false);
+  const LoadedMesh loaded = load_mesh(c.mesh, c.mesh_options, false);
   const MeshData& mesh = loaded.mesh;
   const RepairedMesh* repair = loaded.repaired();
   check_finite(mesh.V);
@@ -141,7 +142,7 @@ void register_render(CLI::App& app) {
   cmd->add_option("--streamlines-out", c.streamlines_out, "Also write the streamlines as OBJ polylines");
   cmd->add_flag("--flat", c.flat, "Flat shading (one normal per face)");
   cmd->add_flag("--no-legend", c.no_legend, "Leave out the legend");
-  add_repair_flag(cmd, c.no_repair);
+  add_mesh_options(cmd, c.mesh_options);
   c.features.add_to(cmd, "drawn as lines");
   cmd->callback([field, uv] {
     if (field->count() == 0 && uv->count() == 0) throw CLI::RequiredError("--field or --uv");

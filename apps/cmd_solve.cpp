@@ -35,7 +35,7 @@ struct SolveOptions {
   std::string sing_batch;
   OutputPaths out;
   bool quiet = false;
-  bool no_repair = false;                // --no-repair
+  MeshOptions mesh_options;              // --no-repair, --weld
   double tolerance = kDefaultTolerance;  // --tolerance
 };
 
@@ -158,7 +158,7 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, const FieldDesigner&
 
 void run_solve(const SolveOptions& o) {
   auto t0 = Clock::now();
-  const LoadedMesh loaded = load_mesh(o.mesh, !o.no_repair, o.quiet);
+  const LoadedMesh loaded = load_mesh(o.mesh, o.mesh_options, o.quiet);
   const MeshData& mesh = loaded.mesh;
   const RepairedMesh* repair = loaded.repaired();
   if (repair && o.out.mesh.empty() && (!o.out.connection.empty() || !o.out.matching.empty()))
@@ -306,7 +306,7 @@ void register_solve(CLI::App& app) {
   cmd->add_option("--png", o.out.png, "Picture of the field (as `trivcon render` with its defaults)");
   cmd->add_option("--report", o.out.report, "JSON report: sizes, topology, indices used, energy, residuals, timings");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");
-  add_repair_flag(cmd, o.no_repair);
+  add_mesh_options(cmd, o.mesh_options);
   cmd->add_option("--tolerance", o.tolerance,
                   "Verification limit on the holonomy residuals, transport and fixed faces, relative to max(1, right-hand sides) "
                   "(default 1e-9); a solve that misses it exits 3 and says why")

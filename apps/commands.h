@@ -43,13 +43,17 @@ struct LoadedMesh {
   const MeshData& as_read() const { return repair ? input : mesh; }
 };
 
-// Reads `path`; with `repair`, repairs it when it needs it and warns on stderr (unless `quiet`) with
-// repair_summary. Without, a face with a repeated vertex is the reader's error (what the topology refuses is
-// refused later, with its message).
-LoadedMesh load_mesh(const std::string& path, bool repair, bool quiet);
+// How a command reads its mesh: --no-repair, --weld TOL (STL).
+struct MeshOptions {
+  bool no_repair = false;
+  double weld = 0;
+};
+void add_mesh_options(CLI::App* cmd, MeshOptions& options);
 
-// Adds --no-repair to `cmd`.
-void add_repair_flag(CLI::App* cmd, bool& no_repair);
+// Reads `path` (STL corners welded within options.weld); unless options.no_repair, repairs it when it needs it
+// and warns on stderr (unless `quiet`) with repair_summary. With no_repair, a face with a repeated vertex is the
+// reader's error (what the topology refuses is refused later, with its message).
+LoadedMesh load_mesh(const std::string& path, const MeshOptions& options, bool quiet);
 
 // Per-face rows of the input (a field file) as rows of the mesh worked on.
 MatrixX3d rows_on_mesh(const LoadedMesh& mesh, const MatrixX3d& input_rows);

@@ -13,10 +13,10 @@ namespace trivcon::cli {
 int exit_code = 0;
 MeshData load_mesh(const std::string& path) { return read_mesh(path); }
 
-LoadedMesh load_mesh(const std::string& path, bool repair, bool quiet) {
+LoadedMesh load_mesh(const std::string& path, const MeshOptions& options, bool quiet) {
   LoadedMesh out;
-  out.mesh = read_mesh(path);
-  if (!repair) {
+  out.mesh = read_mesh(path, options.weld);
+  if (options.no_repair) {
     if (!out.mesh.repeated_vertex.empty()) throw Error(out.mesh.repeated_vertex);
     return out;
   }
@@ -34,8 +34,11 @@ LoadedMesh load_mesh(const std::string& path, bool repair, bool quiet) {
   return out;
 }
 
-void add_repair_flag(CLI::App* cmd, bool& no_repair) {
-  cmd->add_flag("--no-repair", no_repair,
+void add_mesh_options(CLI::App* cmd, MeshOptions& options) {
+  cmd->add_option("--weld", options.weld,
+                  "STL: join corners closer than this distance (in the mesh's units) into one vertex; default 0, exact position")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--no-repair", options.no_repair,
                 "Refuse a mesh that is not manifold (faces with a repeated vertex, duplicate faces, edges with more than two faces, "
                 "vertices where sheets touch) instead of repairing it");
 }

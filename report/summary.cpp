@@ -83,6 +83,7 @@ nlohmann::ordered_json repair_summary_json(const RepairedMesh& r) {
           {"duplicate_faces", duplicates},
           {"cut_edges", cut},
           {"unpaired_faces", r.unpaired_faces},
+          {"unseparated_faces", r.unseparated_faces},
           {"split_vertices", split},
           {"appended_vertices", copies}};
 }

@@ -103,4 +103,21 @@ TEST(Stl, Errors) {
 }
 
 }  // namespace
+// --weld: corners within the tolerance of an earlier vertex join it; the earliest wins and keeps its position.
+TEST(Stl, WeldsWithinATolerance) {
+  const std::string text =
+      "solid t\n"
+      "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+      "facet normal 0 0 1\nouter loop\nvertex 1.0000001 0 0\nvertex 1 1 0\nvertex 0 1.0000002 0\nendloop\nendfacet\n"
+      "endsolid t\n";
+  EXPECT_EQ(read_stl(text, "t.stl").V.rows(), 6);
+  const MeshData m = read_stl(text, "t.stl", 1e-6);
+  ASSERT_EQ(m.V.rows(), 4);
+  EXPECT_EQ(m.F(1, 0), 1);
+  EXPECT_EQ(m.F(1, 2), 2);
+  EXPECT_EQ(m.V(1, 0), 1.0);  // the first corner's position
+  EXPECT_EQ(read_stl(text, "t.stl", 1e-8).V.rows(), 6);
+  EXPECT_EQ(error_of([&] { read_stl(text, "t.stl", -1); }), "t.stl: the weld tolerance must be a finite number >= 0, not -1.000000");
+}
+
 }  // namespace trivcon

@@ -39,15 +39,18 @@ struct MeshData : Mesh {
 };
 
 // Reads by extension: .obj .off .ply .stl .gltf .glb, each optionally followed by .gz (case-insensitive).
-MeshData read_mesh(const std::string& path);
+// weld_tolerance: for STL, see read_stl; another format with a tolerance other than 0 is an error.
+MeshData read_mesh(const std::string& path, double weld_tolerance = 0);
 
 // Format-specific readers on an in-memory buffer (already decompressed); `name` is used in messages.
 MeshData read_obj(const std::string& buffer, const std::string& name);
 MeshData read_off(const std::string& buffer, const std::string& name);
 MeshData read_ply(const std::string& buffer, const std::string& name);
 // STL, ASCII or binary (binary when the size matches its header's triangle count): corners welded into vertices
-// by exact position, numbered in order of first appearance; format "stl-ascii" or "stl-binary".
-MeshData read_stl(const std::string& buffer, const std::string& name);
+// by exact position, numbered in order of first appearance; format "stl-ascii" or "stl-binary". With
+// weld_tolerance > 0, a corner within that distance of a vertex made before joins it (the earliest such vertex;
+// a vertex keeps the position of its first corner): for exports that store shared corners slightly apart.
+MeshData read_stl(const std::string& buffer, const std::string& name, double weld_tolerance = 0);
 // glTF 2.0, .gltf (`name`'s folder resolves external buffers) or .glb (by its magic): every triangle primitive of
 // the default scene's nodes, transforms applied, each its own block of vertices; format "gltf" or "glb".
 MeshData read_gltf(const std::string& buffer, const std::string& name);

@@ -10,7 +10,10 @@
 //   the edge as a boundary edge;
 // - then every vertex whose faces form several fans (connected across the paired edges) is split: the fan
 //   holding the vertex's first corner in file order keeps the vertex's id, each other fan gets a new vertex,
-//   appended after the input's vertices in order of first appearance.
+//   appended after the input's vertices in order of first appearance;
+// - where the sheets of a cut edge meet again around both its ends (so that splitting its vertices cannot
+//   separate them, e.g. two pages joined along two edges), the faces beyond the first two on the edge (in file
+//   order) are dropped and the repair runs again; each maps like a degenerate face, to a face sharing an edge.
 // Faces stay in file order (duplicates left out) with their corners in the input's order; the re-orientation of
 // orientable components is build_topology's (trivcon/topology.h). Indices out of range and non-orientable
 // components are not repaired: build_topology's errors name them.
@@ -27,7 +30,7 @@ struct RepairedMesh {
   MatrixX3d V;                    // the input's vertices (same ids), then the split vertices' copies
   MatrixX3i F;                    // the input's faces in order, duplicates left out
   std::vector<int> face_of_input;  // per input face: its face in F (for a duplicate, the face it duplicates; for a
-                                   // degenerate face, the one above or −1)
+                                   // dropped face, one sharing an edge or a vertex, or −1)
   std::vector<int> input_face;     // per face of F: its input face
   std::vector<int> vertex_origin;  // per vertex of V: the input vertex it copies (itself for ids < input count)
   int input_vertices = 0, input_faces = 0;  // the input's counts
@@ -37,11 +40,13 @@ struct RepairedMesh {
   std::vector<std::pair<int, int>> cut_edges;          // (i, j), i < j: edges that had more than two faces
   std::vector<std::pair<int, int>> split_vertices;     // (vertex, fans): vertices split into that many
   std::vector<int> unpaired_faces;                     // faces left as boundary beside a cut edge
-  bool changed() const { return !degenerate_faces.empty() || !duplicates.empty() || !cut_edges.empty() || !split_vertices.empty(); }
+  std::vector<int> unseparated_faces;                  // dropped where sheets of a cut edge meet again, increasing
+  bool changed() const {
+    return !degenerate_faces.empty() || !duplicates.empty() || !cut_edges.empty() || !split_vertices.empty() || !unseparated_faces.empty();
+  }
 };
 
-// Throws trivcon::Error for an index out of range (as build_topology does), and for sheets that meet again around
-// both ends of a cut edge (which splitting cannot separate), naming the edge.
+// Throws trivcon::Error for an index out of range (as build_topology does) and when no face is left.
 RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F);
 
 // One sentence with the counts and the first ids ("" when nothing was done), e.g. "repaired: 2 duplicate faces

@@ -708,12 +708,13 @@ PYBIND11_MODULE(_core, m) {
   // --- Files.
   m.def(
       "read_mesh",
-      [](const std::string& path) {
-        const MeshData mesh = interruptible(0, [path] { return read_mesh(path); });
+      [](const std::string& path, double weld) {
+        const MeshData mesh = interruptible(0, [path, weld] { return read_mesh(path, weld); });
         return py::make_tuple(double_matrix3(mesh.V), int64_matrix(mesh.F), int64_vector(mesh.polygon_of_triangle), mesh.polygon_count,
                               mesh.format, mesh.repeated_vertex);
       },
-      py::arg("path"), "(V, F, polygon_of_triangle, polygon_count, format, repeated_vertex) of a mesh file (trivcon/io.h).");
+      py::arg("path"), py::arg("weld") = 0.0,
+      "(V, F, polygon_of_triangle, polygon_count, format, repeated_vertex) of a mesh file (trivcon/io.h).");
   m.def(
       "write_mesh",
       [](const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
@@ -880,6 +881,7 @@ PYBIND11_MODULE(_core, m) {
                                d["vertex_origin"] = r.vertex_origin, d["degenerate_faces"] = r.degenerate_faces;
                                d["duplicate_faces"] = r.duplicates, d["cut_edges"] = r.cut_edges;
                                d["split_vertices"] = r.split_vertices, d["unpaired_faces"] = r.unpaired_faces;
+                               d["unseparated_faces"] = r.unseparated_faces;
                                return d;
                              })
       .def("repaired_vertex",

@@ -422,7 +422,7 @@ _atexit.register(_wait_for_abandoned_work)
 # Files
 
 
-def read_mesh(path, info=False):
+def read_mesh(path, info=False, weld=0.0):
     """Read a triangle mesh: OBJ, OFF, PLY (ascii or binary), STL (ascii or binary, corners welded by exact
     position) or glTF 2.0 (.gltf, .glb: the default scene's triangle primitives, transforms applied), each
     optionally gzipped (.obj.gz, ...).
@@ -433,9 +433,11 @@ def read_mesh(path, info=False):
     "ply-binary-le", "ply-binary-be", "stl-ascii", "stl-binary", "gltf", "glb"), "polygon_count" and
     "polygon_of_triangle" (int64 (m,): the file polygon each triangle comes from) and "repeated_vertex" (the first
     polygon with a repeated corner, as a message with the file and line, or ""; such faces are read, and
-    FieldDesigner's repair drops them). Errors (trivcon.Error) name the file and line or byte offset.
+    FieldDesigner's repair drops them). weld: for STL, join corners closer than this distance into one vertex
+    (0, the default: exact position), as the CLI's --weld. Errors (trivcon.Error) name the file and line or
+    byte offset.
     """
-    V, F, polygon_of_triangle, polygon_count, fmt, repeated = _core.read_mesh(str(path))
+    V, F, polygon_of_triangle, polygon_count, fmt, repeated = _core.read_mesh(str(path), float(weld))
     if info:
         return V, F, {"format": fmt, "polygon_count": polygon_count, "polygon_of_triangle": polygon_of_triangle,
                       "repeated_vertex": repeated}
@@ -713,7 +715,8 @@ class FieldDesigner(_Cached):
         here; a duplicate's the face it duplicates; a dropped degenerate face's a neighbour, or -1),
         input_face (per face here its input face), vertex_origin (per vertex here the input vertex it
         copies), degenerate_faces, duplicate_faces ((dropped, original) pairs), cut_edges, split_vertices
-        ((vertex, fans) pairs), unpaired_faces, all in the input's ids."""
+        ((vertex, fans) pairs), unpaired_faces, unseparated_faces (dropped where the sheets of a cut edge meet
+        again), all in the input's ids."""
         return self._d.repair
 
     @property

@@ -49,13 +49,15 @@ std::string read_file_bytes(const std::string& path) {
   return bytes;
 }
 
-MeshData read_mesh(const std::string& path) {
+MeshData read_mesh(const std::string& path, double weld_tolerance) {
   std::string_view stem = path;
   if (ends_with_ignoring_case(stem, ".gz")) stem.remove_suffix(3);
+  if (weld_tolerance != 0 && !ends_with_ignoring_case(stem, ".stl"))
+    throw Error("cannot read '" + path + "' with a weld tolerance: only STL files are welded (their triangles carry their own corners)");
   if (ends_with_ignoring_case(stem, ".obj")) return read_obj(read_file_bytes(path), path);
   if (ends_with_ignoring_case(stem, ".off")) return read_off(read_file_bytes(path), path);
   if (ends_with_ignoring_case(stem, ".ply")) return read_ply(read_file_bytes(path), path);
-  if (ends_with_ignoring_case(stem, ".stl")) return read_stl(read_file_bytes(path), path);
+  if (ends_with_ignoring_case(stem, ".stl")) return read_stl(read_file_bytes(path), path, weld_tolerance);
   if (ends_with_ignoring_case(stem, ".gltf") || ends_with_ignoring_case(stem, ".glb")) return read_gltf(read_file_bytes(path), path);
   throw Error("cannot read '" + path +
               "': unknown mesh format (supported: .obj, .off, .ply, .stl, .gltf, .glb, each optionally followed by .gz)");

@@ -36,11 +36,15 @@ struct PositionHash {
   }
 };
 
+// Corners into vertices: at the same position (tolerance 0), or within `tolerance` of a vertex made before (the
+// first one found in the 27 grid cells of that size around the corner; positions are the first corner's).
 class Welder {
  public:
+  explicit Welder(double tolerance = 0) : tolerance_(tolerance) {}
   int add(const std::array<double, 3>& p) {
     std::array<double, 3> key = p;
     for (double& c : key) c = c == 0 ? 0.0 : c;
+    if (tolerance_ > 0) return add_near(key);
     const auto [it, inserted] = index_.emplace(key, static_cast<int>(points_.size()));
     if (inserted) points_.push_back(key);
     return it->second;
@@ -52,7 +56,35 @@ class Welder {
   }
 
  private:
+  int add_near(const std::array<double, 3>& p) {
+    std::array<std::int64_t, 3> cell;
+    for (int a = 0; a < 3; ++a) cell[a] = static_cast<std::int64_t>(std::floor(p[a] / tolerance_));
+    int found = -1;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells_.find({cell[0] + dx, cell[1] + dy, cell[2] + dz});
+          if (it == cells_.end()) continue;
+          for (int v : it->second) {
+            const double d2 = (points_[v][0] - p[0]) * (points_[v][0] - p[0]) + (points_[v][1] - p[1]) * (points_[v][1] - p[1]) +
+                              (points_[v][2] - p[2]) * (points_[v][2] - p[2]);
+            if (d2 <= tolerance_ * tolerance_ && (found < 0 || v < found)) found = v;
+          }
+        }
+    if (found >= 0) return found;
+    points_.push_back(p);
+    cells_[cell].push_back(static_cast<int>(points_.size()) - 1);
+    return static_cast<int>(points_.size()) - 1;
+  }
+  struct CellHash {
+    std::size_t operator()(const std::array<std::int64_t, 3>& c) const {
+      return std::hash<std::int64_t>()(c[0] * 73856093 ^ c[1] * 19349663 ^ c[2] * 83492791);
+    }
+  };
+
+  double tolerance_ = 0;
   std::unordered_map<std::array<double, 3>, int, PositionHash> index_;
+  std::unordered_map<std::array<std::int64_t, 3>, std::vector<int>, CellHash> cells_;
   std::vector<std::array<double, 3>> points_;
 };
 
@@ -73,12 +105,12 @@ void add_triangle(FaceCollector& faces, Welder& welder, const std::array<std::ar
   faces.add(ids);
 }
 
-MeshData read_binary_stl(const std::string& buffer, const std::string& name, std::uint32_t count) {
+MeshData read_binary_stl(const std::string& buffer, const std::string& name, std::uint32_t count, double tolerance) {
   MeshData mesh;
   mesh.format = "stl-binary";
   FaceCollector faces;
   faces.reserve_triangles(count);
-  Welder welder;
+  Welder welder(tolerance);
   for (std::uint32_t t = 0; t < count; ++t) {
     const char* record = buffer.data() + 84 + 50 * static_cast<std::size_t>(t) + 12;  // after the normal
     std::array<std::array<double, 3>, 3> corner;
@@ -101,11 +133,11 @@ MeshData with_faces(MeshData mesh, const std::string& name) {
   return mesh;
 }
 
-MeshData read_ascii_stl(const std::string& buffer, const std::string& name) {
+MeshData read_ascii_stl(const std::string& buffer, const std::string& name, double tolerance) {
   MeshData mesh;
   mesh.format = "stl-ascii";
   FaceCollector faces;
-  Welder welder;
+  Welder welder(tolerance);
   TextScanner in(buffer, name, /*hash_comments=*/false);
   std::string_view token;
   if (!in.next_content_line() || !in.next_token(token) || token != "solid") in.fail("not an STL file: expected 'solid'");
@@ -146,7 +178,9 @@ MeshData read_ascii_stl(const std::string& buffer, const std::string& name) {
 
 }  // namespace
 
-MeshData read_stl(const std::string& buffer, const std::string& name) {
+MeshData read_stl(const std::string& buffer, const std::string& name, double weld_tolerance) {
+  if (!(weld_tolerance >= 0) || !std::isfinite(weld_tolerance))
+    throw Error(name + ": the weld tolerance must be a finite number >= 0, not " + std::to_string(weld_tolerance));
   if (buffer.empty()) fail(name, "empty file");
   // Binary when the size is exactly the header's triangle count's (a binary file may also begin with "solid").
   if (buffer.size() >= 84) {
@@ -154,11 +188,11 @@ MeshData read_stl(const std::string& buffer, const std::string& name) {
     std::memcpy(&count, buffer.data() + 80, 4);
     if (buffer.size() == 84 + 50ull * count) {
       if (count > static_cast<std::uint64_t>(kMaxCount) / 3) fail(name, "too many triangles (" + std::to_string(count) + ")");
-      return with_faces(read_binary_stl(buffer, name, count), name);
+      return with_faces(read_binary_stl(buffer, name, count, weld_tolerance), name);
     }
   }
   std::size_t start = buffer.find_first_not_of(" \t\r\n");
-  if (start != std::string::npos && buffer.compare(start, 5, "solid") == 0) return with_faces(read_ascii_stl(buffer, name), name);
+  if (start != std::string::npos && buffer.compare(start, 5, "solid") == 0) return with_faces(read_ascii_stl(buffer, name, weld_tolerance), name);
   if (buffer.size() >= 84) {
     std::uint32_t count;
     std::memcpy(&count, buffer.data() + 80, 4);

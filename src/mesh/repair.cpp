@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <numeric>
 #include <string>
@@ -21,15 +22,14 @@ int find_root(std::vector<int>& parent, int a) {
 
 }  // namespace
 
-RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F) {
+namespace {
+
+// One pass of repair_mesh with the `excluded` faces left out. Where the sheets of a cut edge meet again around
+// both its ends (splitting cannot separate them), the faces beyond the first two on the edge that still has more
+// than two are put into `exclude` and the result is not valid: the caller runs again without them.
+RepairedMesh repair_pass(const MatrixX3d& V, const MatrixX3i& F, const std::vector<char>& excluded, std::vector<int>& exclude) {
   // Sorted arrays rather than hash maps: a mesh that needs nothing costs a few sorts of its faces and edges.
   const int nV = static_cast<int>(V.rows()), nF = static_cast<int>(F.rows());
-  for (int f = 0; f < nF; ++f) {
-    for (int k = 0; k < 3; ++k)
-      if (F(f, k) < 0 || F(f, k) >= nV)
-        throw Error("vertex index " + std::to_string(F(f, k)) + " out of range in face " + std::to_string(f) + " (mesh has " +
-                    std::to_string(nV) + " vertices)");
-  }
   RepairedMesh out;
   out.input_vertices = nV, out.input_faces = nF;
   out.face_of_input.assign(nF, -1);
@@ -43,6 +43,7 @@ RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F) {
       out.degenerate_faces.push_back(f);
       continue;
     }
+    if (excluded[f]) continue;
     std::array<int, 4> key{F(f, 0), F(f, 1), F(f, 2), f};
     std::sort(key.begin(), key.begin() + 3);
     by_corners.push_back(key);
@@ -61,7 +62,7 @@ RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F) {
   std::vector<int> kept;
   kept.reserve(by_corners.size());
   for (int f = 0; f < nF; ++f)
-    if (!duplicate[f] && out.face_of_input[f] < 0 &&
+    if (!duplicate[f] && !excluded[f] && out.face_of_input[f] < 0 &&
         !(F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 0) == F(f, 2))) {
       out.face_of_input[f] = static_cast<int>(kept.size());
       kept.push_back(f);
@@ -175,39 +176,60 @@ RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F) {
     if (fans[v] > 1) out.split_vertices.emplace_back(v, fans[v]);
   out.input_face = kept;
 
-  // What splitting cannot separate (sheets that meet again elsewhere around both ends) stays refused: only the
-  // faces of cut edges can still share an edge with more than two of them.
+  // Sheets that meet again elsewhere around both ends of a cut edge share it still: only the faces of cut edges
+  // can. The faces beyond the first two (in file order) on such an edge are left out, and the pass runs again.
   for (const auto& [begin, end] : cut_ranges) {
-    std::vector<std::uint64_t> copies;
+    std::vector<std::pair<std::uint64_t, int>> copies;  // (edge of the repaired mesh, face in file order)
     for (size_t i = begin; i < end; ++i) {
       const Holder h = holder(i);
-      copies.push_back(edge_key(out.F(h.face, h.corner), out.F(h.face, (h.corner + 1) % 3)));
+      copies.emplace_back(edge_key(out.F(h.face, h.corner), out.F(h.face, (h.corner + 1) % 3)), kept[h.face]);
     }
     std::sort(copies.begin(), copies.end());
     for (size_t i = 2; i < copies.size(); ++i)
-      if (copies[i] == copies[i - 2]) {
-        const int a = static_cast<int>(copies[i] >> 32), b = static_cast<int>(copies[i] & 0xffffffffu);
-        throw Error("repair: the edge (" + std::to_string(out.vertex_origin[a]) + ", " + std::to_string(out.vertex_origin[b]) +
-                    ") has more than two faces whose sheets meet again around both its ends, which cutting it cannot separate");
-      }
+      if (copies[i].first == copies[i - 2].first) exclude.push_back(copies[i].second);
   }
-  // A degenerate face reads the field of a face sharing its edge, else one sharing a vertex (none: −1).
-  if (!out.degenerate_faces.empty()) {
-    std::vector<int> face_at(nV, -1);  // a kept face at each input vertex
-    for (int q = nK - 1; q >= 0; --q)
-      for (int k = 0; k < 3; ++k) face_at[F(kept[q], k)] = q;
-    for (int f : out.degenerate_faces) {
-      const int a = F(f, 0), b = F(f, 0) == F(f, 1) ? F(f, 2) : F(f, 1);
-      int q = -1;
-      if (a != b) {
-        const auto it = std::lower_bound(half_edges.begin(), half_edges.end(), std::make_pair(edge_key(a, b), -1));
-        if (it != half_edges.end() && it->first == edge_key(a, b)) q = it->second / 3;
-      }
-      for (int k = 0; k < 3 && q < 0; ++k) q = face_at[F(f, k)];
-      out.face_of_input[f] = q;
+  if (!exclude.empty()) return out;
+  // A dropped face (repeated vertex, or left out above) reads the field of a face sharing an edge, else one
+  // sharing a vertex (none: −1).
+  std::vector<int> face_at(nV, -1);  // a kept face at each input vertex
+  for (int q = nK - 1; q >= 0; --q)
+    for (int k = 0; k < 3; ++k) face_at[F(kept[q], k)] = q;
+  for (int f = 0; f < nF; ++f) {
+    if (out.face_of_input[f] >= 0) continue;
+    int q = -1;
+    for (int k = 0; k < 3 && q < 0; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      if (a == b) continue;
+      const auto it = std::lower_bound(half_edges.begin(), half_edges.end(), std::make_pair(edge_key(a, b), -1));
+      if (it != half_edges.end() && it->first == edge_key(a, b)) q = it->second / 3;
     }
+    for (int k = 0; k < 3 && q < 0; ++k) q = face_at[F(f, k)];
+    out.face_of_input[f] = q;
   }
   return out;
+}
+
+}  // namespace
+
+RepairedMesh repair_mesh(const MatrixX3d& V, const MatrixX3i& F) {
+  const int nV = static_cast<int>(V.rows()), nF = static_cast<int>(F.rows());
+  for (int f = 0; f < nF; ++f) {
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) < 0 || F(f, k) >= nV)
+        throw Error("vertex index " + std::to_string(F(f, k)) + " out of range in face " + std::to_string(f) + " (mesh has " +
+                    std::to_string(nV) + " vertices)");
+  }
+  std::vector<char> excluded(nF, 0);
+  for (;;) {  // each pass leaves out at least one more face, so this ends
+    std::vector<int> exclude;
+    RepairedMesh out = repair_pass(V, F, excluded, exclude);
+    if (exclude.empty()) {
+      for (int f = 0; f < nF; ++f)
+        if (excluded[f]) out.unseparated_faces.push_back(f);
+      return out;
+    }
+    for (int f : exclude) excluded[f] = 1;
+  }
 }
 
 std::string repair_summary(const RepairedMesh& r) {
@@ -217,6 +239,11 @@ std::string repair_summary(const RepairedMesh& r) {
   if (!r.degenerate_faces.empty()) {
     s += sep + std::to_string(r.degenerate_faces.size()) + " face" + (r.degenerate_faces.size() > 1 ? "s" : "") +
          " with a repeated vertex dropped (first: face " + std::to_string(r.degenerate_faces[0]) + ")";
+    sep = "; ";
+  }
+  if (!r.unseparated_faces.empty()) {
+    s += sep + std::to_string(r.unseparated_faces.size()) + " face" + (r.unseparated_faces.size() > 1 ? "s" : "") +
+         " dropped where sheets of an edge with more than two faces meet again (first: face " + std::to_string(r.unseparated_faces[0]) + ")";
     sep = "; ";
   }
   if (!r.duplicates.empty()) {
