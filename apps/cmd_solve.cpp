@@ -186,7 +186,7 @@ void run_solve(const SolveOptions& o) {
   designer.set_fixed_faces(constraints.fixed_faces);
 
   nlohmann::ordered_json extra = nlohmann::ordered_json::object();
-  if (repair) extra["repair"] = repair_summary_json(*repair);
+  if (repair) extra["repair"] = repair_summary_json(*repair), extra["repair"]["seconds"] = loaded.repair_seconds;
   std::string features_summary;
   if (request.features_given()) report_features(o, designer, constraints, request.prescription.N, extra, features_summary);
   const Topology& t = designer.topology();
@@ -195,7 +195,7 @@ void run_solve(const SolveOptions& o) {
     std::cout << "mesh " << o.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
               << " component(s), chi " << t.euler_characteristic() << ", " << designer.cycles().generators.size() << " generator(s), "
               << t.boundary_loops.size() << " boundary loop(s)\n"
-              << "time: read " << fmt(read_seconds) << " s, prepared in " << fmt(pt.prepare) << " s (topology " << fmt(pt.topology)
+              << "time: read " << fmt(loaded.read_seconds) << " s, repair " << fmt(loaded.repair_seconds) << " s, prepared in " << fmt(pt.prepare) << " s (topology " << fmt(pt.topology)
               << " s, geometry " << fmt(pt.geometry) << " s, cycles " << fmt(pt.cycles) << " s, plan " << fmt(pt.plan) << " s, setup "
               << fmt(pt.setup) << " s)\n"
               << features_summary;

@@ -39,6 +39,7 @@ struct LoadedMesh {
   MeshData mesh;                       // what the command works on: the input, or its repair
   MeshData input;                      // the input as read, when repair changed it (else empty: `mesh` is the input)
   std::optional<RepairedMesh> repair;  // when repair changed the mesh
+  double read_seconds = 0, repair_seconds = 0;  // repair_seconds: checking and repairing (0 with --no-repair)
   const RepairedMesh* repaired() const { return repair ? &*repair : nullptr; }
   const MeshData& as_read() const { return repair ? input : mesh; }
 };

@@ -1,4 +1,5 @@
 // trivcon: command-line front end. Subcommands live in apps/cmd_*.cpp; all the work is in the library.
+#include <chrono>
 #include <cstdio>
 #include <exception>
 #include <iostream>
@@ -15,12 +16,16 @@ MeshData load_mesh(const std::string& path) { return read_mesh(path); }
 
 LoadedMesh load_mesh(const std::string& path, const MeshOptions& options, bool quiet) {
   LoadedMesh out;
+  const auto t0 = std::chrono::steady_clock::now();
   out.mesh = read_mesh(path, options.weld);
+  const auto t1 = std::chrono::steady_clock::now();
+  out.read_seconds = std::chrono::duration<double>(t1 - t0).count();
   if (options.no_repair) {
     if (!out.mesh.repeated_vertex.empty()) throw Error(out.mesh.repeated_vertex);
     return out;
   }
   RepairedMesh r = repair_mesh(out.mesh.V, out.mesh.F);
+  out.repair_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   if (!r.changed()) return out;
   out.input = std::move(out.mesh);
   out.mesh.V = r.V, out.mesh.F = r.F;
