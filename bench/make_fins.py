@@ -6,13 +6,10 @@ V = []; F = []
 idx = lambda i, j: i * (m + 1) + j
 for i in range(m + 1):
     for j in range(m + 1): V.append((i, j, 0))
-E = set()
 for i in range(m):
     for j in range(m):
         a, b, c, d = idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)
         F += [(a, b, c), (a, c, d)]
-        for e in ((a, b), (b, c), (c, a), (a, c), (c, d), (d, a)):
-            k = (min(e), max(e)); E.add(k) if k not in E else E.add(k)
 from collections import Counter
 cnt = Counter()
 for f in F:
