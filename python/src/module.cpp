@@ -877,8 +877,8 @@ PYBIND11_MODULE(_core, m) {
                                py::dict d;
                                d["summary"] = repair_summary(r);
                                d["input_vertices"] = r.input_vertices, d["input_faces"] = r.input_faces;
-                               d["face_of_input"] = r.face_of_input, d["input_face"] = r.input_face;
-                               d["vertex_origin"] = r.vertex_origin, d["degenerate_faces"] = r.degenerate_faces;
+                               d["face_of_input"] = int64_vector(r.face_of_input), d["input_face"] = int64_vector(r.input_face);
+                               d["vertex_origin"] = int64_vector(r.vertex_origin), d["degenerate_faces"] = r.degenerate_faces;
                                d["duplicate_faces"] = r.duplicates, d["cut_edges"] = r.cut_edges;
                                d["split_vertices"] = r.split_vertices, d["unpaired_faces"] = r.unpaired_faces;
                                d["unseparated_faces"] = r.unseparated_faces;

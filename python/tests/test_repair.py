@@ -81,3 +81,20 @@ def test_three_fins_on_an_edge():
         d = trivcon.FieldDesigner(V, F)
     assert d.repair["unpaired_faces"] == [2] and d.num_vertices == 7
     assert d.solve(N=4, singularities="auto").verified
+
+
+def test_the_batch_repairs_and_says_so(tmp_path):
+    from trivcon import batch
+
+    V, F = two_boxes()
+    mesh = tmp_path / "boxes.obj"
+    trivcon.write_mesh(str(mesh), V, F)
+    job = {"mesh": str(mesh), "name": "boxes", "out": str(tmp_path), "N": 4, "sing_file": None, "auto_cancel": 0.0,
+           "align_boundary": False, "weights": "cotan", "field_format": "txt", "connection": True, "png": False}
+    row = batch.solve_mesh(job)
+    assert row["status"] == "ok", row["message"]
+    assert row["repair"].startswith("repaired: 1 vertex split")
+    assert trivcon.read_field(str(tmp_path / "boxes.field.txt"), 24)[0].shape == (24, 3)
+    assert (tmp_path / "boxes.mesh.obj").exists()  # beside the connection, whose edges are its vertex pairs
+    row = batch.solve_mesh(dict(job, repair=False))
+    assert row["status"] == "failed" and row["message"].startswith("non-manifold vertex 7")

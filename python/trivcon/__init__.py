@@ -711,10 +711,10 @@ class FieldDesigner(_Cached):
     @property
     def repair(self):
         """None when the mesh needed no repair (or repair=False); else a dict mapping the repaired mesh to the
-        input: summary (one sentence), input_vertices, input_faces, face_of_input (per input face its face
-        here; a duplicate's the face it duplicates; a dropped degenerate face's a neighbour, or -1),
-        input_face (per face here its input face), vertex_origin (per vertex here the input vertex it
-        copies), degenerate_faces, duplicate_faces ((dropped, original) pairs), cut_edges, split_vertices
+        input: summary (one sentence), input_vertices, input_faces, face_of_input (int64 array: per input face
+        its face here; a duplicate's the face it duplicates; a dropped face's a neighbour, or -1), input_face
+        (int64 array: per face here its input face), vertex_origin (int64 array: per vertex here the input vertex
+        it copies), and lists: degenerate_faces, duplicate_faces ((dropped, original) pairs), cut_edges, split_vertices
         ((vertex, fans) pairs), unpaired_faces, unseparated_faces (dropped where the sheets of a cut edge meet
         again), all in the input's ids."""
         return self._d.repair

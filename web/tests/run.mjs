@@ -456,6 +456,43 @@ async function main() {
       await page.click('#dl-png');
     });
 
+    await check('a mesh that is not manifold is repaired: the page says how, a downloaded field has a row per face of the file', async () => {
+      // Two closed boxes touching at one corner (vertex 7 of the first is vertex 0 of the second).
+      const v = [], f = [];
+      for (const o of [0, 1]) {
+        const b = v.length;
+        for (let i = 0; i < 8; i++) v.push([o + ((i >> 2) & 1), o + ((i >> 1) & 1), o + (i & 1)]);
+        for (const [a, c, d, e] of [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]])
+          f.push([b + a, b + c, b + d], [b + a, b + d, b + e]);
+      }
+      v.splice(8, 1);
+      const faces = f.map((t) => t.map((i) => (i === 8 ? 7 : i > 8 ? i - 1 : i) + 1));
+      const path = resolve(tmpdir(), `trivcon-boxes-${process.pid}.obj`);
+      writeFileSync(path, v.map((p) => `v ${p.join(' ')}\n`).join('') + faces.map((t) => `f ${t.join(' ')}\n`).join(''));
+      const other = await startEditor(trivcon, [path, '-N', '4']);
+      const tab = await browser.newPage();
+      tab.on('pageerror', (e) => pageErrors.push(e.message));
+      try {
+        await tab.goto(other.url);
+        await tab.waitForFunction(() => window.__trivcon && window.__trivcon.ready, { timeout: 120000 });
+        const info = await tab.evaluate(() => document.getElementById('meshinfo').textContent);
+        assert.match(info, /16 vertices, 24 faces/);
+        assert.match(info, /repaired: 1 vertex split into separate fans \(first: vertex 7, 2 fans\)/);
+        assert.match(other.stderr(), /repaired: 1 vertex split/);
+        const session = await tab.evaluate(() => window.__trivcon.session);
+        const txt = await (await fetch(new URL('/api/export?format=txt', other.url), {
+          method: 'POST', headers: { 'X-Trivcon-Token': other.token, 'Content-Type': 'application/json' },
+          // Every corner of both boxes +1/4: vertex 15 is the second box's copy of the shared corner 7.
+          body: JSON.stringify({ ...session, singularities: [...Array(16).keys()].map((i) => [i, '1/4']) }),
+        })).text();
+        assert.match(txt, /# faces 24\n/);
+      } finally {
+        await tab.close();
+        other.child.kill('SIGTERM');
+        await once(other.child, 'exit');
+      }
+    });
+
     await check('glyphs cover large faces in proportion to area (two big triangles beside 20000 small ones)', async () => {
       const path = resolve(tmpdir(), `trivcon-uneven-${process.pid}.obj`);
       writeUnevenMesh(path);
