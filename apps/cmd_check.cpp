@@ -42,11 +42,7 @@ void run_check(CheckOptions& o) {
   // Without a prescription, check only lists the field's singularities.
   const bool compare = !o.prescription.empty();
   IndexPrescription p = o.prescription.build();
-  if (repair) {
-    std::map<int, int> vertex;
-    for (const auto& [v, n] : p.vertex) vertex[repaired_vertex(*repair, v, "singular vertex")] = n;
-    p.vertex = std::move(vertex);
-  }
+  if (repair) p.vertex = singularities_on_repaired(*repair, p.vertex);
   // Ids printed: the input's (a copy repair appended is named by the vertex it copies).
   const auto id = [repair](int v) { return repair ? repair->vertex_origin[v] : v; };
   if (compare) validate_prescription(t, static_cast<int>(cycles.generators.size()), p);

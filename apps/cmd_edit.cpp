@@ -69,11 +69,7 @@ void run_edit(const EditOptions& o) {
   options.mesh_path = o.mesh;
   options.host = o.host;
   options.initial = o.prescription.build();
-  if (options.repair) {  // the file's ids, on the repaired mesh
-    std::map<int, int> vertex;
-    for (const auto& [v, n] : options.initial.vertex) vertex[repaired_vertex(*options.repair, v, "singular vertex")] = n;
-    options.initial.vertex = std::move(vertex);
-  }
+  if (options.repair) options.initial.vertex = singularities_on_repaired(*options.repair, options.initial.vertex);  // the file's ids
   options.align_boundary = o.align_boundary;
   options.feature_degrees = o.feature_degrees;
   auto designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F);

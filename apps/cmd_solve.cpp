@@ -171,13 +171,11 @@ void run_solve(const SolveOptions& o) {
   if (!o.sing_batch.empty()) batch = read_batch(o.sing_batch, request.prescription);
   if (repair)
     for (BatchItem& item : batch) {
-      std::map<int, int> vertex;
       try {
-        for (const auto& [v, n] : item.prescription.vertex) vertex[repaired_vertex(*repair, v, "singular vertex")] = n;
+        item.prescription.vertex = singularities_on_repaired(*repair, item.prescription.vertex);
       } catch (const Error& e) {
         throw Error("batch item '" + item.name + "': " + e.what());
       }
-      item.prescription.vertex = std::move(vertex);
     }
   if (!batch.empty() && request.split_large_turns)
     throw Error("--split-large-turns refines the mesh for one prescription: not with --sing-batch");

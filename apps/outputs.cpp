@@ -102,11 +102,7 @@ void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const
 }
 
 std::map<int, int> input_singularities(const std::map<int, int>& vertex, const RepairedMesh* repair) {
-  if (!repair) return vertex;
-  std::map<int, int> out;
-  for (const auto& [v, n] : vertex) out[repair->vertex_origin[v]] += n;
-  for (auto it = out.begin(); it != out.end();) it = it->second == 0 ? out.erase(it) : std::next(it);
-  return out;
+  return repair ? values_on_input(*repair, vertex) : vertex;
 }
 
 }  // namespace trivcon::cli

@@ -1163,13 +1163,9 @@ struct EditorServer::Impl {
                   } catch (const Error& e) {
                     throw BadRequest{400, e.what()};
                   }
-                  std::map<int, int> vertex = r.prescription.vertex;  // by the file's ids
-                  if (options.repair) {
-                    vertex.clear();
-                    for (const auto& [v, n] : r.prescription.vertex) vertex[options.repair->vertex_origin[v]] += n;
-                    for (auto it = vertex.begin(); it != vertex.end();) it = it->second == 0 ? vertex.erase(it) : std::next(it);
-                  }
-                  write_singularities_to(out, vertex, r.prescription.N);
+                  // By the file's ids.
+                  write_singularities_to(out, options.repair ? values_on_input(*options.repair, r.prescription.vertex) : r.prescription.vertex,
+                                         r.prescription.N);
                   name = "singularities.txt";
                 } else {
                   const Solved s = solve(r);

@@ -18,6 +18,7 @@
 // orientable components is build_topology's (trivcon/topology.h). Indices out of range and non-orientable
 // components are not repaired: build_topology's errors name them.
 #pragma once
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -75,6 +76,11 @@ MatrixX3d rows_on_repaired(const RepairedMesh& repaired, const MatrixX3d& input_
 Eigen::MatrixXd corner_rows_on_input(const RepairedMesh& repaired, const MatrixX3i& input_F, const Eigen::MatrixXd& rows);
 // The inverse: per-corner rows of the input's faces as rows of the repaired mesh's, corners matched by vertex.
 Eigen::MatrixXd corner_rows_on_repaired(const RepairedMesh& repaired, const MatrixX3i& input_F, const Eigen::MatrixXd& input_rows);
+// Singular vertices (vertex → n) given by the input's ids, on the repaired mesh (repaired_vertex for each).
+std::map<int, int> singularities_on_repaired(const RepairedMesh& repaired, const std::map<int, int>& input_vertex);
+// Per-vertex values (e.g. singularities: vertex → n) of the repaired mesh by the input's ids: a copy's goes to the
+// vertex it copies (summed with the others there; zeros left out).
+std::map<int, int> values_on_input(const RepairedMesh& repaired, const std::map<int, int>& per_vertex);
 // The vertices of the repaired mesh that copy input vertex v (v itself first), for edges named by input vertices.
 std::vector<int> vertex_copies(const RepairedMesh& repaired, int input_vertex);
 

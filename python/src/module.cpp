@@ -884,10 +884,6 @@ PYBIND11_MODULE(_core, m) {
                                d["unseparated_faces"] = r.unseparated_faces;
                                return d;
                              })
-      .def("repaired_vertex",
-           [](const DesignerState& s, int v, const std::string& what) { return s.repair ? repaired_vertex(*s.repair, v, what) : v; })
-      .def("repaired_face", [](const DesignerState& s, int f, const std::string& what) { return s.repair ? repaired_face(*s.repair, f, what) : f; })
-      .def("vertex_copies", [](const DesignerState& s, int v) { return s.repair ? vertex_copies(*s.repair, v) : std::vector<int>{v}; })
       .def_property_readonly("F", [](const DesignerState& s) { return int64_matrix(s.topology().F); })
       .def_property_readonly("num_vertices", [](const DesignerState& s) { return s.topology().num_vertices; })
       .def_property_readonly("num_faces", [](const DesignerState& s) { return s.topology().num_faces; })
@@ -1182,13 +1178,9 @@ PYBIND11_MODULE(_core, m) {
           "write_singularities",
           [](const DesignResult& r, const std::string& path) {
             py::gil_scoped_release release;
-            std::map<int, int> vertex = r.prescription.vertex;
-            if (r.state->repair) {  // the input's ids (a copy repair appended names the vertex it copies)
-              vertex.clear();
-              for (const auto& [v, n] : r.prescription.vertex) vertex[r.state->repair->vertex_origin[v]] += n;
-              for (auto it = vertex.begin(); it != vertex.end();) it = it->second == 0 ? vertex.erase(it) : std::next(it);
-            }
-            write_singularities(path, vertex, r.prescription.N);
+            // The input's ids (a copy repair appended names the vertex it copies).
+            write_singularities(path, r.state->repair ? values_on_input(*r.state->repair, r.prescription.vertex) : r.prescription.vertex,
+                                r.prescription.N);
           },
           py::arg("path"))
       .def(

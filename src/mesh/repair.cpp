@@ -373,6 +373,19 @@ Eigen::MatrixXd corner_rows_on_repaired(const RepairedMesh& r, const MatrixX3i& 
   return out;
 }
 
+std::map<int, int> singularities_on_repaired(const RepairedMesh& r, const std::map<int, int>& input_vertex) {
+  std::map<int, int> out;
+  for (const auto& [v, n] : input_vertex) out[repaired_vertex(r, v, "singular vertex")] = n;
+  return out;
+}
+
+std::map<int, int> values_on_input(const RepairedMesh& r, const std::map<int, int>& per_vertex) {
+  std::map<int, int> out;
+  for (const auto& [v, n] : per_vertex) out[r.vertex_origin[v]] += n;
+  for (auto it = out.begin(); it != out.end();) it = it->second == 0 ? out.erase(it) : std::next(it);
+  return out;
+}
+
 std::vector<int> vertex_copies(const RepairedMesh& r, int v) {
   std::vector<int> out{v};
   for (size_t u = r.input_vertices; u < r.vertex_origin.size(); ++u)

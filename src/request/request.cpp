@@ -91,9 +91,7 @@ AutoResult request_auto(const FieldDesigner& designer, const FieldRequest& reque
 }
 
 void move_request_to_repaired(FieldRequest& r, const Topology& t, const RepairedMesh& repaired) {
-  std::map<int, int> vertex;
-  for (const auto& [v, n] : r.prescription.vertex) vertex[repaired_vertex(repaired, v, "singular vertex")] = n;
-  r.prescription.vertex = std::move(vertex);
+  r.prescription.vertex = singularities_on_repaired(repaired, r.prescription.vertex);
   for (auto& [f, angle] : r.roots) f = repaired_face(repaired, f, "root face");
   std::vector<int> edges;
   for (int e : r.feature_edges) {  // given as the repaired topology's edge between the input ids' vertices
