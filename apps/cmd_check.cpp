@@ -38,7 +38,7 @@ void run_check(CheckOptions& o) {
   const Cycles cycles = compute_cycles(t);
   // The field file has a row per input face.
   const MatrixX3d directions =
-      rows_on_mesh(loaded, o.prescription.read_field_file(o.field, repair ? repair->input_faces : t.num_faces, o.prescription.N));
+      rows_on_mesh(loaded, o.prescription.read_field_file(o.field, loaded.input_faces(), o.prescription.N));
   // Without a prescription, check only lists the field's singularities.
   const bool compare = !o.prescription.empty();
   IndexPrescription p = o.prescription.build();

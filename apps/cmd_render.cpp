@@ -66,7 +66,7 @@ void run_render(const RenderCommand& c) {
   int file_N = 0;
   // Without --field (a checkerboard of --uv alone): a zero field, not drawn.
   const MatrixX3d directions = c.field.empty() ? MatrixX3d(g.frame_x)
-                                               : rows_on_mesh(loaded, read_field(c.field, repair ? repair->input_faces : t.num_faces, &file_N));
+                                               : rows_on_mesh(loaded, read_field(c.field, loaded.input_faces(), &file_N));
   const int N = c.N > 0 ? c.N : std::max(1, file_N);
   const Field field = field_from_directions(g, directions, N);
 
@@ -101,7 +101,7 @@ void run_render(const RenderCommand& c) {
   if (!c.uv.empty()) {  // the file's corners in the input's order, the renderer's in the topology's
     // The file has the input's faces; on a repaired mesh each face reads its input face's corners.
     const Eigen::MatrixXd input =
-        repair ? corner_rows_on_repaired(*repair, loaded.input.F, read_corner_uv(c.uv, loaded.input.F)) : read_corner_uv(c.uv, mesh.F);
+        repair ? corner_rows_on_repaired(*repair, read_corner_uv(c.uv, loaded.input.F)) : read_corner_uv(c.uv, mesh.F);
     o.corner_uv.resize(t.num_faces, 6);
     for (int f = 0; f < t.num_faces; ++f)
       for (int k = 0; k < 3; ++k)

@@ -41,7 +41,7 @@ struct LoadedMesh {
   std::optional<RepairedMesh> repair;  // when repair changed the mesh
   double read_seconds = 0, repair_seconds = 0;  // repair_seconds: checking and repairing (0 with --no-repair)
   const RepairedMesh* repaired() const { return repair ? &*repair : nullptr; }
-  const MeshData& as_read() const { return repair ? input : mesh; }
+  int input_faces() const { return static_cast<int>((repair ? input : mesh).F.rows()); }  // the file's (triangulated)
 };
 
 // How a command reads its mesh: --no-repair, --weld TOL (STL).

@@ -74,8 +74,9 @@ MatrixX3d rows_on_repaired(const RepairedMesh& repaired, const MatrixX3d& input_
 // (a duplicate may list them in another order); a degenerate face's corners take those of the face it maps to at
 // the same vertex, else its first corner's; a face mapped to −1 gets zeros.
 Eigen::MatrixXd corner_rows_on_input(const RepairedMesh& repaired, const MatrixX3i& input_F, const Eigen::MatrixXd& rows);
-// The inverse: per-corner rows of the input's faces as rows of the repaired mesh's, corners matched by vertex.
-Eigen::MatrixXd corner_rows_on_repaired(const RepairedMesh& repaired, const MatrixX3i& input_F, const Eigen::MatrixXd& input_rows);
+// The inverse: per-corner rows of the input's faces as rows of the repaired mesh's (a kept face keeps its corners
+// in the input's order).
+Eigen::MatrixXd corner_rows_on_repaired(const RepairedMesh& repaired, const Eigen::MatrixXd& input_rows);
 // Singular vertices (vertex → n) given by the input's ids, on the repaired mesh (repaired_vertex for each).
 std::map<int, int> singularities_on_repaired(const RepairedMesh& repaired, const std::map<int, int>& input_vertex);
 // Per-vertex values (e.g. singularities: vertex → n) of the repaired mesh by the input's ids: a copy's goes to the

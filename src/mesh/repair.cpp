@@ -331,12 +331,22 @@ int repaired_face(const RepairedMesh& r, int f, const std::string& what) {
   return r.face_of_input[f];
 }
 
-MatrixX3d rows_on_repaired(const RepairedMesh& r, const MatrixX3d& input_rows) {
+namespace {
+
+// Row q of the result is row input_face[q] of `input_rows` (a kept face keeps its corners in the input's order).
+template <class Matrix>
+Matrix gather_input_rows(const RepairedMesh& r, const Matrix& input_rows, const char* what) {
   if (input_rows.rows() != r.input_faces)
-    throw Error("rows_on_repaired: " + std::to_string(input_rows.rows()) + " rows for " + std::to_string(r.input_faces) + " input faces");
-  MatrixX3d out(r.input_face.size(), 3);
+    throw Error(std::string(what) + ": " + std::to_string(input_rows.rows()) + " rows for " + std::to_string(r.input_faces) + " input faces");
+  Matrix out(static_cast<Eigen::Index>(r.input_face.size()), input_rows.cols());
   for (size_t q = 0; q < r.input_face.size(); ++q) out.row(static_cast<Eigen::Index>(q)) = input_rows.row(r.input_face[q]);
   return out;
+}
+
+}  // namespace
+
+MatrixX3d rows_on_repaired(const RepairedMesh& r, const MatrixX3d& input_rows) {
+  return gather_input_rows(r, input_rows, "rows_on_repaired");
 }
 
 Eigen::MatrixXd corner_rows_on_input(const RepairedMesh& r, const MatrixX3i& input_F, const Eigen::MatrixXd& rows) {
@@ -360,17 +370,8 @@ Eigen::MatrixXd corner_rows_on_input(const RepairedMesh& r, const MatrixX3i& inp
   return out;
 }
 
-Eigen::MatrixXd corner_rows_on_repaired(const RepairedMesh& r, const MatrixX3i& input_F, const Eigen::MatrixXd& input_rows) {
-  if (input_rows.rows() != r.input_faces || input_rows.cols() % 3 != 0 || input_F.rows() != r.input_faces)
-    throw Error("corner_rows_on_repaired: " + std::to_string(input_rows.rows()) + " x " + std::to_string(input_rows.cols()) +
-                " rows for " + std::to_string(r.input_faces) + " input faces (3 corners each)");
-  const Eigen::Index w = input_rows.cols() / 3;
-  Eigen::MatrixXd out(r.F.rows(), input_rows.cols());
-  for (Eigen::Index q = 0; q < r.F.rows(); ++q) {
-    const int f = r.input_face[q];  // same corners in the same order (copies at the same positions)
-    for (int k = 0; k < 3; ++k) out.block(q, k * w, 1, w) = input_rows.block(f, k * w, 1, w);
-  }
-  return out;
+Eigen::MatrixXd corner_rows_on_repaired(const RepairedMesh& r, const Eigen::MatrixXd& input_rows) {
+  return gather_input_rows(r, input_rows, "corner_rows_on_repaired");
 }
 
 std::map<int, int> singularities_on_repaired(const RepairedMesh& r, const std::map<int, int>& input_vertex) {
