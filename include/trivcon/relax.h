@@ -20,13 +20,17 @@
 //   R_vu = (e_v − e_u)ᵀ M⁻¹ (e_v − e_u) ≥ 0, the effective resistance between v and u of the network M.
 // The first term costs nothing per candidate once λ is known (one solve per accepted move); R_vu would
 // cost a solve each, so it is estimated: R̃ = (1/d_v + 1/d_u)(1 + (√3/π) ln r), d the weighted degree
-// Σ w_e at a vertex and r the edges between v and u (1 for a step). Between neighbours this is exact on
-// vertex-transitive networks (2/d; e.g. a regular triangulation), and it grows with r as the continuum's
-// (1/π) ln r on a regular triangulation. Candidates are ranked by 2c(λ_v − λ_u) + c² R̃, and only those
-// whose first-order term is negative are solved, in that order: since R_vu ≥ 0 no other can lower E while
-// the free cycle indices stay as they were (a move that lowers E only through a new choice of free
-// generator or loop indices can be missed). Each accepted move is the first candidate in rank order whose
-// real energy is lower; the duals are then recomputed and the candidates ranked again.
+// Σ w_e at a vertex and r the edges between v and u (1 for a step): between neighbours, the 2/d of an
+// edge-transitive network (e.g. a regular triangulation), growing with r as the continuum's (1/π) ln r
+// does there; it ignores anisotropy and cycles. A step across an edge that a cycle with a chosen index
+// crosses (a free generator, a fixed-face path) may change that index too: moved along
+// (δb = c s A e_e, s = +1 when v is the edge's larger id), the first order is the edge's own
+// 2c s x_e / w_e, and the smaller of the two first orders is used (a held generator would make R_vu large
+// instead, which R̃ does not see). Candidates are ranked by first order + c² R̃, and only those whose
+// first order is negative are solved, in that order: since R_vu ≥ 0 no other can lower E unless a solve
+// chooses other free indices than the move carries. Each accepted move is the first candidate in rank
+// order whose real energy is lower; the duals are then recomputed and the candidates ranked again. The
+// result is a local minimum for single moves (greedy: e.g. a cancellation taken early is not undone).
 #pragma once
 #include <vector>
 
@@ -63,7 +67,9 @@ struct RelaxCandidate {
   int index = 0;            // n moved
   int distance = 1;         // edges between `from` and `to`
   bool cancels = false;     // `to` holds −n
-  double first_order = 0;   // 2c (λ_from − λ_to), c = 2πn/N: exact derivative
+  // 2c (λ_from − λ_to), c = 2πn/N: the exact first-order change with the cycle indices held; across an edge
+  // of a free cycle, the smaller of that and 2c s x_e / w_e (the index carried along).
+  double first_order = 0;
   double estimate = 0;      // first_order + c² R̃
 };
 
