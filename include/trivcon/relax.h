@@ -46,9 +46,9 @@ struct RelaxOptions {
 
 struct RelaxMove {
   int from = 0, to = 0;
-  int index = 0;          // n (index n/N) that moved from `from` to `to`
-  double energy = 0;      // the energy after the move
-  bool cancelled = false; // `to` held −n: both vanished
+  int index = 0;           // n (index n/N) that moved from `from` to `to`
+  double energy = 0;       // the energy after the move
+  bool cancelled = false;  // `to` held −n: both vanished
 };
 
 struct RelaxResult {
@@ -64,13 +64,13 @@ struct RelaxResult {
 // A candidate move and its estimated change of energy (see above).
 struct RelaxCandidate {
   int from = 0, to = 0;
-  int index = 0;            // n moved
-  int distance = 1;         // edges between `from` and `to`
-  bool cancels = false;     // `to` holds −n
+  int index = 0;         // n moved
+  int distance = 1;      // edges between `from` and `to`
+  bool cancels = false;  // `to` holds −n
   // 2c (λ_from − λ_to), c = 2πn/N: the exact first-order change with the cycle indices held; across an edge
   // of a free cycle, the smaller of that and 2c s x_e / w_e (the index carried along).
   double first_order = 0;
-  double estimate = 0;      // first_order + c² R̃
+  double estimate = 0;  // first_order + c² R̃
 };
 
 // Every candidate move of `prescription` whose connection from designer.solver() is `connection`, lowest

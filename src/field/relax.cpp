@@ -18,8 +18,7 @@ constexpr double kRelativeDecrease = 1e-12;
 
 std::vector<char> pinned_vertices(const Topology& t, const RelaxOptions& options) {
   if (options.max_moves < 0) throw Error("relax: max_moves must be at least 0, not " + std::to_string(options.max_moves));
-  if (options.cancel_distance < 0)
-    throw Error("relax: cancel_distance must be at least 0, not " + std::to_string(options.cancel_distance));
+  if (options.cancel_distance < 0) throw Error("relax: cancel_distance must be at least 0, not " + std::to_string(options.cancel_distance));
   std::vector<char> pinned(t.num_vertices, 0);
   for (int v : options.pins) {
     if (v < 0 || v >= t.num_vertices)
