@@ -121,6 +121,12 @@ class ConnectionSolver {
 
   // Validates the prescription and returns the connection. Only right-hand sides change per call.
   Connection solve(const IndexPrescription& prescription) const;
+  // The Lagrange multipliers of the vertex rows for a connection this solver returned, per vertex:
+  // λ = (A W Aᵀ)⁻¹ A x restricted to them, 0 where a vertex has no row (boundary and unreferenced vertices,
+  // each closed component's dropped vertex). With the cycle rows' right-hand sides held at those the
+  // connection used, E = bᵀ (A W Aᵀ)⁻¹ b, so ∂E/∂b_v = 2 λ_v (b_v = K_v − 2π k_v): moving index n/N from v
+  // to u changes E by 2 (2πn/N)(λ_v − λ_u) to first order (trivcon/relax.h). Costs one solve's substitutions.
+  Eigen::VectorXd vertex_duals(const Connection& connection) const;
 
   const Eigen::VectorXd& weights() const;  // per edge, 0 on boundary edges
   const SetupTimings& timings() const;

@@ -350,6 +350,19 @@ class CholeskyEngine : public SolverEngine {
     return true;
   }
 
+  Eigen::VectorXd multipliers(const Eigen::VectorXd& x) const override {
+    const int n = nD + nC;
+    if (n == 0) return Eigen::VectorXd();
+    Eigen::VectorXd y = Eigen::VectorXd::Zero(n);  // Π A x, in factor order
+    for (int a = 0; a < m; ++a)
+      for (int k = edge_rows_.start[a]; k < edge_rows_.start[a + 1]; ++k) y(edge_rows_.row[k]) += edge_rows_.coefficient[k] * x(a);
+    y = lower_solve(y);
+    backward(y);
+    Eigen::VectorXd out(n);
+    for (int row = 0; row < n; ++row) out(row) = y(position_[row]);
+    return out;
+  }
+
  private:
   // x = W Aᵀ y for y in factor order.
   Eigen::VectorXd edge_values(const Eigen::VectorXd& y) const {

@@ -98,6 +98,23 @@ class QREngine : public SolverEngine {
     cholmod_l_free_dense(&B, &cc()), cholmod_l_free_dense(&Z, &cc()), cholmod_l_free_dense(&X, &cc());
     return y;
   }
+  // With (A W^½)ᵀ E = Q R: A W Aᵀ = E Rᵀ R Eᵀ and A x = E Rᵀ (Qᵀ W^-½ x) restricted to R's rows, so
+  // y = E R⁻¹ (Qᵀ W^-½ x).
+  Eigen::VectorXd multipliers(const Eigen::VectorXd& x) const override {
+    const int n = nD + nC;
+    if (n == 0) return Eigen::VectorXd();
+    cholmod_dense* B = cholmod_l_allocate_dense(m, 1, m, CHOLMOD_REAL, &cc());
+    Eigen::Map<Eigen::VectorXd>(static_cast<double*>(B->x), m) = x.cwiseQuotient(sqrt_w);
+    cholmod_dense* Z = SuiteSparseQR_qmult<double>(SPQR_QTX, qr, B, &cc());
+    cholmod_dense* Y = Z ? SuiteSparseQR_solve<double>(SPQR_RETX_EQUALS_B, qr, Z, &cc()) : nullptr;
+    if (!Y) {
+      cholmod_l_free_dense(&B, &cc()), cholmod_l_free_dense(&Z, &cc());
+      throw Error("SuiteSparseQR solve failed");
+    }
+    Eigen::VectorXd y = Eigen::Map<Eigen::VectorXd>(static_cast<double*>(Y->x), n);
+    cholmod_l_free_dense(&B, &cc()), cholmod_l_free_dense(&Z, &cc()), cholmod_l_free_dense(&Y, &cc());
+    return y;
+  }
   Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const override {
     Eigen::VectorXd b = Eigen::VectorXd::Zero(nD + nC);
     b.head(nD) = b_D;

@@ -282,6 +282,21 @@ void ConnectionSolver::Impl::factor(const std::function<SolverAnalysis()>& analy
 
 ConnectionSolver::~ConnectionSolver() = default;
 
+Eigen::VectorXd ConnectionSolver::vertex_duals(const Connection& connection) const {
+  const Impl& s = *impl_;
+  if (connection.x.size() != s.topology.num_edges)
+    throw Error("vertex_duals: the connection has " + std::to_string(connection.x.size()) + " edge values for " +
+                std::to_string(s.topology.num_edges) + " edges");
+  const int m = static_cast<int>(s.active_edges.size());
+  Eigen::VectorXd x_active(m);
+  for (int a = 0; a < m; ++a) x_active(a) = connection.x(s.active_edges[a]);
+  const Eigen::VectorXd y = s.engine->multipliers(x_active);
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(s.topology.num_vertices);
+  for (int v = 0; v < s.topology.num_vertices; ++v)
+    if (s.vertex_row[v] >= 0) lambda(v) = y(s.vertex_row[v]);
+  return lambda;
+}
+
 const Eigen::VectorXd& ConnectionSolver::weights() const { return impl_->weights; }
 const SetupTimings& ConnectionSolver::timings() const { return impl_->timings; }
 std::string ConnectionSolver::ordering() const { return impl_->engine ? impl_->engine->ordering() : ""; }

@@ -32,6 +32,10 @@ class SolverEngine {
   // full right-hand side b = [b_D; b_C] (vertex rows, then cycle rows, as solve() used them). Returns
   // false, leaving x, on a route that has nothing to refine (QR solves the constraints directly).
   virtual bool refine(const Eigen::VectorXd& /*b*/, Eigen::VectorXd& /*x*/) const { return false; }
+  // y = (A W Aᵀ)⁻¹ A x in row order (vertex rows, then the extra rows, then the cycle rows, as solve()
+  // used them), for x on the system edges. For an x that solve() returned, A x is the right-hand side it
+  // met, so y are the constraints' Lagrange multipliers (the energy bᵀ (A W Aᵀ)⁻¹ b has gradient 2y in b).
+  virtual Eigen::VectorXd multipliers(const Eigen::VectorXd& x) const = 0;
   // The fill-reducing order the factorization used.
   virtual std::string ordering() const = 0;
   // diag(P)

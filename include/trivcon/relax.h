@@ -1,0 +1,85 @@
+// trivcon/relax.h: singularity relaxation — moving the prescribed singularities, one edge at a time,
+// to where the field is smoother (lower Connection::energy), keeping their indices.
+//
+//   trivcon::RelaxResult r = trivcon::relax(designer, p);     // p: e.g. singularities placed by hand
+//   designer.design(r.prescription) ...                        // the relaxed field
+//
+// A move takes a singular vertex v's whole index n/N to an interior neighbour u (one edge away) that is
+// not singular; with cancel_distance > 0 it may also take it onto a vertex holding −n/N at most that many
+// edges away, where both vanish. Boundary vertices never receive a singularity, pinned vertices neither
+// move nor receive one, nothing moves between components, so each component keeps its multiset of
+// indices (less the cancelled pairs). Generator and loop indices, and the fixed directions, stay as the
+// prescription gives them (free ones are chosen smoothest by every solve, as in any design). A move is
+// accepted only when a real solve (designer.solver().solve) lowers the energy by more than 1e-12 of it;
+// relax stops when no candidate does, or after max_moves moves.
+//
+// Ranking (docs/solver.md, "Singularity relaxation"). The energy is E = bᵀ M⁻¹ b with M = A W Aᵀ and b the
+// right-hand sides (trivcon/solver.h; vertex rows b_v = K_v − 2π n_v/N). Moving n from v to u is
+// δb = c (e_v − e_u), c = 2πn/N, so with the cycle rows' right-hand sides held, exactly
+//   ΔE = 2c (λ_v − λ_u) + c² R_vu,   λ = M⁻¹ b (ConnectionSolver::vertex_duals),
+//   R_vu = (e_v − e_u)ᵀ M⁻¹ (e_v − e_u) ≥ 0, the effective resistance between v and u of the network M.
+// The first term costs nothing per candidate once λ is known (one solve per accepted move); R_vu would
+// cost a solve each, so it is estimated: R̃ = (1/d_v + 1/d_u)(1 + (√3/π) ln r), d the weighted degree
+// Σ w_e at a vertex and r the edges between v and u (1 for a step): between neighbours, the 2/d of an
+// edge-transitive network (e.g. a regular triangulation), growing with r as the continuum's (1/π) ln r
+// does there; it ignores anisotropy and cycles. A step across an edge that a cycle with a chosen index
+// crosses (a free generator, a fixed-face path) may change that index too: moved along
+// (δb = c s A e_e, s = +1 when v is the edge's larger id), the first order is the edge's own
+// 2c s x_e / w_e, and the smaller of the two first orders is used (a held generator would make R_vu large
+// instead, which R̃ does not see). Candidates are ranked by first order + c² R̃, and only those whose
+// first order is negative are solved, in that order: since R_vu ≥ 0 no other can lower E unless a solve
+// chooses other free indices than the move carries. Each accepted move is the first candidate in rank
+// order whose real energy is lower; the duals are then recomputed and the candidates ranked again. The
+// result is a local minimum for single moves (greedy: e.g. a cancellation taken early is not undone).
+#pragma once
+#include <vector>
+
+#include "trivcon/design.h"
+
+namespace trivcon {
+
+struct RelaxOptions {
+  std::vector<int> pins;    // vertices that keep their index (none moves away, none arrives)
+  int max_moves = 10000;    // accepted moves at most (≥ 0)
+  int cancel_distance = 0;  // > 0: an index n may meet a −n at most this many edges away, both vanishing; 0: never
+};
+
+struct RelaxMove {
+  int from = 0, to = 0;
+  int index = 0;           // n (index n/N) that moved from `from` to `to`
+  double energy = 0;       // the energy after the move
+  bool cancelled = false;  // `to` held −n: both vanished
+};
+
+struct RelaxResult {
+  IndexPrescription prescription;  // the relaxed one (only its vertex indices differ from the start)
+  double energy_before = 0, energy_after = 0;
+  std::vector<RelaxMove> moves;
+  std::vector<double> energies;  // energy_before, then after each move: strictly decreasing
+  int candidates_evaluated = 0;  // real solves of candidate moves
+  bool converged = false;        // stopped because no candidate lowers the energy (not at max_moves)
+  double seconds = 0;
+};
+
+// A candidate move and its estimated change of energy (see above).
+struct RelaxCandidate {
+  int from = 0, to = 0;
+  int index = 0;         // n moved
+  int distance = 1;      // edges between `from` and `to`
+  bool cancels = false;  // `to` holds −n
+  // 2c (λ_from − λ_to), c = 2πn/N: the exact first-order change with the cycle indices held; across an edge
+  // of a free cycle, the smaller of that and 2c s x_e / w_e (the index carried along).
+  double first_order = 0;
+  double estimate = 0;  // first_order + c² R̃
+};
+
+// Every candidate move of `prescription` whose connection from designer.solver() is `connection`, lowest
+// estimate first (ties: by from, then to). A cancellation is listed once per pair, from its smaller vertex.
+std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, const IndexPrescription& prescription,
+                                             const Connection& connection, const RelaxOptions& options = {});
+
+// Relaxes `start` as above; throws trivcon::Error for an invalid prescription (as a design would), a pin out
+// of range, or a negative max_moves or cancel_distance. Polls trivcon/cancel.h once per candidate solve.
+RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start, const RelaxOptions& options = {});
+
+}  // namespace trivcon

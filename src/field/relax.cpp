@@ -1,0 +1,153 @@
+// Singularity relaxation (trivcon/relax.h): candidates ranked by the vertex duals, verified by real solves.
+#include "trivcon/relax.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "linalg/timing.h"
+#include "trivcon/cancel.h"
+#include "trivcon/error.h"
+
+namespace trivcon {
+
+namespace {
+
+// A move must lower the energy by more than this fraction of it.
+constexpr double kRelativeDecrease = 1e-12;
+
+std::vector<char> pinned_vertices(const Topology& t, const RelaxOptions& options) {
+  if (options.max_moves < 0) throw Error("relax: max_moves must be at least 0, not " + std::to_string(options.max_moves));
+  if (options.cancel_distance < 0) throw Error("relax: cancel_distance must be at least 0, not " + std::to_string(options.cancel_distance));
+  std::vector<char> pinned(t.num_vertices, 0);
+  for (int v : options.pins) {
+    if (v < 0 || v >= t.num_vertices)
+      throw Error("relax: pinned vertex " + std::to_string(v) + " out of range (mesh has " + std::to_string(t.num_vertices) + " vertices)");
+    pinned[v] = 1;
+  }
+  return pinned;
+}
+
+int index_at(const IndexPrescription& p, int v) {
+  const auto it = p.vertex.find(v);
+  return it == p.vertex.end() ? 0 : it->second;
+}
+
+void apply(const RelaxCandidate& move, IndexPrescription& p) {
+  p.vertex.erase(move.from);
+  if (move.cancels)
+    p.vertex.erase(move.to);
+  else
+    p.vertex[move.to] = move.index;
+}
+
+}  // namespace
+
+std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, const IndexPrescription& prescription,
+                                             const Connection& connection, const RelaxOptions& options) {
+  const Topology& t = designer.topology();
+  const std::vector<char> pinned = pinned_vertices(t, options);
+  const ConnectionSolver& solver = designer.solver();
+  const Eigen::VectorXd lambda = solver.vertex_duals(connection);
+  const Eigen::VectorXd& w = solver.weights();
+  // 1 / weighted degree: each vertex's share of the estimated resistance (trivcon/relax.h).
+  Eigen::VectorXd degree = Eigen::VectorXd::Zero(t.num_vertices);
+  for (int e = 0; e < t.num_edges; ++e) degree(t.edge_vertices(e, 0)) += w(e), degree(t.edge_vertices(e, 1)) += w(e);
+  auto spread = [&](int v) { return degree(v) > 0 ? 1 / degree(v) : 0.0; };
+  // The edges a cycle whose index each solve chooses crosses: free generators and fixed-face paths (a loop
+  // cycle only crosses edges with a boundary end, which no move takes).
+  std::vector<char> free_cycle_edge(t.num_edges, 0);
+  const Cycles& cycles = designer.cycles();
+  for (int g = 0; g < static_cast<int>(cycles.generators.size()); ++g)
+    if (!prescription.generator.count(g))
+      for (int e : cycles.generators[g].edges) free_cycle_edge[e] = 1;
+  for (const FixedPath& path : solver.fixed_paths())
+    for (int e : path.path.edges) free_cycle_edge[e] = 1;
+  const double step = 2 * kPi / prescription.N;
+  std::vector<RelaxCandidate> out;
+  auto add = [&](int v, int u, int n, int distance, bool cancels, int edge) {
+    const double c = step * n;
+    RelaxCandidate m;
+    m.from = v, m.to = u, m.index = n, m.distance = distance, m.cancels = cancels;
+    m.first_order = 2 * c * (lambda(v) - lambda(u));
+    // Across such an edge the move may carry the cycle's index along: δb = c s A e_e (s = +1 when v is the
+    // edge's larger id), whose first-order change is the edge's own 2 c s x_e / w_e.
+    if (edge >= 0 && free_cycle_edge[edge] && w(edge) > 0) {
+      const double s = t.edge_vertices(edge, 1) == v ? 1.0 : -1.0;
+      m.first_order = std::min(m.first_order, 2 * c * s * connection.x(edge) / w(edge));
+    }
+    const double resistance = (spread(v) + spread(u)) * (1 + std::sqrt(3.0) / kPi * std::log(static_cast<double>(distance)));
+    m.estimate = m.first_order + c * c * resistance;
+    out.push_back(m);
+  };
+  auto other_end = [&](int e, int v) { return t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0); };
+  std::vector<int> seen(t.num_vertices, -1), frontier, next;
+  for (auto [v, n] : prescription.vertex) {
+    if (n == 0 || pinned[v]) continue;
+    for (int a = t.vertex_edge_offsets[v]; a < t.vertex_edge_offsets[v + 1]; ++a) {
+      const int e = t.vertex_edges[a], u = other_end(e, v);
+      if (t.is_interior_vertex(u) && !pinned[u] && index_at(prescription, u) == 0) add(v, u, n, 1, false, e);
+    }
+    if (options.cancel_distance == 0) continue;
+    // Breadth-first to cancel_distance edges, for the vertices holding −n (each pair once, from its smaller vertex).
+    seen[v] = v;
+    frontier.assign(1, v);
+    for (int distance = 1; distance <= options.cancel_distance && !frontier.empty(); ++distance) {
+      next.clear();
+      for (int x : frontier)
+        for (int a = t.vertex_edge_offsets[x]; a < t.vertex_edge_offsets[x + 1]; ++a) {
+          const int u = other_end(t.vertex_edges[a], x);
+          if (seen[u] == v) continue;
+          seen[u] = v;
+          next.push_back(u);
+          if (u > v && !pinned[u] && index_at(prescription, u) == -n) add(v, u, n, distance, true, -1);
+        }
+      frontier.swap(next);
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const RelaxCandidate& a, const RelaxCandidate& b) {
+    if (a.estimate != b.estimate) return a.estimate < b.estimate;
+    return a.from != b.from ? a.from < b.from : a.to < b.to;
+  });
+  return out;
+}
+
+RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start, const RelaxOptions& options) {
+  const auto t0 = linalg::Clock::now();
+  pinned_vertices(designer.topology(), options);  // checks the options before the first solve
+  const ConnectionSolver& solver = designer.solver();
+  RelaxResult r;
+  r.prescription = start;
+  Connection current = solver.solve(start);
+  r.energy_before = current.energy;
+  r.energies.push_back(current.energy);
+  while (true) {
+    if (static_cast<int>(r.moves.size()) >= options.max_moves) break;
+    const std::vector<RelaxCandidate> candidates = relax_candidates(designer, r.prescription, current, options);
+    bool moved = false;
+    for (const RelaxCandidate& move : candidates) {
+      if (!(move.first_order < 0)) continue;  // ΔE = first order + c² R with R ≥ 0: cannot lower E
+      check_cancelled();
+      IndexPrescription p = r.prescription;
+      apply(move, p);
+      Connection next = solver.solve(p);
+      ++r.candidates_evaluated;
+      if (!(next.energy < current.energy - kRelativeDecrease * std::abs(current.energy))) continue;
+      r.prescription = std::move(p);
+      current = std::move(next);
+      r.moves.push_back({move.from, move.to, move.index, current.energy, move.cancels});
+      r.energies.push_back(current.energy);
+      moved = true;
+      break;
+    }
+    if (!moved) {
+      r.converged = true;
+      break;
+    }
+  }
+  r.energy_after = current.energy;
+  r.seconds = linalg::seconds_since(t0);
+  return r;
+}
+
+}  // namespace trivcon
