@@ -86,6 +86,7 @@ void run_param(const ParamCommand& o) {
                                      {"param", param_report(param)},
                                      {"seconds", {{"read", read_seconds}, {"write", seconds_since(t1)}}}};
     if (repair) report["repair"] = repair_summary_json(*repair);
+    if (out.relax_result) report["relax"] = relax_summary_json(*out.relax_result);
     for (size_t i = 0; i < param.cones.size(); ++i)
       report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
     staged.write(o.report, [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& s) { s << report.dump(2) << "\n"; }); });
@@ -95,6 +96,7 @@ void run_param(const ParamCommand& o) {
   if (!o.quiet)
     std::cout << "mesh " << o.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
               << " component(s), chi " << t.euler_characteristic() << ", " << t.boundary_loops.size() << " boundary loop(s)\n"
+              << (out.relax_result ? relax_summary_line(*out.relax_result) + "\n" : std::string())
               << "field: N 4, " << param.cones.size() << " singular vertices, verified\n"
               << "map: edge length " << fmt(param.edge_length) << ", " << fmt(q.unit_squares) << " unit squares (target " << fmt(q.target_squares)
               << "), " << q.cut_edges << " cut edges, " << q.integer_unknowns << " integers rounded in " << q.rounding_rounds << " solves\n"

@@ -241,6 +241,10 @@ void run_solve(const SolveOptions& o) {
       std::cout << "auto: smoothest field found " << r.found.size() << " singularities, " << r.coincident_removed
                 << " removed by summing over coincident vertices, cancelled " << r.pairs.size() << " pairs, using " << r.vertex.size() << "\n";
   }
+  if (out.relax_result) {
+    extra["relax"] = relax_summary_json(*out.relax_result);
+    if (!o.quiet) std::cout << relax_summary_line(*out.relax_result) << "\n";
+  }
   MeshData refined_mesh;
   if (request.split_large_turns) {
     nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
@@ -287,6 +291,7 @@ void register_solve(CLI::App& app) {
                       "outputs get the item's name ({name} in a path, or before the extension)");
   o.field.auto_flag->excludes(batch);
   o.field.from_field_option->excludes(batch);
+  o.field.relax_flag->excludes(batch);
   cmd->add_option("--field-out", o.out.field,
                   "Field file: .txt (x y z per face), .rawfield (Directional), .rosy (QuadWild, N = 4) or .ply");
   cmd->add_option(

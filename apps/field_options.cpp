@@ -59,6 +59,21 @@ void FieldOptions::add_to(CLI::App* cmd, bool fixed_N) {
                                       "Use the singularities of a per-face field (.txt, .ply or Directional's .rawfield, as `check` reads)");
   auto_flag->excludes(prescription.files_option)->excludes(prescription.sing_option)->excludes(from_field_option);
   from_field_option->excludes(prescription.files_option)->excludes(prescription.sing_option);
+  relax_flag = cmd->add_flag("--relax", relax,
+                             "Move the singularities (of -s, --sing, --auto or --sing-from-field) one edge at a time while the field's energy "
+                             "goes down, each move a real solve, until no single move lowers it; indices per component kept, boundary "
+                             "vertices never singular");
+  cmd->add_option("--relax-pin", relax_pins, "With --relax: this vertex keeps its index, and no singularity moves onto it (repeatable)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(relax_flag);
+  cmd->add_option("--relax-cancel", relax_cancel,
+                  "With --relax: a singularity may also move onto one of opposite index at most D edges away, both vanishing, when "
+                  "that lowers the energy (default 0: never)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(relax_flag);
+  cmd->add_option("--relax-max-moves", relax_max_moves, "With --relax: accepted moves at most (default 10000)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(relax_flag);
   cmd->add_option("--root-face", root_faces, "Face where propagation starts (one per component at most; repeatable)");
   cmd->add_option("--root-angle", root_angles, "Angle (radians, in the root face's frame) of the field at the matching --root-face");
   cmd->add_flag("--split-large-turns", split_large_turns,
@@ -95,6 +110,10 @@ FieldRequest FieldOptions::request(const FieldDesigner& designer, const Repaired
   r.auto_place = auto_place;
   r.auto_options.cancel_distance = auto_cancel;
   if (!align.empty()) r.auto_options.align_curvature = true, r.auto_options.curvature_t = *alignment_strength(align);  // checked by CLI11
+  r.relax = relax;
+  r.relax_options.pins = relax_pins;
+  r.relax_options.cancel_distance = relax_cancel;
+  r.relax_options.max_moves = relax_max_moves;
   r.split_large_turns = split_large_turns;
   if (repaired) move_request_to_repaired(r, designer.topology(), *repaired);
   if (!sing_from_field.empty()) {

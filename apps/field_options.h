@@ -26,9 +26,14 @@ struct FieldOptions {
   double auto_cancel = 0;   // --auto-cancel, in mean edge lengths
   std::string align;        // --align curvature[:t]
   std::string sing_from_field;
+  bool relax = false;              // --relax
+  std::vector<int> relax_pins;     // --relax-pin
+  int relax_cancel = 0;            // --relax-cancel, in edges
+  int relax_max_moves = 10000;     // --relax-max-moves
   bool split_large_turns = false;  // --split-large-turns
   CLI::Option* auto_flag = nullptr;
   CLI::Option* from_field_option = nullptr;
+  CLI::Option* relax_flag = nullptr;
 
   // Adds the options to `cmd` (-N among them unless `fixed_N`: `param` is for N = 4 only).
   void add_to(CLI::App* cmd, bool fixed_N = false);

@@ -1,5 +1,8 @@
 #include "summary.h"
 
+#include <iomanip>
+#include <sstream>
+
 namespace trivcon::cli {
 
 nlohmann::ordered_json mesh_summary(const std::string& path, const MeshData& mesh, const Topology& t, const Geometry& g) {
@@ -86,6 +89,35 @@ nlohmann::ordered_json repair_summary_json(const RepairedMesh& r) {
           {"unseparated_faces", r.unseparated_faces},
           {"split_vertices", split},
           {"appended_vertices", copies}};
+}
+
+nlohmann::ordered_json relax_summary_json(const RelaxResult& r) {
+  nlohmann::ordered_json moves = nlohmann::ordered_json::array();
+  int cancelled = 0;
+  for (const RelaxMove& m : r.moves) {
+    moves.push_back({{"from", m.from}, {"to", m.to}, {"index", m.index}, {"energy", m.energy}, {"cancelled", m.cancelled}});
+    cancelled += m.cancelled;
+  }
+  return {{"energy_before", r.energy_before},
+          {"energy_after", r.energy_after},
+          {"moves", moves},
+          {"cancelled_pairs", cancelled},
+          {"candidates_evaluated", r.candidates_evaluated},
+          {"converged", r.converged},
+          {"seconds", r.seconds}};
+}
+
+std::string relax_summary_line(const RelaxResult& r) {
+  int cancelled = 0;
+  for (const RelaxMove& m : r.moves) cancelled += m.cancelled;
+  std::ostringstream s;
+  s << std::setprecision(6) << "relax: energy " << r.energy_before << " -> " << r.energy_after;
+  if (r.energy_before > 0) s << std::setprecision(3) << " (" << 100 * (r.energy_after - r.energy_before) / r.energy_before << " %)";
+  s << std::setprecision(3) << ", " << r.moves.size() << " moves";
+  if (cancelled > 0) s << " (" << cancelled << " cancelling a pair)";
+  s << ", " << r.candidates_evaluated << " candidate solves, " << r.seconds << " s"
+    << (r.converged ? "" : " (stopped at --relax-max-moves: a move may still lower the energy)");
+  return s.str();
 }
 
 }  // namespace trivcon::cli

@@ -8,6 +8,7 @@
 #include "trivcon/cycles.h"
 #include "trivcon/geometry.h"
 #include "trivcon/io.h"
+#include "trivcon/relax.h"
 #include "trivcon/repair.h"
 #include "trivcon/topology.h"
 
@@ -19,6 +20,10 @@ nlohmann::ordered_json cycles_summary(const Topology& topology, const Geometry& 
 // appended (each with the input vertex it copies); ids at or above the input's vertex count in other entries
 // are those copies.
 nlohmann::ordered_json repair_summary_json(const RepairedMesh& repaired);
+// The "relax" entry of a report (trivcon/relax.h): energies, every move (vertex ids of the mesh solved on),
+// candidate solves, time; and its one-line summary.
+nlohmann::ordered_json relax_summary_json(const RelaxResult& relax);
+std::string relax_summary_line(const RelaxResult& relax);
 
 using Clock = std::chrono::steady_clock;
 inline double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }

@@ -23,6 +23,7 @@
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/features.h"
+#include "trivcon/relax.h"
 #include "trivcon/repair.h"
 #include "trivcon/split_large_turns.h"
 
@@ -38,6 +39,8 @@ struct FieldRequest {
   bool auto_place = false;               // the singularities of the smoothest field (auto_singularities)
   AutoOptions auto_options;              // its cancel distance, iterations, curvature guidance (N and fixed: the request's)
   std::vector<std::pair<int, double>> roots;  // (face, angle): where a component's field starts
+  bool relax = false;                    // move the vertex singularities downhill in the energy first (trivcon/relax.h)
+  RelaxOptions relax_options;            // its pins, moves at most, cancellations
   bool split_large_turns = false;        // refine where the connection turns by π/N or more (split_large_turns.h)
   int max_split_rounds = 8;
   bool features_given() const { return feature_degrees.has_value() || !feature_edges.empty(); }
@@ -72,6 +75,7 @@ struct FieldOutcome {
   Design design;                          // on the final mesh
   bool verified = false;                  // design_verified(design)
   std::optional<AutoResult> auto_result;  // with auto_place
+  std::optional<RelaxResult> relax_result;  // with relax: its prescription is the one designed (on the input mesh)
   // With split_large_turns: the refined mesh (refined == nullptr when no round was needed: the input's).
   std::unique_ptr<FieldDesigner> refined;
   MatrixX3d V;                            // the refined mesh (empty without one)
@@ -85,13 +89,13 @@ struct FieldOutcome {
 
 // A request stated in the input file's ids (vertices, faces, edges between input vertices), moved onto its repair
 // (trivcon/repair.h) whose topology is `topology`: singular vertices keep their ids (a split one is an error,
-// repaired_vertex), roots go to face_of_input, and a listed feature edge between two input vertices marks every
+// repaired_vertex), relaxation pins hold every copy of their vertex, roots go to face_of_input, and a listed feature edge between two input vertices marks every
 // copy of it (the sheets of a cut edge each get theirs). Fixed directions are not here: their angles are in a
 // face's frame, so they are read onto the repaired mesh's faces directly (read_fixed_directions's face map).
 // Throws trivcon::Error for an id out of the input's range.
 void move_request_to_repaired(FieldRequest& request, const Topology& topology, const RepairedMesh& repaired);
 
-// The whole request: constraints, set-up (set_fixed_faces, only when they changed), auto placement,
+// The whole request: constraints, set-up (set_fixed_faces, only when they changed), auto placement, relaxation,
 // validation (check_aligned_index_sums, validate_prescription: the CLI's messages), design, splitting.
 // `F` is the faces `designer` was built from, as given (for split_large_turns). Throws trivcon::Error.
 FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const FieldRequest& request);

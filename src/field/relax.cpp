@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
 #include <string>
 
 #include "linalg/timing.h"
@@ -116,22 +118,40 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
   const auto t0 = linalg::Clock::now();
   pinned_vertices(designer.topology(), options);  // checks the options before the first solve
   const ConnectionSolver& solver = designer.solver();
+  const double step = 2 * kPi / start.N;
   RelaxResult r;
   r.prescription = start;
   Connection current = solver.solve(start);
   r.energy_before = current.energy;
   r.energies.push_back(current.energy);
-  while (true) {
-    if (static_cast<int>(r.moves.size()) >= options.max_moves) break;
-    const std::vector<RelaxCandidate> candidates = relax_candidates(designer, r.prescription, current, options);
+  // The second-order term of a move, measured by its real solve: (ΔE − first order) / c². With the cycle
+  // indices held it is R_vu exactly, a property of the mesh and not of the placement, so a move solved once is
+  // ranked exactly ever after (keyed by its unordered pair of vertices; a cancellation has its own entry).
+  std::map<std::pair<int, int>, double> measured;
+  auto key = [](const RelaxCandidate& m) { return std::make_pair(std::min(m.from, m.to), std::max(m.from, m.to)); };
+  // A candidate whose measured estimate is not negative is not solved again, except in the check before
+  // stopping: only a full pass that solves every candidate with a negative first order ends the search.
+  bool checking = false;
+  while (static_cast<int>(r.moves.size()) < options.max_moves) {
+    std::vector<RelaxCandidate> candidates = relax_candidates(designer, r.prescription, current, options);
+    for (RelaxCandidate& m : candidates)
+      if (const auto it = measured.find(key(m)); it != measured.end()) {
+        const double c = step * m.index;
+        m.estimate = m.first_order + c * c * it->second;
+      }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const RelaxCandidate& a, const RelaxCandidate& b) { return a.estimate < b.estimate; });
     bool moved = false;
     for (const RelaxCandidate& move : candidates) {
       if (!(move.first_order < 0)) continue;  // ΔE = first order + c² R with R ≥ 0: cannot lower E
+      if (!checking && !(move.estimate < 0) && measured.count(key(move))) continue;
       check_cancelled();
       IndexPrescription p = r.prescription;
       apply(move, p);
       Connection next = solver.solve(p);
       ++r.candidates_evaluated;
+      const double c = step * move.index;
+      measured[key(move)] = std::max(0.0, (next.energy - current.energy - move.first_order) / (c * c));
       if (!(next.energy < current.energy - kRelativeDecrease * std::abs(current.energy))) continue;
       r.prescription = std::move(p);
       current = std::move(next);
@@ -140,7 +160,11 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
       moved = true;
       break;
     }
-    if (!moved) {
+    if (moved) {
+      checking = false;
+    } else if (!checking) {
+      checking = true;  // nothing found among the unmeasured and the promising: solve every candidate once more
+    } else {
       r.converged = true;
       break;
     }

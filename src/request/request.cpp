@@ -93,6 +93,14 @@ AutoResult request_auto(const FieldDesigner& designer, const FieldRequest& reque
 void move_request_to_repaired(FieldRequest& r, const Topology& t, const RepairedMesh& repaired) {
   r.prescription.vertex = singularities_on_repaired(repaired, r.prescription.vertex);
   for (auto& [f, angle] : r.roots) f = repaired_face(repaired, f, "root face");
+  std::vector<int> pins;
+  for (int v : r.relax_options.pins) {
+    if (v < 0 || v >= repaired.input_vertices)
+      throw Error("relax: pinned vertex " + std::to_string(v) + " out of range (the mesh has " + std::to_string(repaired.input_vertices) +
+                  " vertices)");
+    for (int copy : vertex_copies(repaired, v)) pins.push_back(copy);
+  }
+  r.relax_options.pins = std::move(pins);
   std::vector<int> edges;
   for (int e : r.feature_edges) {  // given as the repaired topology's edge between the input ids' vertices
     if (e < 0 || e >= t.num_edges) {
@@ -125,6 +133,10 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
   if (request.auto_place) {
     out.auto_result = request_auto(designer, request, out.constraints);
     p.vertex = out.auto_result->vertex;
+  }
+  if (request.relax) {
+    out.relax_result = relax(designer, p, request.relax_options);
+    p = out.relax_result->prescription;
   }
   if (!request.split_large_turns) {
     out.design = request_design(designer, p, request.roots, out.auto_result ? &out.auto_result->field : nullptr);
