@@ -965,7 +965,8 @@ PYBIND11_MODULE(_core, m) {
           [](const DesignerPtr& s, int N, std::optional<std::map<int, int>> vertex, std::map<int, int> generator, std::map<int, int> loop,
              std::map<int, double> fixed, bool align_boundary, std::optional<double> feature_degrees,
              std::vector<std::pair<int, int>> feature_edges, std::vector<std::pair<int, double>> roots, double auto_cancel, bool auto_cancel_absolute, int auto_iterations,
-             std::optional<double> curvature_t, bool split, int max_rounds) {
+             std::optional<double> curvature_t, bool split, int max_rounds, bool relax, std::vector<int> relax_pins, int relax_cancel,
+             int relax_max_moves) {
             // The library's request layer (trivcon/request.h) does the work; here only the conversion.
             FieldRequest q;
             q.prescription.N = N;
@@ -991,6 +992,10 @@ PYBIND11_MODULE(_core, m) {
             if (curvature_t) q.auto_options.align_curvature = true, q.auto_options.curvature_t = *curvature_t;
             q.split_large_turns = split;
             q.max_split_rounds = max_rounds;
+            q.relax = relax;
+            q.relax_options.pins = std::move(relax_pins);
+            q.relax_options.cancel_distance = relax_cancel;
+            q.relax_options.max_moves = relax_max_moves;
             struct Out {
               DesignerPtr designer;
               DesignResultPtr result;
@@ -999,6 +1004,7 @@ PYBIND11_MODULE(_core, m) {
               std::vector<RefineRound> rounds;
               bool converged = true;
               std::vector<int> sharp;
+              std::optional<RelaxResult> relaxed;
             };
             Out out = interruptible(s->threads, [s, q = std::move(q)] {
               Out o;
@@ -1031,6 +1037,7 @@ PYBIND11_MODULE(_core, m) {
               o.rounds = std::move(r.rounds);
               o.converged = r.split_converged;
               o.sharp = std::move(r.sharp_edges);
+              o.relaxed = std::move(r.relax_result);
               return o;
             });
             py::list round_list;
@@ -1044,13 +1051,31 @@ PYBIND11_MODULE(_core, m) {
             Int64Array sharp({static_cast<py::ssize_t>(out.sharp.size()), static_cast<py::ssize_t>(2)});
             auto S = sharp.mutable_unchecked<2>();
             for (size_t k = 0; k < out.sharp.size(); ++k) S(k, 0) = t.edge_vertices(out.sharp[k], 0), S(k, 1) = t.edge_vertices(out.sharp[k], 1);
-            return py::make_tuple(out.designer, out.result, auto_out, int64_vector(out.parent), round_list, out.converged, sharp);
+            py::object relaxed = py::none();
+            if (out.relaxed) {  // the moves as arrays: from, to, n (index n / N), energy after, cancelled
+              const RelaxResult& x = *out.relaxed;
+              const std::vector<RelaxMove>& m = x.moves;
+              std::vector<int> from(m.size()), to(m.size()), n(m.size());
+              std::vector<bool> cancelled(m.size());
+              for (size_t k = 0; k < m.size(); ++k) from[k] = m[k].from, to[k] = m[k].to, n[k] = m[k].index, cancelled[k] = m[k].cancelled;
+              py::dict d;
+              d["vertex"] = x.prescription.vertex;
+              d["energy_before"] = x.energy_before, d["energy_after"] = x.energy_after;
+              d["energies"] = py::array_t<double>(static_cast<py::ssize_t>(x.energies.size()), x.energies.data());
+              d["from"] = int64_vector(from), d["to"] = int64_vector(to), d["index"] = int64_vector(n);
+              d["cancelled"] = py::array_t<bool>(py::cast(cancelled));
+              d["candidates_evaluated"] = x.candidates_evaluated, d["converged"] = x.converged, d["seconds"] = x.seconds;
+              relaxed = d;
+            }
+            return py::make_tuple(out.designer, out.result, auto_out, int64_vector(out.parent), round_list, out.converged, sharp, relaxed);
           },
           py::arg("N"), py::arg("vertex"), py::arg("generator"), py::arg("loop"), py::arg("fixed"), py::arg("align_boundary"),
           py::arg("feature_degrees"), py::arg("feature_edges"), py::arg("roots"), py::arg("auto_cancel"), py::arg("auto_cancel_absolute"),
-          py::arg("auto_iterations"), py::arg("curvature_t"), py::arg("split"), py::arg("max_rounds"),
+          py::arg("auto_iterations"), py::arg("curvature_t"), py::arg("split"), py::arg("max_rounds"), py::arg("relax") = false,
+          py::arg("relax_pins") = std::vector<int>{}, py::arg("relax_cancel") = 0, py::arg("relax_max_moves") = 10000,
           "One field request (trivcon/request.h; vertex None: the smoothest field's singularities): (designer of the final mesh, "
-          "DesignResult, AutoResult or None, parent face of each face (with split), rounds, converged, sharp edges).")
+          "DesignResult, AutoResult or None, parent face of each face (with split), rounds, converged, sharp edges, relaxation "
+          "as a dict or None).")
       .def(
           "sharp_edges",
           [](const DesignerPtr& s, double degrees) {

@@ -68,6 +68,7 @@ __all__ = [
     "FieldDesigner",
     "Result",
     "AutoResult",
+    "RelaxResult",
     "Parametrization",
     "read_mesh",
     "write_mesh",
@@ -817,7 +818,7 @@ class FieldDesigner(_Cached):
 
     def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False,
               align_features=None, feature_edges=None, roots=None, auto_cancel=0.0, align_curvature=None,
-              split_large_turns=False, max_rounds=8):
+              split_large_turns=False, max_rounds=8, relax=False, relax_pins=None, relax_cancel=0, relax_max_moves=10000):
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
@@ -840,6 +841,13 @@ class FieldDesigner(_Cached):
           --features file). Result.sharp_edges lists the edges followed.
         roots: {face: angle}: where the field's propagation starts per component (default: each
           component's smallest face, angle 0; a component with fixed faces starts at its smallest one).
+
+        relax: first move the vertex singularities (given, or "auto"'s) one edge at a time downhill in the
+          field's energy, each move a real solve, until no single move lowers it (as solve --relax;
+          trivcon/relax.h): indices per component kept, boundary vertices never singular; relax_pins: vertices
+          that keep their index (none moves away or onto them); relax_cancel: an index may also move onto an
+          opposite one at most this many edges away, both vanishing (0: never); relax_max_moves: accepted
+          moves at most. Result.relax is then a RelaxResult (energies, moves); the field is the relaxed one.
 
         split_large_turns: refine the mesh where the connection turns by pi/N or more and solve again
           with the same vertex singularities, at most max_rounds times, until no edge does (trivcon
@@ -895,15 +903,28 @@ class FieldDesigner(_Cached):
                 raise Error("split_large_turns splits edges, which feature_edges names: use align_features instead")
             if isinstance(max_rounds, bool) or not isinstance(max_rounds, _numbers.Integral) or max_rounds < 0:
                 raise Error(f"max_rounds must be a whole number >= 0, not {max_rounds!r}")
-        core, r, a, parent, rounds, converged, sharp = self._d.solve_request(
+        pins = []
+        if relax_pins is not None:
+            pin_array = _array(relax_pins, "relax_pins").reshape(-1)
+            if pin_array.size and pin_array.dtype.kind not in "iu":
+                raise Error(f"relax_pins: expected vertex ids (integers), got an array of type {pin_array.dtype}")
+            pins = [_id(int(v), "relax_pins") for v in pin_array]
+        for name, value in (("relax_cancel", relax_cancel), ("relax_max_moves", relax_max_moves)):
+            if isinstance(value, bool) or not isinstance(value, _numbers.Integral) or value < 0:
+                raise Error(f"{name} must be a whole number >= 0, not {value!r}")
+        if not relax and (pins or relax_cancel or relax_max_moves != 10000):
+            raise Error("relax_pins, relax_cancel and relax_max_moves need relax=True")
+        core, r, a, parent, rounds, converged, sharp, relaxed = self._d.solve_request(
             N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), explicit, bool(align_boundary),
-            degrees, edge_pairs, root_list, cancel, False, 8, curvature_t, bool(split_large_turns), int(max_rounds))
+            degrees, edge_pairs, root_list, cancel, False, 8, curvature_t, bool(split_large_turns), int(max_rounds),
+            bool(relax), pins, int(relax_cancel), int(relax_max_moves))
         auto = AutoResult(a, self) if a is not None else None
         designer = self if core is self._d else FieldDesigner._of_core(core, self)
         result = Result(designer, r, auto)
         result._align_boundary = bool(align_boundary)
         if degrees is not None or edge_pairs:
             result.sharp_edges = _frozen(sharp)
+        result.relax = RelaxResult(relaxed, N) if relaxed is not None else None
         if split_large_turns:
             result.parent_face = _frozen(parent)
             result.split_rounds = rounds
@@ -928,6 +949,21 @@ class FieldDesigner(_Cached):
         fixed_angles = self._fixed(fixed, align_boundary)
         return AutoResult(self._d.auto_singularities(N, int(iterations), cancel, bool(cancel_absolute), fixed_angles,
                                                      curvature_t is not None, curvature_t or 0.0), self)
+
+    def relax(self, singularities, N=1, pins=None, max_moves=10000, cancel_distance=0, generators=None, boundary=None, fixed=None,
+              align_boundary=False, align_features=None, feature_edges=None, auto_cancel=0.0):
+        """Singularities moved downhill in the field's own energy (trivcon/relax.h): a RelaxResult.
+
+        singularities: as in solve (or "auto", with auto_cancel); pins, max_moves, cancel_distance: see solve's
+        relax_pins, relax_max_moves, relax_cancel; generators, boundary, fixed, align_boundary, align_features,
+        feature_edges as in solve. RelaxResult.singularities go straight into solve; RelaxResult.result is the
+        field of the relaxed placement, already solved.
+        """
+        result = self.solve(N, singularities, generators=generators, boundary=boundary, fixed=fixed, align_boundary=align_boundary,
+                            align_features=align_features, feature_edges=feature_edges, auto_cancel=auto_cancel, relax=True,
+                            relax_pins=pins, relax_cancel=cancel_distance, relax_max_moves=max_moves)
+        result.relax.result = result
+        return result.relax
 
     def field_indices(self, directions, N=1, arrays=False):
         """{vertex: Fraction} of a per-face field (m, 3) on this mesh (as trivcon.field_indices); with
@@ -1007,7 +1043,7 @@ class Result(_Cached):
 
     def __getstate__(self):
         state = {"designer": self._designer, "core": self._r.get_state(), "auto": self.auto}
-        for key in ("parent_face", "split_rounds", "split_converged", "sharp_edges", "_align_boundary"):
+        for key in ("parent_face", "split_rounds", "split_converged", "sharp_edges", "_align_boundary", "relax"):
             if key in self.__dict__:
                 state[key] = self.__dict__[key]
         return state
@@ -1017,6 +1053,7 @@ class Result(_Cached):
         self._r = _core.DesignResult.restore(self._designer._d, state["core"])
         self.auto = state["auto"]
         self._cache = {}
+        self.relax = state.get("relax")
         if "sharp_edges" in state:
             self.sharp_edges = state["sharp_edges"]
         if "_align_boundary" in state:
@@ -1279,6 +1316,52 @@ class Result(_Cached):
         prescribed (as `trivcon solve --png`)."""
         args = _render_args(size, view, up, style, spacing, flat, legend, supersampling)
         return self._r.render(_singular_pairs(singularities, self.N), args)
+
+
+class RelaxResult:
+    """Singularities relaxed (FieldDesigner.relax, or solve(..., relax=True) as Result.relax).
+
+      singularities  {vertex: Fraction}: the relaxed placement (goes straight into solve(singularities=...));
+                     singularity_arrays the same as (vertices, numerators) int64 arrays
+      energy_before, energy_after   the field's energy (sum of x^2 / w) at the start and at the end
+      energies       float64 (k + 1,): energy_before, then after each move, strictly decreasing
+      moves          dict of arrays, one entry per accepted move in order: "from", "to" (int64 vertices),
+                     "index" (int64 n of the index n / N moved), "energy" (float64, after it), "cancelled"
+                     (bool: "to" held the opposite index and both vanished)
+      candidates_evaluated  real solves of candidate moves; converged: stopped because no single move lowers
+                     the energy (False: stopped at max_moves); seconds
+      result         the Result of the relaxed field (set by FieldDesigner.relax; None inside a Result)
+    """
+
+    def __init__(self, d, N):
+        self.N = N
+        self._vertex = {int(k): int(v) for k, v in d["vertex"].items()}
+        self.energy_before, self.energy_after = d["energy_before"], d["energy_after"]
+        self.energies = _frozen(_np.asarray(d["energies"], dtype=_np.float64))
+        self.moves = {"from": _frozen(d["from"]), "to": _frozen(d["to"]), "index": _frozen(d["index"]),
+                      "energy": _frozen(_np.asarray(d["energies"], dtype=_np.float64)[1:].copy()),
+                      "cancelled": _frozen(_np.asarray(d["cancelled"], dtype=bool))}
+        self.candidates_evaluated, self.converged, self.seconds = d["candidates_evaluated"], d["converged"], d["seconds"]
+        self.result = None
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state["result"] = None  # the Result pickles this one, not the other way round
+        return state
+
+    @property
+    def singularities(self):
+        """{vertex: Fraction}: the relaxed placement."""
+        return _fractions(self._vertex, self.N)
+
+    @property
+    def singularity_arrays(self):
+        """(vertices, numerators): `singularities` as two int64 arrays sorted by vertex, index = numerator / N."""
+        return _pair_arrays(self._vertex)
+
+    def __repr__(self):
+        return (f"<trivcon.RelaxResult: energy {self.energy_before:.6g} -> {self.energy_after:.6g}, {len(self.moves['from'])} moves, "
+                f"{int(self.moves['cancelled'].sum())} cancelling a pair, converged={self.converged}>")
 
 
 class Parametrization:

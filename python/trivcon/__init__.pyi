@@ -149,7 +149,26 @@ class FieldDesigner:
         align_curvature: Optional[float] = ...,
         split_large_turns: bool = ...,
         max_rounds: int = ...,
+        relax: bool = ...,
+        relax_pins: Optional[npt.ArrayLike] = ...,
+        relax_cancel: int = ...,
+        relax_max_moves: int = ...,
     ) -> Result: ...
+    def relax(
+        self,
+        singularities: Union[_Indices, Literal["auto"]],
+        N: int = ...,
+        pins: Optional[npt.ArrayLike] = ...,
+        max_moves: int = ...,
+        cancel_distance: int = ...,
+        generators: Optional[_Indices] = ...,
+        boundary: Optional[_Indices] = ...,
+        fixed: Union[Mapping[int, _Direction], Iterable[Tuple[int, _Direction]], None] = ...,
+        align_boundary: bool = ...,
+        align_features: Optional[float] = ...,
+        feature_edges: Optional[npt.ArrayLike] = ...,
+        auto_cancel: float = ...,
+    ) -> RelaxResult: ...
     def auto_singularities(
         self,
         N: int = ...,
@@ -170,6 +189,7 @@ class FieldDesigner:
 
 class Result:
     auto: Optional[AutoResult]
+    relax: Optional[RelaxResult]
     # Only after solve(split_large_turns=True):
     parent_face: _IntArray
     sharp_edges: _IntArray
@@ -287,6 +307,22 @@ class Parametrization:
     @property
     def seamless(self) -> bool: ...
     def write_obj(self, path: _Path) -> None: ...
+
+class RelaxResult:
+    def __init__(self, d: Mapping[str, Any], N: int) -> None: ...
+    N: int
+    energy_before: float
+    energy_after: float
+    energies: _FloatArray
+    moves: Dict[str, npt.NDArray[Any]]
+    candidates_evaluated: int
+    converged: bool
+    seconds: float
+    result: Optional[Result]
+    @property
+    def singularities(self) -> Dict[int, Fraction]: ...
+    @property
+    def singularity_arrays(self) -> _IndexArrays: ...
 
 class AutoResult:
     def __init__(self, a: Any, designer: Optional[FieldDesigner] = ...) -> None: ...
