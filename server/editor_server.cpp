@@ -32,6 +32,8 @@
 #include "report.h"
 #include "summary.h"
 #include "trivcon/auto.h"
+#include "trivcon/cancel.h"
+#include "trivcon/relax.h"
 #include "trivcon/request.h"
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
@@ -480,6 +482,8 @@ struct EditorServer::Impl {
   int port = -1;
   std::atomic<bool> bound{false};
   std::atomic<bool> stopping{false};
+  // Set with `stopping`: long work (a relaxation) polls it and ends at once (trivcon/cancel.h).
+  CancelFlag stop_flag = std::make_shared<std::atomic<bool>>(false);
   const Limits limits{seconds(options.header_seconds), seconds(options.body_seconds), seconds(options.io_idle_seconds),
                       seconds(options.keep_alive_seconds), options.max_body_bytes};
   Http http{limits, stopping, options.max_connections};
@@ -547,7 +551,8 @@ struct EditorServer::Impl {
             {"align_features", r.field.feature_degrees ? ojson(*r.field.feature_degrees) : ojson(nullptr)}};
   }
 
-  Request parse_request(const std::string& body_text) const {
+  // `parsed`: the body's JSON too, for the keys of one endpoint.
+  Request parse_request(const std::string& body_text, json* parsed = nullptr) const {
     json body;
     try {
       body = json::parse(body_text, [](int depth, json::parse_event_t, json&) {
@@ -567,6 +572,7 @@ struct EditorServer::Impl {
       throw BadRequest{400, std::string("the request body is not valid JSON: ") + e.what()};
     }
     if (!body.is_object()) throw BadRequest{400, "the request body must be a JSON object, got " + std::string(body.type_name())};
+    if (parsed) *parsed = body;
     Request r;
     IndexPrescription& p = r.field.prescription;
     p.N = options.initial.N;
@@ -897,7 +903,7 @@ struct EditorServer::Impl {
         return refuse(res, 400, "a " + req.method + " request has no body", true);
       return httplib::Server::HandlerResponse::Unhandled;
     }
-    static const std::vector<std::string> posts = {"/api/solve", "/api/auto", "/api/export", "/api/streamlines"};
+    static const std::vector<std::string> posts = {"/api/solve", "/api/auto", "/api/relax", "/api/export", "/api/streamlines"};
     if (std::find(posts.begin(), posts.end(), req.path) == posts.end())
       return refuse(res, 404, "no such endpoint (see README.md, Editor)", has_body);
     // A form of any web page can POST text/plain, form data or multipart without asking; only a script of the
@@ -1151,6 +1157,62 @@ struct EditorServer::Impl {
                 ojson out = {{"N", N}, {"singularities", sing}, {"found", a.found.size()}, {"cancelled_pairs", a.pairs.size()}};
                 res.set_content(out.dump() + "\n", kJson);
               }));
+    http.Post("/api/relax", api_post([this](const httplib::Request&, const std::string& text, httplib::Response& res) {
+                json body;
+                const Request r = parse_request(text, &body);
+                RelaxOptions o;
+                o.max_seconds = options.relax_seconds;
+                if (body.contains("pins")) {
+                  const json& pins = body["pins"];
+                  if (!pins.is_array()) throw BadRequest{400, "pins: expected a list of vertex ids, got " + brief(pins)};
+                  for (size_t i = 0; i < pins.size(); ++i) {
+                    const json& v = pins[i];
+                    if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<int64_t>() >= designer->topology().num_vertices)
+                      throw BadRequest{400, "pins[" + std::to_string(i) + "]: expected a vertex id from 0 to " +
+                                                std::to_string(designer->topology().num_vertices - 1) + ", got " + brief(v)};
+                    o.pins.push_back(v.get<int>());
+                  }
+                }
+                auto count = [&](const char* key, int& out, int largest) {
+                  if (!body.contains(key)) return;
+                  const json& c = body[key];
+                  if (!c.is_number_integer() || c.get<int64_t>() < 0 || c.get<int64_t>() > largest)
+                    throw BadRequest{400, std::string(key) + ": expected a whole number from 0 to " + std::to_string(largest) + ", got " +
+                                              brief(c)};
+                  out = c.get<int>();
+                };
+                count("relax_cancel", o.cancel_distance, 1000);
+                count("max_moves", o.max_moves, 1000000);
+                try {
+                  validate_prescription(designer->topology(), num_generators(), r.prescription);
+                } catch (const Error& e) {
+                  throw BadRequest{400, e.what()};
+                }
+                RelaxResult x;
+                {
+                  CancelScope scope(stop_flag);  // SIGTERM ends it between two solves
+                  try {
+                    x = with_designer(r.fixed_faces, [&](const FieldDesigner& d) { return relax(d, r.prescription, o); });
+                  } catch (const Cancelled&) {
+                    throw BadRequest{503, "the editor is stopping"};
+                  }
+                }
+                const int N = r.prescription.N;
+                ojson sing = ojson::array(), moves = ojson::array();
+                for (auto [v, n] : x.prescription.vertex) sing.push_back({v, format_index(n, N)});
+                for (const RelaxMove& m : x.moves) moves.push_back({{"from", m.from}, {"to", m.to}, {"index", format_index(m.index, N)},
+                                                                     {"energy", m.energy}, {"cancelled", m.cancelled}});
+                ojson out = {{"N", N},
+                             {"singularities", sing},
+                             {"moves", moves},
+                             {"energy_before", x.energy_before},
+                             {"energy_after", x.energy_after},
+                             {"candidates_evaluated", x.candidates_evaluated},
+                             {"converged", x.converged},
+                             {"out_of_time", x.out_of_time},
+                             {"seconds", x.seconds}};
+                res.set_content(out.dump() + "\n", kJson);
+              }));
     http.Post("/api/export", api_post([this](const httplib::Request& req, const std::string& body, httplib::Response& res) {
                 const std::string format = req.has_param("format") ? req.get_param_value("format") : "txt";
                 check_format(req, {"txt", "rawfield", "ply", "sing"});
@@ -1230,6 +1292,7 @@ int EditorServer::bind(int port) {
 bool EditorServer::run() { return impl_->http.listen_after_bind(); }
 void EditorServer::stop() {
   impl_->stopping = true;  // first: the connections' waits end at once
+  impl_->stop_flag->store(true);
   if (impl_->bound) impl_->http.stop();
 }
 bool EditorServer::running() const { return impl_->http.is_running(); }

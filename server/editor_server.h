@@ -45,6 +45,7 @@ struct EditorOptions {
   // end). A request's line and headers must arrive within header_seconds of its first byte, its body within
   // body_seconds after them; a read or write that makes no progress for io_idle_seconds fails; an idle
   // keep-alive connection is closed after keep_alive_seconds.
+  double relax_seconds = 20;  // POST /api/relax stops after about this long, with the moves made so far
   int max_connections = 128;
   double header_seconds = 10;
   double body_seconds = 60;

@@ -42,6 +42,7 @@ struct RelaxOptions {
   std::vector<int> pins;    // vertices that keep their index (none moves away, none arrives)
   int max_moves = 10000;    // accepted moves at most (≥ 0)
   int cancel_distance = 0;  // > 0: an index n may meet a −n at most this many edges away, both vanishing; 0: never
+  double max_seconds = 0;   // > 0: stop after about this long (checked between solves), with the moves made so far
 };
 
 struct RelaxMove {
@@ -57,7 +58,8 @@ struct RelaxResult {
   std::vector<RelaxMove> moves;
   std::vector<double> energies;  // energy_before, then after each move: strictly decreasing
   int candidates_evaluated = 0;  // real solves of candidate moves
-  bool converged = false;        // stopped because no candidate lowers the energy (not at max_moves)
+  bool converged = false;        // stopped because no candidate lowers the energy (not at max_moves or max_seconds)
+  bool out_of_time = false;      // stopped at max_seconds
   double seconds = 0;
 };
 
@@ -79,7 +81,7 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
                                              const Connection& connection, const RelaxOptions& options = {});
 
 // Relaxes `start` as above; throws trivcon::Error for an invalid prescription (as a design would), a pin out
-// of range, or a negative max_moves or cancel_distance. Polls trivcon/cancel.h once per candidate solve.
+// of range, or a negative max_moves, cancel_distance or max_seconds. Polls trivcon/cancel.h once per candidate solve.
 RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start, const RelaxOptions& options = {});
 
 }  // namespace trivcon

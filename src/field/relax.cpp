@@ -21,6 +21,7 @@ constexpr double kRelativeDecrease = 1e-12;
 std::vector<char> pinned_vertices(const Topology& t, const RelaxOptions& options) {
   if (options.max_moves < 0) throw Error("relax: max_moves must be at least 0, not " + std::to_string(options.max_moves));
   if (options.cancel_distance < 0) throw Error("relax: cancel_distance must be at least 0, not " + std::to_string(options.cancel_distance));
+  if (!(options.max_seconds >= 0)) throw Error("relax: max_seconds must be at least 0");
   std::vector<char> pinned(t.num_vertices, 0);
   for (int v : options.pins) {
     if (v < 0 || v >= t.num_vertices)
@@ -146,6 +147,10 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
       if (!(move.first_order < 0)) continue;  // ΔE = first order + c² R with R ≥ 0: cannot lower E
       if (!checking && !(move.estimate < 0) && measured.count(key(move))) continue;
       check_cancelled();
+      if (options.max_seconds > 0 && linalg::seconds_since(t0) > options.max_seconds) {
+        r.out_of_time = true;
+        break;
+      }
       IndexPrescription p = r.prescription;
       apply(move, p);
       Connection next = solver.solve(p);
@@ -160,6 +165,7 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
       moved = true;
       break;
     }
+    if (r.out_of_time) break;
     if (moved) {
       checking = false;
     } else if (!checking) {

@@ -104,6 +104,13 @@ export async function autoPlace(body) {
   return res.json();
 }
 
+// Relaxation: {singularities, moves: [{from, to, index, energy, cancelled}], energy_before, energy_after, ...}.
+export async function relax(body) {
+  const res = await post('/api/relax', body);
+  if (!res.ok) await fail(res);
+  return res.json();
+}
+
 export async function streamlines(body) {
   const res = await post('/api/streamlines', body);
   if (!res.ok) await fail(res);

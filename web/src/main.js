@@ -17,12 +17,16 @@ meshPromise?.catch(() => {});
 statePromise?.catch(() => {});
 
 // --- the session ---------------------------------------------------------------------------------
-// n are integers meaning n/N (as in trivcon/indices.h); fixed directions are world vectors.
+// n are integers meaning n/N (as in trivcon/indices.h); fixed directions are world vectors; pins are singular
+// vertices that relaxation leaves where they are.
 function emptySession(N) {
-  return { N, sings: new Map(), gens: new Map(), loops: new Map(), fixed: new Map(), align: false };
+  return { N, sings: new Map(), gens: new Map(), loops: new Map(), fixed: new Map(), align: false, pins: new Set() };
 }
 function cloneSession(s) {
-  return { N: s.N, sings: new Map(s.sings), gens: new Map(s.gens), loops: new Map(s.loops), fixed: new Map(s.fixed), align: s.align };
+  return {
+    N: s.N, sings: new Map(s.sings), gens: new Map(s.gens), loops: new Map(s.loops), fixed: new Map(s.fixed), align: s.align,
+    pins: new Set(s.pins),
+  };
 }
 function requestBody(s) {
   const pairs = (m) => [...m].sort((a, b) => a[0] - b[0]).map(([id, n]) => [id, formatIndex(n, s.N)]);
@@ -33,6 +37,7 @@ function requestBody(s) {
     boundary: pairs(s.loops),
     fixed: [...s.fixed].sort((a, b) => a[0] - b[0]).map(([f, d]) => [f, d]),
     align_boundary: s.align,
+    pins: [...s.pins].filter((v) => s.sings.has(v)).sort((a, b) => a - b),
   };
 }
 function sessionFromRequest(r, fallbackN) {
@@ -50,6 +55,7 @@ function sessionFromRequest(r, fallbackN) {
   fill(s.loops, r.boundary);
   for (const [f, d] of r.fixed || []) s.fixed.set(f, d);
   s.align = !!r.align_boundary;
+  for (const v of r.pins || []) if (s.sings.has(v)) s.pins.add(v);
   return s;
 }
 
@@ -261,6 +267,10 @@ function buildMesh() {
 
 // --- singularity markers, fixed arrows, highlights ------------------------------------------------
 const sphereGeometry = new THREE.SphereGeometry(1, 16, 12);
+// A pinned singularity: a cube with dark edges instead of a ball.
+const pinGeometry = new THREE.BoxGeometry(1.5, 1.5, 1.5);
+const pinEdges = new THREE.EdgesGeometry(pinGeometry);
+const pinEdgeMaterial = new THREE.LineBasicMaterial({ color: 0x202020 });
 function markerColor(n, N) {
   const t = Math.min(1, Math.abs(n) / N);
   return n > 0 ? new THREE.Color().setHSL(0.02 + 0.1 * (1 - t), 0.9, 0.5) : new THREE.Color().setHSL(0.6 - 0.1 * (1 - t), 0.85, 0.5);
@@ -269,9 +279,11 @@ function rebuildMarkers() {
   markers.clear();
   const p = mesh.positions;
   for (const [v, n] of session.sings) {
-    const m = new THREE.Mesh(sphereGeometry, new THREE.MeshLambertMaterial({ color: markerColor(n, session.N) }));
+    const pinned = session.pins.has(v);
+    const m = new THREE.Mesh(pinned ? pinGeometry : sphereGeometry, new THREE.MeshLambertMaterial({ color: markerColor(n, session.N) }));
     m.position.set(p[3 * v], p[3 * v + 1], p[3 * v + 2]);
-    m.userData = { vertex: v, n };
+    m.userData = { vertex: v, n, pinned };
+    if (pinned) m.add(new THREE.LineSegments(pinEdges, pinEdgeMaterial));
     markers.add(m);
   }
   updateMarkerSizes();
@@ -558,7 +570,73 @@ function removeSingularity(v) {
   const next = cloneSession(session);
   const n = next.sings.get(v);
   next.sings.delete(v);
+  next.pins.delete(v);
   commit(`remove ${formatIndex(n, session.N)} at vertex ${v}`, next);
+}
+function togglePin(v) {
+  const next = cloneSession(session);
+  const pinned = next.pins.has(v);
+  if (pinned) next.pins.delete(v);
+  else next.pins.add(v);
+  commit(`${pinned ? 'unpin' : 'pin'} ${formatIndex(next.sings.get(v), next.N)} at vertex ${v}`, next);
+}
+// --- relaxation (POST /api/relax) -------------------------------------------------------------------
+// The server moves the singularities one edge at a time while the energy goes down (trivcon/relax.h); the page
+// replays the moves on the markers, then commits the end as one step of the history (one undo).
+let relaxing = false;
+let lastRelax = null;
+const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+const energyText = (e) => (Math.abs(e) >= 1e-3 && Math.abs(e) < 1e5 ? e.toFixed(4) : e.toExponential(3));
+async function relax() {
+  if (relaxing) return;
+  if (!session.sings.size) {
+    status('relax: there are no singularities to move');
+    return;
+  }
+  relaxing = true;
+  $('relax').disabled = true;
+  status('relax: moving singularities downhill in the energy…');
+  try {
+    const body = requestBody(session);
+    body.relax_cancel = Math.max(0, Math.min(1000, Math.round(parseFloat($('relaxcancel').value) || 0)));
+    const r = await api.relax(body);
+    lastRelax = r;
+    const percent = r.energy_before > 0 ? ` (${((100 * (r.energy_after - r.energy_before)) / r.energy_before).toFixed(1)} %)` : '';
+    const cancelled = r.moves.filter((m) => m.cancelled).length;
+    const summary = `${r.moves.length} move${r.moves.length === 1 ? '' : 's'}${cancelled ? ` (${cancelled} cancelling a pair)` : ''}, ` +
+      `energy ${energyText(r.energy_before)} → ${energyText(r.energy_after)}${percent}`;
+    const why = r.out_of_time ? '; stopped after its time budget: relax again to go on' : r.converged ? '; no single move lowers it further' : '';
+    $('relaxinfo').textContent = `last: ${summary}, ${r.candidates_evaluated} solves in ${r.seconds.toFixed(2)} s${why}`;
+    if (!r.moves.length) {
+      status(`relax: no single move lowers the energy (${energyText(r.energy_before)})`);
+      return;
+    }
+    // The replay: each move on the markers, about 1.5 s in all (edits on the mesh and keys wait for it).
+    const before = session;
+    const shown = cloneSession(session);
+    session = shown;
+    const pause = Math.min(120, 1500 / r.moves.length);
+    for (const m of r.moves) {
+      shown.sings.delete(m.from);
+      if (m.cancelled) shown.sings.delete(m.to);
+      else shown.sings.set(m.to, parseIndex(m.index, shown.N));
+      rebuildMarkers();
+      invalidate();
+      await sleep(pause);
+      if (session !== shown) return; // undo, the history or a button chose another state meanwhile
+    }
+    session = before;
+    const next = cloneSession(before);
+    next.sings = new Map(r.singularities.map(([v, t]) => [v, parseIndex(t, before.N)]));
+    for (const v of [...next.pins]) if (!next.sings.has(v)) next.pins.delete(v);
+    const detail = r.moves.map((m) => `${m.index} ${m.from} → ${m.to}${m.cancelled ? ' (cancelled)' : ''}`).join('\n');
+    commit(`relax: ${summary}`, next, { detail, told: `relaxed: ${summary}${why}` });
+  } catch (e) {
+    status(`relax: ${e.message}`);
+  } finally {
+    relaxing = false;
+    $('relax').disabled = false;
+  }
 }
 function setN(N) {
   if (!(N >= 1 && N <= 1000) || N === session.N) {
@@ -644,7 +722,9 @@ function renderPalette() {
   box.appendChild(row);
   $('modehint').textContent = mode === 'sing'
     ? `click a vertex: add ${formatIndex(indexChoice, N)}; click a singularity: remove; drag one: move`
-    : 'drag on a face: fix its direction; click a fixed face: free it';
+    : mode === 'pin'
+      ? 'click a singularity: pin it (relax leaves it where it is) or unpin it'
+      : 'drag on a face: fix its direction; click a fixed face: free it';
 }
 function setIndexChoice(k) {
   indexChoice = k;
@@ -654,6 +734,7 @@ function setMode(m) {
   mode = m;
   $('mode-sing').className = m === 'sing' ? 'on' : '';
   $('mode-fix').className = m === 'fix' ? 'on' : '';
+  $('mode-pin').className = m === 'pin' ? 'on' : '';
   renderPalette();
 }
 // The list is built once (a mesh may have hundreds of cycles); edits and solves update its fields in place.
@@ -768,7 +849,18 @@ function walkTowards(v, x, y) {
 let gesture = null; // {kind: 'orbit'|'drag-sing'|'fix', x0, y0, ...}
 renderer.domElement.addEventListener('pointerdown', (e) => {
   if (!surface || e.button !== 0) return;
-  if (mode === 'sing') {
+  if (relaxing) {  // edits wait for the relaxation's replay; the view still turns
+    gesture = { kind: 'orbit', x0: e.clientX, y0: e.clientY, passive: true };
+    return;
+  }
+  if (mode === 'pin') {
+    raycaster.setFromCamera(ndc(e.clientX, e.clientY), camera);
+    const m = raycaster.intersectObjects(markers.children, false)[0];
+    if (m) {
+      gesture = { kind: 'pin', x0: e.clientX, y0: e.clientY, vertex: m.object.userData.vertex };
+      return;
+    }
+  } else if (mode === 'sing') {
     raycaster.setFromCamera(ndc(e.clientX, e.clientY), camera);
     const m = raycaster.intersectObjects(markers.children, false)[0];
     if (m) {
@@ -797,6 +889,7 @@ renderer.domElement.addEventListener('pointermove', (e) => {
     const n = session.sings.get(gesture.at);
     session.sings.delete(gesture.at);
     session.sings.set(v, n);
+    if (session.pins.delete(gesture.at)) session.pins.add(v); // a pin goes where its singularity goes
     gesture.at = v;
     rebuildMarkers();
     // No frame of its own: the marker is drawn with the field solved for it (showField), so that the page
@@ -839,7 +932,9 @@ renderer.domElement.addEventListener('pointerup', (e) => {
       commit(`free face ${g.face}`, next);
     }
     invalidate();
-  } else if (g.kind === 'orbit' && !moved && mode === 'sing') {
+  } else if (g.kind === 'pin') {
+    if (!moved && session.sings.has(g.vertex)) togglePin(g.vertex);
+  } else if (g.kind === 'orbit' && !moved && mode === 'sing' && !g.passive) {
     const v = pickVertex(e.clientX, e.clientY);
     if (v < 0) return;
     if (session.sings.has(v)) removeSingularity(v);
@@ -872,6 +967,8 @@ function wireControls() {
   $('N').onchange = () => setN(parseInt($('N').value, 10));
   $('mode-sing').onclick = () => setMode('sing');
   $('mode-fix').onclick = () => setMode('fix');
+  $('mode-pin').onclick = () => setMode('pin');
+  $('relax').onclick = relax;
   $('balance').onclick = balance;
   $('undo').onclick = undo;
   $('redo').onclick = redo;
@@ -941,7 +1038,7 @@ function wireControls() {
     if (typing(e.target)) e.target.dataset.committed = e.target.value;
   });
   window.addEventListener('keydown', (e) => {
-    if (typing(e.target)) return;
+    if (typing(e.target) || relaxing) return;
     const key = e.key.toLowerCase();
     if ((e.ctrlKey || e.metaKey) && key === 'z') {
       e.preventDefault();
@@ -955,6 +1052,8 @@ function wireControls() {
       setIndexChoice((e.shiftKey ? -1 : 1) * parseInt(e.code.slice(5), 10));
     } else if (key === 's') setMode('sing');
     else if (key === 'f') setMode('fix');
+    else if (key === 'p') setMode('pin');
+    else if (key === 'r') relax();
     else if (key === 'b') balance();
     else if (key === 'l') ($('streamlines').checked = !$('streamlines').checked), refreshStreamlines();
   });
@@ -1100,6 +1199,9 @@ window.__trivcon = {
   get historyLength() { return history.length; },
   get historyLabels() { return history.map((h) => h.label); },
   get historyIndex() { return historyIndex; },
+  // The vertices whose markers are drawn as pinned, and the last relaxation's answer (POST /api/relax).
+  get pinnedMarkers() { return markers.children.filter((m) => m.userData.pinned).map((m) => m.userData.vertex).sort((a, b) => a - b); },
+  get lastRelax() { return lastRelax; },
 };
 
 start();

@@ -272,6 +272,71 @@ async function main() {
       assert.equal((await api('/api/state')).solved, true);
     });
 
+    await check('a pinned singularity is drawn as such; relax moves the others downhill, the pinned one stays, undo is one step', async () => {
+      const before = await singularities();
+      await page.keyboard.press('KeyP');
+      const p = await pos(movedTo);
+      await page.mouse.click(p.x, p.y);
+      await idle();
+      assert.deepEqual((await T(() => window.__trivcon.session)).pins, [movedTo]);
+      assert.deepEqual(await T(() => window.__trivcon.pinnedMarkers), [movedTo]);
+      const entries = await T(() => window.__trivcon.historyLength);
+      await page.click('#relax');
+      await page.waitForFunction((n) => window.__trivcon.historyLength > n, { timeout: 60000 }, entries);
+      await idle();
+      const r = await T(() => window.__trivcon.lastRelax);
+      assert.ok(r.moves.length >= 1, 'nothing moved');
+      assert.ok(r.converged);
+      assert.ok(r.energy_after < r.energy_before);
+      for (let k = 1; k < r.moves.length; ++k) assert.ok(r.moves[k].energy < r.moves[k - 1].energy);
+      assert.ok(r.moves.every((m) => m.from !== movedTo && m.to !== movedTo));
+      const after = await singularities();
+      assert.deepEqual(after, r.singularities);
+      assert.ok(after.some(([v, i]) => v === movedTo && i === '1/4'), 'the pinned singularity moved');
+      const indices = (list) => list.map(([, i]) => i).sort();
+      assert.deepEqual(indices(after), indices(before));
+      assert.deepEqual(await T(() => window.__trivcon.pinnedMarkers), [movedTo]);
+      const labels = await T(() => window.__trivcon.historyLabels);
+      assert.match(labels[labels.length - 1], /^relax: \d+ moves?, energy /);
+      assert.equal(await T(() => window.__trivcon.historyLength), entries + 1);
+      const state = await api('/api/state');
+      assert.equal(state.solved, true);
+      assert.deepEqual(state.last_solved.singularities, r.singularities);
+      // One undo gives the set before the relaxation back.
+      await page.keyboard.down('Control');
+      await page.keyboard.press('KeyZ');
+      await page.keyboard.up('Control');
+      await idle();
+      assert.deepEqual(await singularities(), before);
+      await page.keyboard.down('Control');
+      await page.keyboard.down('Shift');
+      await page.keyboard.press('KeyZ');
+      await page.keyboard.up('Shift');
+      await page.keyboard.up('Control');
+      await idle();
+      assert.deepEqual(await singularities(), r.singularities);
+      await page.keyboard.press('KeyS');
+    });
+
+    await check('POST /api/relax names what is wrong with a body', async () => {
+      const before8 = () => readFileSync(singPath, 'utf8').split('\n').filter((l) => l.trim() && !l.startsWith('#'))
+        .map((l) => l.trim().split(/\s+/)).map(([v, i]) => [+v, i]);
+      const post = (body) => fetch(new URL('/api/relax', editor.url), {
+        method: 'POST', headers: { 'X-Trivcon-Token': editor.token, 'Content-Type': 'application/json' }, body: JSON.stringify(body),
+      });
+      const bad = await post({ N: 4, singularities: before8(), pins: [-1] });
+      assert.equal(bad.status, 400);
+      assert.match((await bad.json()).error, /pins\[0\]: expected a vertex id from 0 to \d+, got -1/);
+      const unbalanced = await post({ N: 4, singularities: [[0, '1/4']] });
+      assert.equal(unbalanced.status, 400);
+      assert.match((await unbalanced.json()).error, /Gauss-Bonnet/);
+      const ok = await post({ N: 4, singularities: before8(), max_moves: 0 });
+      assert.equal(ok.status, 200);
+      const j = await ok.json();
+      assert.deepEqual(j.moves, []);
+      assert.equal(j.converged, false);
+    });
+
     await check('automatic placement gives a balanced set the server solves', async () => {
       const entries = await T(() => window.__trivcon.historyLength);
       await page.click('#auto');
