@@ -5,8 +5,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "commands.h"
-#include "field_options.h"
+#include "map_command.h"
 #include "outputs.h"
 #include "report.h"
 #include "summary.h"
@@ -21,11 +20,8 @@ namespace trivcon::cli {
 namespace {
 
 struct ParamCommand {
-  std::string mesh, output, sing_out, report;
-  FieldOptions field;
-  double target_faces = 0, edge_length = 0;
-  bool quiet = false;
-  MeshOptions mesh_options;  // --no-repair, --weld
+  MapCommand map;
+  std::string output, sing_out, report;
 };
 
 std::string fmt(double v) {
@@ -35,31 +31,14 @@ std::string fmt(double v) {
 }
 
 void run_param(const ParamCommand& o) {
-  const auto t0 = Clock::now();
-  const LoadedMesh loaded = load_mesh(o.mesh, o.mesh_options, o.quiet);
+  const MapRun run = run_map(o.map);
+  const LoadedMesh& loaded = run.loaded;
   const MeshData& mesh = loaded.mesh;
-  const RepairedMesh* repair = loaded.repaired();
-  const double read_seconds = seconds_since(t0);
-  FieldDesigner designer(mesh.V, mesh.F, o.field.solver_options());
-  FieldRequest request = o.field.request(designer, repair);
-  // With --auto, a ± pair closer than one unit of the map cannot sit on two integer points without folding it:
-  // unless --auto-cancel says otherwise, pairs within one quad edge cancel.
-  double area = 0;
-  for (int f = 0; f < designer.topology().num_faces; ++f) area += designer.geometry().face_area[f];
-  const double unit = o.edge_length > 0 ? o.edge_length : std::sqrt(area / o.target_faces);
-  if (request.auto_place && o.field.auto_cancel == 0) request.auto_options.cancel_distance = unit, request.auto_options.cancel_absolute = true;
-  const FieldOutcome out = solve_request(designer, mesh.F, request);
-  if (!out.verified)
-    throw Error("the field did not pass verification, so no map was made: " + verification_failure(designer, out.design));
-  const Topology& t = designer.topology();
-  ParamOptions options;
-  options.edge_length = o.edge_length;
-  options.target_faces = o.target_faces;
-  if (request.align_boundary)
-    for (int e = 0; e < t.num_edges; ++e)
-      if (t.is_boundary_edge(e)) options.aligned_edges.push_back(e);
-  options.aligned_edges.insert(options.aligned_edges.end(), out.sharp_edges.begin(), out.sharp_edges.end());
-  const Parametrization param = parametrize(designer, out.design, options);
+  const RepairedMesh* repair = run.repaired();
+  const double read_seconds = run.read_seconds;
+  const FieldOutcome& out = run.out;
+  const Topology& t = run.designer->topology();
+  const Parametrization& param = run.param;
   const ParamQuality& q = param.quality;
 
   const auto t1 = Clock::now();
@@ -74,7 +53,7 @@ void run_param(const ParamCommand& o) {
   if (!o.sing_out.empty())
     staged.write(o.sing_out, [&](const std::string& path) { write_singularities(path, input_singularities(out.prescription.vertex, repair), 4); });
   if (!o.report.empty()) {
-    nlohmann::ordered_json report = {{"mesh", o.mesh},
+    nlohmann::ordered_json report = {{"mesh", o.map.mesh},
                                      {"vertices", t.num_vertices},
                                      {"faces", t.num_faces},
                                      {"components", t.components.size()},
@@ -93,8 +72,8 @@ void run_param(const ParamCommand& o) {
   }
   staged.commit();
 
-  if (!o.quiet)
-    std::cout << "mesh " << o.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
+  if (!o.map.quiet)
+    std::cout << "mesh " << o.map.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
               << " component(s), chi " << t.euler_characteristic() << ", " << t.boundary_loops.size() << " boundary loop(s)\n"
               << (out.relax_result ? relax_summary_line(*out.relax_result) + "\n" : std::string())
               << "field: N 4, " << param.cones.size() << " singular vertices, verified\n"
@@ -122,24 +101,12 @@ void run_param(const ParamCommand& o) {
 void register_param(CLI::App& app) {
   static ParamCommand o;
   auto* cmd = app.add_subcommand("param", "Seamless integer-grid parametrization of the cross field (N = 4): an OBJ with one vt per corner");
-  cmd->add_option("mesh", o.mesh, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
-  o.field.add_to(cmd, true);
-  auto* target = cmd->add_option("--target-faces", o.target_faces, "About this many unit squares (quads) over the surface")
-                     ->check(CLI::PositiveNumber);
-  auto* length = cmd->add_option("--edge-length", o.edge_length, "The length of one unit of (u, v), in the mesh's units")
-                     ->check(CLI::PositiveNumber);
-  target->excludes(length);
+  o.map.add_to(cmd, "unit square (quad)");
   cmd->add_option("-o,--output", o.output, "OBJ of the input mesh with (u, v) per corner ('f a/ta b/tb c/tc')")->required();
   cmd->add_option("--sing-out", o.sing_out, "Singularity file of the singularities used ('VERTEX INDEX' lines, readable by -s)");
   cmd->add_option("--report", o.report, "JSON report: the field, the map's integers and quality, time per stage");
-  cmd->add_flag("-q,--quiet", o.quiet, "Print nothing on success");
-  add_mesh_options(cmd, o.mesh_options);
-  cmd->callback([target, length] {
-    if (target->count() == 0 && length->count() == 0)
-      throw CLI::ValidationError("--target-faces / --edge-length", "give the scale of the map: one of them");
-    if (o.field.split_large_turns)
-      throw CLI::ValidationError("--split-large-turns",
-                                 "not needed by param: the map uses the connection's own matching, so large turns are no problem");
+  cmd->callback([] {
+    o.map.check("param");
     run_param(o);
   });
 }

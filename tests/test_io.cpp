@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "trivcon/error.h"
+#include "support.h"
 #include "trivcon/io.h"
 
 namespace {
@@ -1092,3 +1093,31 @@ TEST(SharedMeshes, GzippedCopyReadsIdentically) {
 }
 
 }  // namespace
+
+namespace trivcon {
+namespace {
+
+// A quad mesh written as OBJ or binary PLY reads back as its quads, each fanned into two triangles.
+TEST(WriteQuadMesh, ObjAndPlyReadBackAsTheirQuads) {
+  MatrixX3d V(6, 3);
+  V << 0, 0, 0, 1, 0, 0, 2, 0, 0, 0, 1, 0, 1, 1, 0, 2, 1, 0.25;
+  Eigen::MatrixX4i Q(2, 4);
+  Q << 0, 1, 4, 3, 1, 2, 5, 4;
+  for (const std::string name : {"quads.obj", "quads.ply"}) {
+    const std::string path = test::temp_file(name);
+    write_quad_mesh(path, V, Q);
+    const MeshData m = read_mesh(path);
+    EXPECT_EQ(m.V, V) << name;
+    EXPECT_EQ(m.polygon_count, 2) << name;
+    EXPECT_EQ(m.polygon_of_triangle, (std::vector<int>{0, 0, 1, 1})) << name;
+    EXPECT_EQ(m.F.row(0), Eigen::RowVector3i(0, 1, 4)) << name;
+    EXPECT_EQ(m.F.row(1), Eigen::RowVector3i(0, 4, 3)) << name;
+    EXPECT_EQ(m.F.row(3), Eigen::RowVector3i(1, 5, 4)) << name;
+  }
+  Q(1, 2) = 6;
+  EXPECT_NE(test::error_of([&] { write_quad_mesh(test::temp_file("bad.obj"), V, Q); }).find("face 1 has vertex index 6 out of range"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace trivcon

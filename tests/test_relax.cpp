@@ -150,6 +150,8 @@ TEST(Relax, PinsHoldAndMaxMovesStops) {
   EXPECT_EQ(error_of([&] { relax(designer, p, bad); }), "relax: max_moves must be at least 0, not -1");
   bad = {}, bad.cancel_distance = -2;
   EXPECT_EQ(error_of([&] { relax(designer, p, bad); }), "relax: cancel_distance must be at least 0, not -2");
+  bad = {}, bad.max_seconds = -1;
+  EXPECT_EQ(error_of([&] { relax(designer, p, bad); }), "relax: max_seconds must be at least 0");
 }
 
 TEST(Relax, AlignedDiskKeepsItsBoundaryAndFixedFaces) {

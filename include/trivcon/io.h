@@ -60,6 +60,8 @@ std::string read_file_bytes(const std::string& path);
 
 void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F);
 void write_ply(const std::string& path, const MatrixX3d& V, const MatrixX3i& F);  // binary little-endian, double x y z, int list
+// A quad mesh (a quad per row of Q, counter-clockwise): binary PLY when the path ends in .ply, else OBJ.
+void write_quad_mesh(const std::string& path, const MatrixX3d& V, const Eigen::MatrixX4i& Q);
 // OBJ with one texture coordinate per corner: the vertices and faces as given, then `vt u v` for corner k of
 // face f at line 3f + k + 1 of the vt lines, and `f a/ta b/tb c/tc`. corner_uv: F × 6 ((u, v) of corners 0, 1, 2).
 void write_uv_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Eigen::MatrixXd& corner_uv);

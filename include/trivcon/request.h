@@ -23,6 +23,7 @@
 #include "trivcon/constraints.h"
 #include "trivcon/design.h"
 #include "trivcon/features.h"
+#include "trivcon/param.h"
 #include "trivcon/relax.h"
 #include "trivcon/repair.h"
 #include "trivcon/split_large_turns.h"
@@ -99,5 +100,19 @@ void move_request_to_repaired(FieldRequest& request, const Topology& topology, c
 // validation (check_aligned_index_sums, validate_prescription: the CLI's messages), design, splitting.
 // `F` is the faces `designer` was built from, as given (for split_large_turns). Throws trivcon::Error.
 FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const FieldRequest& request);
+
+// The map of a request's field (trivcon/param.h, N = 4) as `param`, `quad`, Python and the editor make it: the scale
+// (edge_length > 0, else about target_faces unit squares) and, on integer iso-lines, every boundary edge when
+// the request aligns the boundary and the sharp edges the field followed (outcome.sharp_edges).
+ParamOptions request_param_options(const FieldDesigner& designer, const FieldRequest& request, const FieldOutcome& outcome,
+                                   double edge_length, double target_faces);
+
+// One unit of (u, v) in the mesh's units: edge_length when > 0, else √(area / target_faces). With automatic
+// placement a ± pair closer than that cannot sit on two integer points without folding the map, so the map's
+// front ends cancel pairs within it unless the request says otherwise (cancel_for_map).
+double map_unit(const FieldDesigner& designer, double edge_length, double target_faces);
+// Sets request.auto_options to cancel pairs within one unit of the map (absolute), when auto_place and no cancel
+// distance was given.
+void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double edge_length, double target_faces);
 
 }  // namespace trivcon

@@ -22,8 +22,9 @@ using io::kMaxCount;
 using io::non_finite_message;
 using io::polygon_problem;
 
-// Refuses what the readers would reject, so that everything written reads back identically.
-void check_writable(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
+// Refuses what the readers would reject, so that everything written reads back identically. Faces: triangles or quads.
+template <class Faces>
+void check_writable(const std::string& path, const MatrixX3d& V, const Faces& F) {
   const auto refuse = [&](const std::string& why) { throw Error("cannot write '" + path + "': " + why); };
   if (V.rows() > kMaxCount) refuse("too many vertices");
   if (F.rows() == 0) refuse("mesh has no faces");
@@ -32,9 +33,10 @@ void check_writable(const std::string& path, const MatrixX3d& V, const MatrixX3i
       if (!std::isfinite(V(v, axis))) refuse(non_finite_message(v, V(v, axis)));
     }
   }
-  std::vector<int> corners(3);
+  const int n = static_cast<int>(F.cols());
+  std::vector<int> corners(n);
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    for (int c = 0; c < 3; ++c) {
+    for (int c = 0; c < n; ++c) {
       corners[c] = F(f, c);
       if (corners[c] < 0 || corners[c] >= V.rows()) {
         refuse("face " + std::to_string(f) + " has vertex index " + std::to_string(corners[c]) + " out of range (mesh has " +
@@ -84,22 +86,51 @@ void append_obj_vertices(std::string& text, const MatrixX3d& V) {
   }
 }
 
-}  // namespace
-
-void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
+template <class Faces>
+void write_obj_faces(const std::string& path, const MatrixX3d& V, const Faces& F) {
   check_writable(path, V, F);
   std::string text = "# trivcon mesh: " + std::to_string(V.rows()) + " vertices, " + std::to_string(F.rows()) + " faces\n";
-  text.reserve(text.size() + 64 * V.rows() + 24 * F.rows());
+  text.reserve(text.size() + 64 * V.rows() + 8 * F.cols() * F.rows());
   append_obj_vertices(text, V);
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     text += 'f';
-    for (int c = 0; c < 3; ++c) {
+    for (int c = 0; c < F.cols(); ++c) {
       text += ' ';
       append_number(text, F(f, c) + 1);
     }
     text += '\n';
   }
   write_file_atomically(path, [&](std::ostream& out) { out.write(text.data(), static_cast<std::streamsize>(text.size())); });
+}
+
+template <class Faces>
+void write_ply_faces(const std::string& path, const MatrixX3d& V, const Faces& F) {
+  check_writable(path, V, F);
+  std::string data = "ply\nformat binary_little_endian 1.0\ncomment written by trivcon\nelement vertex " + std::to_string(V.rows()) +
+                     "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(F.rows()) +
+                     "\nproperty list uchar int vertex_indices\nend_header\n";
+  data.reserve(data.size() + 24 * V.rows() + (1 + 4 * F.cols()) * F.rows());
+  for (Eigen::Index v = 0; v < V.rows(); ++v) {
+    for (int axis = 0; axis < 3; ++axis) append_little_endian(data, V(v, axis));
+  }
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    data += static_cast<char>(F.cols());
+    for (int c = 0; c < F.cols(); ++c) append_little_endian<std::int32_t>(data, F(f, c));
+  }
+  write_file_atomically(path, [&](std::ostream& out) { out.write(data.data(), static_cast<std::streamsize>(data.size())); });
+}
+
+}  // namespace
+
+void write_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) { write_obj_faces(path, V, F); }
+void write_ply(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) { write_ply_faces(path, V, F); }
+
+void write_quad_mesh(const std::string& path, const MatrixX3d& V, const Eigen::MatrixX4i& Q) {
+  const bool ply = path.size() >= 4 && path.compare(path.size() - 4, 4, ".ply") == 0;
+  if (ply)
+    write_ply_faces(path, V, Q);
+  else
+    write_obj_faces(path, V, Q);
 }
 
 void write_uv_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& F, const Eigen::MatrixXd& corner_uv) {
@@ -130,22 +161,6 @@ void write_uv_obj(const std::string& path, const MatrixX3d& V, const MatrixX3i& 
     text += '\n';
   }
   write_file_atomically(path, [&](std::ostream& out) { out.write(text.data(), static_cast<std::streamsize>(text.size())); });
-}
-
-void write_ply(const std::string& path, const MatrixX3d& V, const MatrixX3i& F) {
-  check_writable(path, V, F);
-  std::string data = "ply\nformat binary_little_endian 1.0\ncomment written by trivcon\nelement vertex " + std::to_string(V.rows()) +
-                     "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(F.rows()) +
-                     "\nproperty list uchar int vertex_indices\nend_header\n";
-  data.reserve(data.size() + 24 * V.rows() + 13 * F.rows());
-  for (Eigen::Index v = 0; v < V.rows(); ++v) {
-    for (int axis = 0; axis < 3; ++axis) append_little_endian(data, V(v, axis));
-  }
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    data += static_cast<char>(3);
-    for (int c = 0; c < 3; ++c) append_little_endian<std::int32_t>(data, F(f, c));
-  }
-  write_file_atomically(path, [&](std::ostream& out) { out.write(data.data(), static_cast<std::streamsize>(data.size())); });
 }
 
 }  // namespace trivcon

@@ -184,4 +184,30 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
   return out;
 }
 
+ParamOptions request_param_options(const FieldDesigner& designer, const FieldRequest& request, const FieldOutcome& outcome,
+                                   double edge_length, double target_faces) {
+  const Topology& t = outcome.designer(designer).topology();
+  ParamOptions options;
+  options.edge_length = edge_length;
+  options.target_faces = target_faces;
+  if (request.align_boundary)
+    for (int e = 0; e < t.num_edges; ++e)
+      if (t.is_boundary_edge(e)) options.aligned_edges.push_back(e);
+  options.aligned_edges.insert(options.aligned_edges.end(), outcome.sharp_edges.begin(), outcome.sharp_edges.end());
+  return options;
+}
+
+double map_unit(const FieldDesigner& designer, double edge_length, double target_faces) {
+  if (edge_length > 0) return edge_length;
+  double area = 0;
+  for (int f = 0; f < designer.topology().num_faces; ++f) area += designer.geometry().face_area[f];
+  return std::sqrt(area / target_faces);
+}
+
+void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double edge_length, double target_faces) {
+  if (!request.auto_place || request.auto_options.cancel_distance != 0) return;
+  request.auto_options.cancel_distance = map_unit(designer, edge_length, target_faces);
+  request.auto_options.cancel_absolute = true;
+}
+
 }  // namespace trivcon

@@ -1,0 +1,44 @@
+#include "map_command.h"
+
+#include "summary.h"
+#include "trivcon/error.h"
+
+namespace trivcon::cli {
+
+void MapCommand::add_to(CLI::App* cmd, const std::string& what_unit) {
+  cmd->add_option("mesh", mesh, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
+  field.add_to(cmd, true);
+  target = cmd->add_option("--target-faces", target_faces, "About this many " + what_unit + "s over the surface")->check(CLI::PositiveNumber);
+  length = cmd->add_option("--edge-length", edge_length, "The length of one unit of (u, v) (one " + what_unit + "'s side), in the mesh's units")
+               ->check(CLI::PositiveNumber);
+  target->excludes(length);
+  cmd->add_flag("-q,--quiet", quiet, "Print nothing on success");
+  add_mesh_options(cmd, mesh_options);
+}
+
+void MapCommand::check(const std::string& command) const {
+  if (target->count() == 0 && length->count() == 0)
+    throw CLI::ValidationError("--target-faces / --edge-length", "give the scale of the map: one of them");
+  if (field.split_large_turns)
+    throw CLI::ValidationError("--split-large-turns", "not needed by " + command +
+                                                          ": the map uses the connection's own matching, so large turns are no problem");
+}
+
+MapRun run_map(const MapCommand& o) {
+  MapRun run;
+  const auto t0 = Clock::now();
+  run.loaded = load_mesh(o.mesh, o.mesh_options, o.quiet);
+  run.read_seconds = seconds_since(t0);
+  const MeshData& mesh = run.loaded.mesh;
+  run.designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F, o.field.solver_options());
+  run.request = o.field.request(*run.designer, run.repaired());
+  cancel_for_map(run.request, *run.designer, o.edge_length, o.target_faces);
+  run.out = solve_request(*run.designer, mesh.F, run.request);
+  if (!run.out.verified)
+    throw Error("the field did not pass verification, so no map was made: " + verification_failure(*run.designer, run.out.design));
+  run.param = parametrize(*run.designer, run.out.design,
+                          request_param_options(*run.designer, run.request, run.out, o.edge_length, o.target_faces));
+  return run;
+}
+
+}  // namespace trivcon::cli

@@ -1,0 +1,46 @@
+// What `param` and `quad` share: the mesh, the field request and the scale of the map, parsed once, and the run
+// from the file to the seamless integer-grid map (trivcon/param.h) of a verified field.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "field_options.h"
+#include "trivcon/param.h"
+#include "trivcon/request.h"
+
+namespace trivcon::cli {
+
+struct MapCommand {
+  std::string mesh;
+  FieldOptions field;
+  double target_faces = 0, edge_length = 0;
+  bool quiet = false;
+  MeshOptions mesh_options;  // --no-repair, --weld
+  CLI::Option* target = nullptr;
+  CLI::Option* length = nullptr;
+
+  // The mesh argument, the field options (N = 4), --target-faces / --edge-length (`what_unit` says what one
+  // unit is: a unit square, a quad), -q, --no-repair, --weld.
+  void add_to(CLI::App* cmd, const std::string& what_unit);
+  // Usage errors found before any work (CLI::ValidationError): no scale, --split-large-turns.
+  void check(const std::string& command) const;
+};
+
+struct MapRun {
+  LoadedMesh loaded;
+  double read_seconds = 0;
+  std::unique_ptr<FieldDesigner> designer;
+  FieldRequest request;
+  FieldOutcome out;
+  Parametrization param;
+  const RepairedMesh* repaired() const { return loaded.repaired(); }
+};
+
+// Reads the mesh (repaired unless --no-repair), solves the request (with --auto, ± pairs within one unit of the
+// map cancel unless --auto-cancel says otherwise: cancel_for_map) and makes the map. Throws trivcon::Error, also
+// when the field does not pass verification.
+MapRun run_map(const MapCommand& command);
+
+}  // namespace trivcon::cli
