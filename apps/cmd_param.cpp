@@ -32,8 +32,6 @@ std::string fmt(double v) {
 
 void run_param(const ParamCommand& o) {
   const MapRun run = run_map(o.map);
-  const LoadedMesh& loaded = run.loaded;
-  const MeshData& mesh = loaded.mesh;
   const RepairedMesh* repair = run.repaired();
   const double read_seconds = run.read_seconds;
   const FieldOutcome& out = run.out;
@@ -43,13 +41,7 @@ void run_param(const ParamCommand& o) {
 
   const auto t1 = Clock::now();
   StagedOutputs staged;
-  staged.write(o.output, [&](const std::string& path) {  // the input's faces, repaired or not
-    const Eigen::MatrixXd uv = input_corner_uv(param, t, mesh.F);
-    if (repair)
-      write_uv_obj(path, loaded.input.V, loaded.input.F, corner_rows_on_input(*repair, loaded.input.F, uv));
-    else
-      write_uv_obj(path, mesh.V, mesh.F, uv);
-  });
+  staged.write(o.output, [&](const std::string& path) { write_map_obj(path, run); });
   if (!o.sing_out.empty())
     staged.write(o.sing_out, [&](const std::string& path) { write_singularities(path, input_singularities(out.prescription.vertex, repair), 4); });
   if (!o.report.empty()) {

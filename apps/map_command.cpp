@@ -41,4 +41,13 @@ MapRun run_map(const MapCommand& o) {
   return run;
 }
 
+void write_map_obj(const std::string& path, const MapRun& run) {
+  const MeshData& mesh = run.loaded.mesh;
+  const Eigen::MatrixXd uv = input_corner_uv(run.param, run.designer->topology(), mesh.F);
+  if (const RepairedMesh* repair = run.repaired())
+    write_uv_obj(path, run.loaded.input.V, run.loaded.input.F, corner_rows_on_input(*repair, run.loaded.input.F, uv));
+  else
+    write_uv_obj(path, mesh.V, mesh.F, uv);
+}
+
 }  // namespace trivcon::cli

@@ -43,4 +43,7 @@ struct MapRun {
 // when the field does not pass verification.
 MapRun run_map(const MapCommand& command);
 
+// The map as `param -o` writes it: the input file's mesh (repaired or not) with one vt per corner.
+void write_map_obj(const std::string& path, const MapRun& run);
+
 }  // namespace trivcon::cli
