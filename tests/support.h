@@ -49,6 +49,8 @@ std::string error_of(const std::function<void()>& f);
 Topology topo(const Mesh& m);
 // Faces from a list of corner triples.
 MatrixX3i faces(const std::vector<std::array<int, 3>>& list);
+// The vertices at exactly `distance` edges from v, increasing.
+std::vector<int> vertex_ring(const Topology& t, int v, int distance);
 // Vertices of a given valence (e.g. the 8 corners of a cube sphere, the 12 of an icosphere).
 std::vector<int> vertices_of_valence(const Mesh& m, int valence);
 // make_disk(rings, segments) with every interior vertex moved in the plane by up to `amount` × the ring

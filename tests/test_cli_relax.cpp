@@ -21,21 +21,8 @@ std::string mesh_file(const Mesh& m, const std::string& name) {
   return path;
 }
 
-// The first vertex `distance` edges from v (breadth-first, increasing ids per ring).
-int vertex_at_distance(const Topology& t, int v, int distance) {
-  std::vector<int> seen(t.num_vertices, -1), ring{v};
-  seen[v] = 0;
-  for (int d = 1; d <= distance; ++d) {
-    std::vector<int> next;
-    for (int x : ring)
-      for (int a = t.vertex_edge_offsets[x]; a < t.vertex_edge_offsets[x + 1]; ++a) {
-        const int e = t.vertex_edges[a], u = t.edge_vertices(e, 0) == x ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
-        if (seen[u] < 0) seen[u] = d, next.push_back(u);
-      }
-    ring = std::move(next);
-  }
-  return *std::min_element(ring.begin(), ring.end());
-}
+// The smallest vertex `distance` edges from v.
+int vertex_at_distance(const Topology& t, int v, int distance) { return test::vertex_ring(t, v, distance).front(); }
 
 // The singularity file's vertex -> index text.
 std::map<int, std::string> read_sing_file(const std::string& path) {

@@ -17,23 +17,7 @@ namespace {
 using test::error_of;
 using test::vertices_of_valence;
 
-// The vertices at exactly `distance` edges from v.
-std::vector<int> ring(const Topology& t, int v, int distance) {
-  std::vector<int> depth(t.num_vertices, -1), frontier{v};
-  depth[v] = 0;
-  for (int d = 1; d <= distance; ++d) {
-    std::vector<int> next;
-    for (int x : frontier)
-      for (int a = t.vertex_edge_offsets[x]; a < t.vertex_edge_offsets[x + 1]; ++a) {
-        const int e = t.vertex_edges[a];
-        const int u = t.edge_vertices(e, 0) == x ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
-        if (depth[u] < 0) depth[u] = d, next.push_back(u);
-      }
-    frontier.swap(next);
-  }
-  std::sort(frontier.begin(), frontier.end());
-  return frontier;
-}
+std::vector<int> ring(const Topology& t, int v, int distance) { return test::vertex_ring(t, v, distance); }
 
 std::multiset<int> indices_of(const IndexPrescription& p) {
   std::multiset<int> out;
