@@ -28,6 +28,7 @@ void register_solve(CLI::App& app);
 void register_check(CLI::App& app);
 void register_render(CLI::App& app);
 void register_param(CLI::App& app);
+void register_quad(CLI::App& app);
 void register_edit(CLI::App& app);  // only with TRIVCON_EDITOR (CMake option)
 
 // Reads a mesh file; messages name the file.

@@ -61,6 +61,7 @@ int main(int argc, char** argv) {
   trivcon::cli::register_info(app);
   trivcon::cli::register_solve(app);
   trivcon::cli::register_param(app);
+  trivcon::cli::register_quad(app);
   trivcon::cli::register_check(app);
   trivcon::cli::register_render(app);
 #ifdef TRIVCON_EDITOR

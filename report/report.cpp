@@ -140,4 +140,43 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
                        {"stiffening", q.seconds_stiffening}, {"check", q.seconds_check}}}};
 }
 
+nlohmann::ordered_json quad_report(const QuadMesh& quads) {
+  const QuadQuality& q = quads.quality;
+  return {{"quads", q.quads},
+          {"vertices", q.vertices},
+          {"edges", q.edges},
+          {"euler_characteristic", q.euler_characteristic},
+          {"input_euler_characteristic", q.input_euler_characteristic},
+          {"boundary_loops", q.boundary_loops},
+          {"input_boundary_loops", q.input_boundary_loops},
+          {"components", q.components},
+          {"input_components", q.input_components},
+          {"manifold", q.manifold},
+          {"oriented", q.oriented},
+          {"non_manifold_edges", q.non_manifold_edges},
+          {"non_manifold_vertices", q.non_manifold_vertices},
+          {"irregular_vertices", q.irregular_vertices},
+          {"singular_mismatches", q.singular_mismatches},
+          {"inverted_quads", q.inverted_quads},
+          {"min_scaled_jacobian", q.min_scaled_jacobian},
+          {"mean_scaled_jacobian", q.mean_scaled_jacobian},
+          {"hausdorff_relative", q.hausdorff_relative},
+          {"target_quads", q.target_quads},
+          {"other_faces", quads.other_faces.size()},
+          {"extraction",
+           {{"integer_points", q.integer_points},
+            {"dropped_points", q.dropped_points},
+            {"traces", q.traces},
+            {"failed_traces", q.failed_traces},
+            {"abandoned_traces", q.abandoned_traces},
+            {"unmatched_traces", q.unmatched_traces},
+            {"non_quad_faces", q.non_quad_faces},
+            {"open_faces", q.open_faces},
+            {"unused_vertices", q.unused_vertices},
+            {"unclosed_vertices", q.unclosed_vertices},
+            {"map_folds", q.map_folds}}},
+          {"problems", q.problems},
+          {"seconds", {{"extract", q.seconds_extract}, {"check", q.seconds_check}}}};
+}
+
 }  // namespace trivcon::cli

@@ -6,6 +6,7 @@
 #include "trivcon/design.h"
 #include "trivcon/io.h"
 #include "trivcon/param.h"
+#include "trivcon/quad.h"
 
 namespace trivcon::cli {
 
@@ -24,5 +25,9 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
 // The "param" entry of `param`'s and `quad`'s reports: the map's size, its integers, what it promises
 // checked on the result (ParamQuality) and the time per stage.
 nlohmann::ordered_json param_report(const Parametrization& param);
+
+// The "quad" entry of `quad`'s report (and of Python's QuadMesh.quality, the editor's quads view): the quad
+// mesh's size, every guarantee checked on it (QuadQuality), what the extraction met, the time per stage.
+nlohmann::ordered_json quad_report(const QuadMesh& quads);
 
 }  // namespace trivcon::cli

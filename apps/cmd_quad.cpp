@@ -1,0 +1,118 @@
+// trivcon quad MESH [field options] (--target-faces K | --edge-length H) -o Q.obj: the quad mesh of the field's
+// seamless integer-grid map (trivcon/quad.h), its irregular vertices exactly the field's singularities.
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "map_command.h"
+#include "outputs.h"
+#include "report.h"
+#include "summary.h"
+#include "trivcon/error.h"
+#include "trivcon/field_io.h"
+#include "trivcon/io.h"
+#include "trivcon/quad.h"
+
+namespace trivcon::cli {
+
+namespace {
+
+struct QuadCommand {
+  MapCommand map;
+  std::string output, uv_out, sing_out, report;
+};
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << std::setprecision(3) << v;
+  return s.str();
+}
+
+void run_quad(const QuadCommand& o) {
+  const MapRun run = run_map(o.map);
+  const RepairedMesh* repair = run.repaired();
+  const Topology& t = run.designer->topology();
+  const Parametrization& param = run.param;
+  const ParamQuality& p = param.quality;
+  const QuadMesh quads = extract_quads(*run.designer, param);
+  const QuadQuality& q = quads.quality;
+
+  const auto t1 = Clock::now();
+  StagedOutputs staged;
+  staged.write(o.output, [&](const std::string& path) { write_quad_mesh(path, quads.V, quads.Q); });
+  if (!o.uv_out.empty()) staged.write(o.uv_out, [&](const std::string& path) { write_map_obj(path, run); });
+  if (!o.sing_out.empty())
+    staged.write(o.sing_out, [&](const std::string& path) { write_singularities(path, input_singularities(run.out.prescription.vertex, repair), 4); });
+  if (!o.report.empty()) {
+    nlohmann::ordered_json report = {{"mesh", o.map.mesh},
+                                     {"vertices", t.num_vertices},
+                                     {"faces", t.num_faces},
+                                     {"components", t.components.size()},
+                                     {"euler_characteristic", t.euler_characteristic()},
+                                     {"boundary_loops", t.boundary_loops.size()},
+                                     {"N", 4},
+                                     {"singularities", nlohmann::ordered_json::array()},
+                                     {"field", {{"verified", run.out.verified}, {"energy", run.out.design.connection.energy}}},
+                                     {"param", param_report(param)},
+                                     {"quad", quad_report(quads)},
+                                     {"seconds", {{"read", run.read_seconds},
+                                                  {"field", run.out.design.solve_seconds + run.out.design.field_seconds},
+                                                  {"write", seconds_since(t1)}}}};
+    if (repair) report["repair"] = repair_summary_json(*repair);
+    if (run.out.relax_result) report["relax"] = relax_summary_json(*run.out.relax_result);
+    for (size_t i = 0; i < param.cones.size(); ++i)
+      report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
+    staged.write(o.report, [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& s) { s << report.dump(2) << "\n"; }); });
+  }
+  staged.commit();
+
+  if (!o.map.quiet) {
+    std::map<int, int> valences;  // valence -> cones of that valence (index n/4: valence 4 - n)
+    for (size_t i = 0; i < param.cones.size(); ++i) ++valences[4 - param.cone_index[i]];
+    std::ostringstream irregular;
+    for (auto [valence, count] : valences) irregular << (irregular.tellp() > 0 ? ", " : "") << count << " of valence " << valence;
+    std::cout << "mesh " << o.map.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
+              << " component(s), chi " << t.euler_characteristic() << ", " << t.boundary_loops.size() << " boundary loop(s)\n"
+              << (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string())
+              << "field: N 4, " << param.cones.size() << " singular vertices, verified\n"
+              << "map: edge length " << fmt(param.edge_length) << ", seamless " << (p.seamless ? "yes" : "NO") << ", flipped faces "
+              << p.flipped_faces << ", degenerate " << p.degenerate_faces << "\n"
+              << "quads: " << q.quads << " (target " << std::llround(q.target_quads) << "), " << q.vertices << " vertices, chi "
+              << q.euler_characteristic << " (input " << q.input_euler_characteristic << "), " << q.boundary_loops << " boundary loop(s) (input "
+              << q.input_boundary_loops << "), " << (q.manifold ? "manifold" : "NOT manifold") << ", "
+              << (q.oriented ? "oriented" : "NOT oriented") << "\n"
+              << "irregular vertices: " << q.irregular_vertices << " (singularities: " << (irregular.tellp() > 0 ? irregular.str() : "none")
+              << "), " << (q.singular_mismatches == 0 ? "exactly at the singularities" : std::to_string(q.singular_mismatches) + " NOT at a singularity of their valence") << "\n"
+              << "scaled Jacobian: min " << fmt(q.min_scaled_jacobian) << ", mean " << fmt(q.mean_scaled_jacobian) << "; inverted quads "
+              << q.inverted_quads << "; distance to the input " << fmt(100 * q.hausdorff_relative) << " % of the bounding box diagonal\n"
+              << "time: read " << fmt(run.read_seconds) << " s, field " << fmt(run.out.design.solve_seconds + run.out.design.field_seconds)
+              << " s, map " << fmt(p.seconds_cut + p.seconds_setup + p.seconds_rounding + p.seconds_stiffening + p.seconds_check)
+              << " s, quads " << fmt(q.seconds_extract + q.seconds_check) << " s (extract " << fmt(q.seconds_extract) << ", check "
+              << fmt(q.seconds_check) << ")\n";
+  }
+  if (const std::string w = param_warning(param); !w.empty()) std::cerr << "trivcon: warning: " << w << "\n";
+  if (const std::string w = quad_warning(quads); !w.empty()) {
+    std::cerr << "trivcon: warning: " << w << "\n";
+    exit_code = kVerificationFailed;
+  }
+}
+
+}  // namespace
+
+void register_quad(CLI::App& app) {
+  static QuadCommand o;
+  auto* cmd = app.add_subcommand("quad", "Quad mesh of the cross field (N = 4): its irregular vertices exactly the singularities");
+  o.map.add_to(cmd, "quad");
+  cmd->add_option("-o,--output", o.output, "The quad mesh: .ply (binary) or .obj")->required();
+  cmd->add_option("--uv-out", o.uv_out, "OBJ of the input mesh with the map's (u, v) per corner (as `param -o`)");
+  cmd->add_option("--sing-out", o.sing_out, "Singularity file of the singularities used ('VERTEX INDEX' lines, readable by -s)");
+  cmd->add_option("--report", o.report, "JSON report: the field, the map, the quad mesh's guarantees and quality, time per stage");
+  cmd->callback([] {
+    o.map.check("quad");
+    run_quad(o);
+  });
+}
+
+}  // namespace trivcon::cli

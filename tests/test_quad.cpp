@@ -1,0 +1,512 @@
+// trivcon/quad.h: quad meshes extracted from integer-grid maps of generated meshes with known answers. Every test
+// checks the quads from (V, Q) alone with the small counts below (edges, orientation, χ, boundary loops, valences,
+// distance to the input), not the extraction's own report only.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "trivcon/common.h"
+#include "trivcon/error.h"
+#include "trivcon/generate.h"
+#include "trivcon/param.h"
+#include "trivcon/quad.h"
+#include "trivcon/request.h"
+#include "support.h"
+
+namespace trivcon {
+namespace {
+
+struct Pipeline {
+  std::unique_ptr<FieldDesigner> designer;
+  FieldOutcome outcome;
+  Parametrization param;
+  QuadMesh quads;
+};
+
+Pipeline run(const Mesh& m, FieldRequest r, ParamOptions o, bool align_sharp = false) {
+  Pipeline out;
+  out.designer = std::make_unique<FieldDesigner>(m.V, m.F);
+  r.prescription.N = 4;
+  out.outcome = solve_request(*out.designer, m.F, r);
+  const Topology& t = out.designer->topology();
+  if (r.align_boundary)
+    for (int e = 0; e < t.num_edges; ++e)
+      if (t.is_boundary_edge(e)) o.aligned_edges.push_back(e);
+  if (align_sharp) o.aligned_edges.insert(o.aligned_edges.end(), out.outcome.sharp_edges.begin(), out.outcome.sharp_edges.end());
+  out.param = parametrize(*out.designer, out.outcome.design, o);
+  out.quads = extract_quads(*out.designer, out.param);
+  return out;
+}
+
+// What (V, Q) say on their own.
+struct Counts {
+  int vertices = 0, edges = 0, faces = 0, boundary_loops = 0;
+  int overfull_edges = 0;               // in more than two quads
+  int repeated_half_edges = 0;          // a directed side run by two quads (inconsistent orientation)
+  int repeated_corners = 0;             // quads with a vertex twice
+  int split_vertices = 0;               // vertices whose quads form more than one fan (linked by the edges at it)
+  std::map<int, int> interior_valence;  // vertex -> number of edges, for vertices on no boundary edge
+  int euler() const { return vertices - edges + faces; }
+};
+
+Counts count(const Eigen::MatrixXd& V, const Eigen::MatrixX4i& Q) {
+  Counts c;
+  c.faces = static_cast<int>(Q.rows());
+  std::map<std::pair<int, int>, int> undirected, directed;
+  std::set<int> used;
+  for (int i = 0; i < Q.rows(); ++i) {
+    std::set<int> distinct;
+    for (int k = 0; k < 4; ++k) {
+      const int a = Q(i, k), b = Q(i, (k + 1) % 4);
+      EXPECT_GE(a, 0);
+      EXPECT_LT(a, V.rows());
+      used.insert(a), distinct.insert(a);
+      ++undirected[{std::min(a, b), std::max(a, b)}];
+      ++directed[{a, b}];
+    }
+    c.repeated_corners += distinct.size() != 4;
+  }
+  c.vertices = static_cast<int>(used.size());
+  c.edges = static_cast<int>(undirected.size());
+  for (const auto& [e, n] : undirected) c.overfull_edges += n > 2;
+  for (const auto& [e, n] : directed) c.repeated_half_edges += n > 1;
+  // Boundary sides: run by one quad; each boundary vertex of a manifold has one leaving it.
+  std::map<int, int> next;
+  std::set<int> boundary;
+  for (const auto& [e, n] : directed)
+    if (!directed.count({e.second, e.first})) next[e.first] = e.second, boundary.insert(e.first), boundary.insert(e.second);
+  std::set<int> seen;
+  for (const auto& [a, b] : next) {
+    if (seen.count(a)) continue;
+    ++c.boundary_loops;
+    for (int v = a; !seen.count(v) && next.count(v); v = next[v]) seen.insert(v);
+  }
+  for (const auto& [e, n] : undirected)
+    for (int v : {e.first, e.second})
+      if (!boundary.count(v)) ++c.interior_valence[v];
+  // Fans: at each vertex, its quads joined when they share an edge at it.
+  std::map<std::pair<int, int>, std::vector<int>> edge_quads;  // (v, w) -> quads with the edge v–w
+  std::map<int, std::vector<int>> vertex_quads;
+  for (int i = 0; i < Q.rows(); ++i)
+    for (int k = 0; k < 4; ++k) {
+      vertex_quads[Q(i, k)].push_back(i);
+      for (int w : {Q(i, (k + 1) % 4), Q(i, (k + 3) % 4)}) edge_quads[{Q(i, k), w}].push_back(i);
+    }
+  for (const auto& [v, quads] : vertex_quads) {
+    std::map<int, int> parent;
+    for (int q : quads) parent[q] = q;
+    std::function<int(int)> root = [&](int q) { return parent[q] == q ? q : parent[q] = root(parent[q]); };
+    for (auto it = edge_quads.lower_bound({v, -1}); it != edge_quads.end() && it->first.first == v; ++it)
+      for (size_t j = 1; j < it->second.size(); ++j) parent[root(it->second[j])] = root(it->second[0]);
+    std::set<int> roots;
+    for (int q : quads) roots.insert(root(q));
+    c.split_vertices += roots.size() > 1;
+  }
+  return c;
+}
+
+double distance_to_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  // Projection into the plane when inside, else the nearest of the three sides.
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const double area2 = n.squaredNorm();
+  if (area2 > 0) {
+    const Eigen::Vector3d q = p - n * (p - a).dot(n) / area2;
+    const double wa = (b - q).cross(c - q).dot(n), wb = (c - q).cross(a - q).dot(n), wc = (a - q).cross(b - q).dot(n);
+    if (wa >= 0 && wb >= 0 && wc >= 0) return (p - q).norm();
+  }
+  auto segment = [&](const Eigen::Vector3d& x, const Eigen::Vector3d& y) {
+    const double l = (y - x).squaredNorm();
+    const double s = l > 0 ? std::clamp((p - x).dot(y - x) / l, 0.0, 1.0) : 0.0;
+    return (p - (x + s * (y - x))).norm();
+  };
+  return std::min({segment(a, b), segment(b, c), segment(c, a)});
+}
+
+// Brute force over the input's triangles: the largest distance of a quad vertex from the surface.
+double farthest_vertex(const Pipeline& r) {
+  const MatrixX3d& V = r.designer->V();
+  const MatrixX3i& F = r.designer->topology().F;
+  double worst = 0;
+  for (int i = 0; i < r.quads.V.rows(); ++i) {
+    const Eigen::Vector3d p = r.quads.V.row(i).transpose();
+    double best = 1e300;
+    for (int f = 0; f < F.rows(); ++f) best = std::min(best, distance_to_triangle(p, V.row(F(f, 0)), V.row(F(f, 1)), V.row(F(f, 2))));
+    worst = std::max(worst, best);
+  }
+  return worst;
+}
+
+// Quads whose normal points away from the input's outward normal at the nearest input face to their centre.
+int inverted(const Pipeline& r) {
+  const MatrixX3d& V = r.designer->V();
+  const MatrixX3i& F = r.designer->topology().F;
+  int n = 0;
+  for (int i = 0; i < r.quads.Q.rows(); ++i) {
+    Eigen::Vector3d p[4];
+    for (int k = 0; k < 4; ++k) p[k] = r.quads.V.row(r.quads.Q(i, k)).transpose();
+    const Eigen::Vector3d centre = (p[0] + p[1] + p[2] + p[3]) / 4;
+    int nearest = 0;
+    double best = 1e300;
+    for (int f = 0; f < F.rows(); ++f) {
+      const double d = distance_to_triangle(centre, V.row(F(f, 0)), V.row(F(f, 1)), V.row(F(f, 2)));
+      if (d < best) best = d, nearest = f;
+    }
+    const Eigen::Vector3d a = V.row(F(nearest, 0)), b = V.row(F(nearest, 1)), c = V.row(F(nearest, 2));
+    n += (p[2] - p[0]).cross(p[3] - p[1]).dot((b - a).cross(c - a)) <= 0;
+  }
+  return n;
+}
+
+// The guarantees every clean extraction must meet, from (V, Q).
+// `brute_force`: also the checks that look at every input face for every quad (small meshes only).
+void expect_clean(const Pipeline& r, const std::string& what, bool brute_force = true) {
+  const QuadMesh& m = r.quads;
+  const Topology& t = r.designer->topology();
+  EXPECT_TRUE(m.quality.problems.empty()) << what << ": " << quad_warning(m);
+  EXPECT_TRUE(m.other_faces.empty()) << what;
+  ASSERT_GT(m.Q.rows(), 0) << what;
+  const Counts c = count(m.V, m.Q);
+  EXPECT_EQ(c.overfull_edges, 0) << what;
+  EXPECT_EQ(c.repeated_half_edges, 0) << what;
+  EXPECT_EQ(c.repeated_corners, 0) << what;
+  EXPECT_EQ(c.split_vertices, 0) << what;
+  EXPECT_EQ(c.vertices, m.V.rows()) << what << ": every vertex is in a quad";
+  EXPECT_EQ(c.euler(), t.euler_characteristic()) << what;
+  EXPECT_EQ(c.boundary_loops, static_cast<int>(t.boundary_loops.size())) << what;
+  // Valence 4 − n at a cone of index n/4, 4 at every other interior vertex.
+  std::map<int, int> cone;
+  for (size_t k = 0; k < r.param.cones.size(); ++k) cone[r.param.cones[k]] = r.param.cone_index[k];
+  std::set<int> cones_seen;
+  for (const auto& [v, valence] : c.interior_valence) {
+    const int input = m.vertex_cone[v];
+    const int n = cone.count(input) ? cone[input] : 0;
+    if (n != 0) cones_seen.insert(input);
+    EXPECT_EQ(valence, 4 - n) << what << ": quad vertex " << v << " (input vertex " << input << ")";
+  }
+  EXPECT_EQ(cones_seen.size(), cone.size()) << what << ": every cone has its quad vertex";
+  if (brute_force) {
+    EXPECT_EQ(inverted(r), 0) << what;
+  }
+  // The measures of the report agree with these counts.
+  EXPECT_EQ(m.quality.quads, c.faces) << what;
+  EXPECT_EQ(m.quality.euler_characteristic, c.euler()) << what;
+  EXPECT_EQ(m.quality.boundary_loops, c.boundary_loops) << what;
+  EXPECT_TRUE(m.quality.manifold) << what;
+  EXPECT_TRUE(m.quality.oriented) << what;
+  EXPECT_EQ(m.quality.singular_mismatches, 0) << what;
+  EXPECT_EQ(m.quality.inverted_quads, 0) << what;
+  // Corners may be reflex where the map is strongly distorted (near close cones), so only the mean is bounded.
+  EXPECT_GT(m.quality.mean_scaled_jacobian, 0.8) << what;
+  EXPECT_LE(m.quality.min_scaled_jacobian, m.quality.mean_scaled_jacobian) << what;
+  // The vertices lie on the input surface.
+  if (brute_force) {
+    const Eigen::Vector3d extent = r.designer->V().colwise().maxCoeff() - r.designer->V().colwise().minCoeff();
+    EXPECT_LT(farthest_vertex(r), 1e-9 * extent.norm()) << what;
+  }
+}
+
+TEST(Quad, FlatCubeIsItsOwnGrid) {
+  // A flat-sided cube of side 2 with its 8 corners +1/4 and the field along the sharp edges: at edge length 2/n
+  // the quads are the n × n grid of each side.
+  const Mesh m = make_cube_sphere(4, false);
+  FieldRequest req;
+  req.feature_degrees = 60;
+  req.auto_place = true;
+  for (int n : {4, 8, 3, 5}) {
+    ParamOptions o;
+    o.edge_length = 2.0 / n;
+    const Pipeline r = run(m, req, o, true);
+    const std::string what = "n = " + std::to_string(n);
+    ASSERT_EQ(r.param.cones.size(), 8u);
+    expect_clean(r, what);
+    EXPECT_EQ(r.quads.Q.rows(), 6 * n * n) << what;
+    const Counts c = count(r.quads.V, r.quads.Q);
+    int three = 0, four = 0;
+    for (const auto& [v, valence] : c.interior_valence) {
+      three += valence == 3;
+      four += valence == 4;
+    }
+    EXPECT_EQ(three, 8) << what;
+    EXPECT_EQ(four, static_cast<int>(c.interior_valence.size()) - 8) << what;
+    // Every quad is a square of side 2 / n (the sides are flat; a quad never bends over a sharp edge).
+    for (int i = 0; i < r.quads.Q.rows(); ++i)
+      for (int k = 0; k < 4; ++k)
+        EXPECT_NEAR((r.quads.V.row(r.quads.Q(i, k)) - r.quads.V.row(r.quads.Q(i, (k + 1) % 4))).norm(), 2.0 / n, 1e-6) << what;
+    EXPECT_NEAR(r.quads.quality.min_scaled_jacobian, 1.0, 1e-6) << what;
+  }
+}
+
+TEST(Quad, CubeSphereWithAutomaticCones) {
+  const Mesh m = make_cube_sphere(12, true);
+  FieldRequest req;
+  req.auto_place = true;
+  ParamOptions o;
+  o.target_faces = 6 * 36;
+  const Pipeline r = run(m, req, o);
+  ASSERT_EQ(r.param.cones.size(), 8u);
+  for (int n : r.param.cone_index) EXPECT_EQ(n, 1);
+  ASSERT_EQ(r.param.quality.flipped_faces, 0) << param_warning(r.param);
+  expect_clean(r, "cube sphere");
+  const Counts c = count(r.quads.V, r.quads.Q);
+  int three = 0;
+  for (const auto& [v, valence] : c.interior_valence) three += valence == 3;
+  EXPECT_EQ(three, 8);
+  EXPECT_NEAR(r.quads.Q.rows() / r.quads.quality.target_quads, 1.0, 0.3);
+  EXPECT_LT(r.quads.quality.hausdorff_relative, 0.05);
+}
+
+TEST(Quad, CubeSphereWithItsCornersPrescribed) {
+  // The 8 valence-3 vertices of the cube sphere as the +1/4 cones: 8 valence-3 quad vertices there, 4 elsewhere.
+  const Mesh m = make_cube_sphere(8, true);
+  const std::vector<int> corners = test::vertices_of_valence(m, 3);
+  ASSERT_EQ(corners.size(), 8u);
+  FieldRequest req;
+  for (int v : corners) req.prescription.vertex[v] = 1;
+  for (double h : {0.35, 0.5, 0.7}) {
+    ParamOptions o;
+    o.edge_length = h;
+    const Pipeline r = run(m, req, o);
+    const std::string what = "h = " + std::to_string(h);
+    ASSERT_EQ(r.param.quality.flipped_faces, 0) << what << ": " << param_warning(r.param);
+    expect_clean(r, what);
+    const Counts c = count(r.quads.V, r.quads.Q);
+    std::set<int> at_three;
+    for (const auto& [v, valence] : c.interior_valence)
+      if (valence == 3) at_three.insert(r.quads.vertex_cone[v]);
+    EXPECT_EQ(at_three, std::set<int>(corners.begin(), corners.end())) << what;
+  }
+}
+
+TEST(Quad, TorusIsARegularGrid) {
+  const Mesh m = make_torus(48, 16);
+  ParamOptions o;
+  o.target_faces = 300;
+  const Pipeline r = run(m, {}, o);
+  ASSERT_TRUE(r.param.cones.empty());
+  expect_clean(r, "torus");
+  const Counts c = count(r.quads.V, r.quads.Q);
+  EXPECT_EQ(c.euler(), 0);
+  for (const auto& [v, valence] : c.interior_valence) EXPECT_EQ(valence, 4);
+  EXPECT_EQ(static_cast<int>(c.interior_valence.size()), c.vertices);
+  EXPECT_EQ(r.quads.quality.irregular_vertices, 0);
+  // A regular grid on a torus: as many vertices as quads.
+  EXPECT_EQ(c.vertices, c.faces);
+  EXPECT_NEAR(r.quads.Q.rows() / r.quads.quality.target_quads, 1.0, 0.3);
+}
+
+TEST(Quad, GenusTwoWithAutomaticSingularities) {
+  const Mesh m = make_genus_surface(2, 3);
+  FieldRequest req;
+  req.auto_place = true;
+  ParamOptions o;
+  o.target_faces = 800;
+  const Pipeline r = run(m, req, o);
+  ASSERT_EQ(r.param.quality.flipped_faces, 0) << param_warning(r.param);
+  expect_clean(r, "genus 2");
+  EXPECT_EQ(count(r.quads.V, r.quads.Q).euler(), -2);
+  int irregular = 0;
+  for (const auto& [v, valence] : count(r.quads.V, r.quads.Q).interior_valence) irregular += valence != 4;
+  EXPECT_EQ(irregular, static_cast<int>(r.param.cones.size()));
+}
+
+TEST(Quad, DiskAndGridsEndOnTheirAlignedBoundary) {
+  FieldRequest req;
+  req.align_boundary = true;
+  req.auto_place = true;
+  {
+    ParamOptions o;
+    o.edge_length = 0.2;
+    const Pipeline r = run(make_disk(12, 8), req, o);
+    ASSERT_EQ(r.param.quality.flipped_faces, 0) << param_warning(r.param);
+    expect_clean(r, "disk");
+    EXPECT_EQ(count(r.quads.V, r.quads.Q).boundary_loops, 1);
+  }
+  {
+    // The unit square with two square holes, 15 × 15 cells, at a quad edge of 2 cells: the grid itself.
+    ParamOptions o;
+    o.edge_length = 2.0 / 15;
+    const Mesh m = make_holed_grid(15, 2);
+    const Pipeline r = run(m, req, o);
+    ASSERT_EQ(r.param.quality.flipped_faces, 0) << param_warning(r.param);
+    expect_clean(r, "holed grid");
+    const Counts c = count(r.quads.V, r.quads.Q);
+    EXPECT_EQ(c.boundary_loops, 3);
+    EXPECT_EQ(c.euler(), -1);
+  }
+  {
+    ParamOptions o;
+    o.target_faces = 150;
+    const Pipeline r = run(make_annulus(8, 48), req, o);
+    ASSERT_EQ(r.param.quality.flipped_faces, 0) << param_warning(r.param);
+    expect_clean(r, "annulus");
+    EXPECT_EQ(count(r.quads.V, r.quads.Q).boundary_loops, 2);
+  }
+}
+
+TEST(Quad, UnalignedBoundaryIsReported) {
+  // Without the boundary on iso-lines the traces leave the surface there: said, not hidden.
+  ParamOptions o;
+  o.edge_length = 0.2;
+  const Pipeline r = run(make_disk(12, 8), {}, o);
+  EXPECT_GT(r.quads.quality.failed_traces, 0);
+  EXPECT_FALSE(r.quads.quality.problems.empty());
+  EXPECT_TRUE(test::contains(quad_warning(r.quads), "aligned")) << quad_warning(r.quads);
+}
+
+TEST(Quad, InputWithMixedOrientation) {
+  // Every third face of the torus reversed: the topology orients them back, and the quads follow its orientation.
+  Mesh m = make_torus(48, 16);
+  for (int f = 0; f < m.F.rows(); f += 3) std::swap(m.F(f, 1), m.F(f, 2));
+  ParamOptions o;
+  o.target_faces = 300;
+  const Pipeline r = run(m, {}, o);
+  ASSERT_FALSE(r.designer->topology().flipped_faces.empty());
+  expect_clean(r, "mixed orientation");
+}
+
+TEST(Quad, SeveralComponents) {
+  // Apart in space, so that the nearest input face to a quad is one of its own component.
+  std::vector<Mesh> parts{make_torus(36, 12), make_cube_sphere(6, true), make_holed_grid(12, 1)};
+  for (size_t i = 0; i < parts.size(); ++i) parts[i].V.col(0).array() += 4.0 * static_cast<double>(i);
+  const Mesh m = concatenate(parts);
+  FieldRequest req;
+  req.auto_place = true;
+  req.align_boundary = true;
+  ParamOptions o;
+  o.target_faces = 600;
+  const Pipeline r = run(m, req, o);
+  ASSERT_EQ(r.param.quality.flipped_faces, 0) << param_warning(r.param);
+  expect_clean(r, "three components");
+  EXPECT_EQ(r.quads.quality.components, 3);
+  EXPECT_EQ(r.quads.quality.input_components, 3);
+}
+
+// A map with folds: the extraction ends, and says what failed instead of hiding it.
+TEST(Quad, FoldsAreReportedNotHidden) {
+  const Mesh m = make_torus(48, 16);
+  ParamOptions o;
+  o.target_faces = 300;
+  Pipeline r = run(m, {}, o);
+  // Push one vertex's (u, v) (every corner of it alike, so the map stays seamless off the cut) far over its ring.
+  const Topology& t = r.designer->topology();
+  for (int v : {100, 400}) {
+    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
+      const int f = t.vertex_faces[j];
+      for (int k = 0; k < 3; ++k)
+        if (t.F(f, k) == v) r.param.uv(3 * f + k, 0) += 2.3, r.param.uv(3 * f + k, 1) += 1.7;
+    }
+  }
+  const QuadMesh q = extract_quads(*r.designer, r.param);
+  EXPECT_FALSE(q.quality.problems.empty());
+  EXPECT_FALSE(quad_warning(q).empty());
+  EXPECT_GT(q.quality.failed_traces + q.quality.unmatched_traces + q.quality.dropped_points, 0);
+  // The quads and the other faces together: every walk closed, and each side of an edge is run once.
+  EXPECT_EQ(q.quality.open_faces, 0);
+  std::map<std::pair<int, int>, int> sides;
+  std::set<int> used;
+  std::vector<std::vector<int>> all = q.other_faces;
+  for (int i = 0; i < q.Q.rows(); ++i) all.push_back({q.Q(i, 0), q.Q(i, 1), q.Q(i, 2), q.Q(i, 3)});
+  for (const auto& face : all)
+    for (size_t k = 0; k < face.size(); ++k) {
+      ASSERT_LT(face[k], q.V.rows());
+      used.insert(face[k]);
+      ++sides[{face[k], face[(k + 1) % face.size()]}];
+    }
+  int unpaired = 0;
+  for (const auto& [side, n] : sides) {
+    EXPECT_EQ(n, 1);
+    unpaired += !sides.count({side.second, side.first});
+  }
+  EXPECT_EQ(unpaired, 0);                                                                                           // closed
+  EXPECT_EQ(static_cast<int>(used.size()) - static_cast<int>(sides.size()) / 2 + static_cast<int>(all.size()), 0);  // χ of the torus
+  // Garbage (u, v): random per vertex. Ends, reports, does not throw.
+  Parametrization garbage = r.param;
+  unsigned seed = 12345;
+  std::vector<Eigen::Vector2d> at(t.num_vertices);
+  for (auto& p : at) {
+    seed = seed * 1103515245u + 12345u;
+    const double a = (seed >> 8) % 1000 / 100.0;
+    seed = seed * 1103515245u + 12345u;
+    p = Eigen::Vector2d(a, (seed >> 8) % 1000 / 100.0);
+  }
+  garbage.cut_edges.clear();
+  garbage.rotation.setZero();
+  garbage.translation.setZero();
+  for (int f = 0; f < t.num_faces; ++f)
+    for (int k = 0; k < 3; ++k) garbage.uv.row(3 * f + k) = at[t.F(f, k)].transpose();
+  const QuadMesh g = extract_quads(*r.designer, garbage);
+  EXPECT_FALSE(g.quality.problems.empty());
+  EXPECT_GT(g.quality.dropped_points + g.quality.failed_traces + g.quality.unmatched_traces, 0);
+}
+
+// check_quads on its own: a quad mesh with one quad removed has a hole the input does not have.
+TEST(Quad, CheckFindsAHole) {
+  const Mesh m = make_torus(48, 16);
+  ParamOptions o;
+  o.target_faces = 300;
+  const Pipeline r = run(m, {}, o);
+  QuadMesh q = r.quads;
+  ASSERT_TRUE(q.quality.problems.empty()) << quad_warning(q);
+  q.Q = q.Q.topRows(q.Q.rows() - 1).eval();
+  q.quality = {};
+  check_quads(*r.designer, r.param, q);
+  EXPECT_EQ(q.quality.boundary_loops, 1);
+  EXPECT_EQ(q.quality.euler_characteristic, -1);
+  EXPECT_EQ(q.quality.problems.size(), 2u) << quad_warning(q);  // χ and the boundary loops
+  // Reversing one quad breaks the orientation.
+  QuadMesh flipped = r.quads;
+  flipped.Q.row(0) = flipped.Q.row(0).reverse().eval();
+  flipped.quality = {};
+  check_quads(*r.designer, r.param, flipped);
+  EXPECT_FALSE(flipped.quality.oriented);
+  EXPECT_EQ(flipped.quality.inverted_quads, 1);
+  QuadMesh bad = r.quads;
+  bad.Q(0, 0) = static_cast<int>(bad.V.rows());
+  EXPECT_THROW(check_quads(*r.designer, r.param, bad), Error);
+}
+
+TEST(Quad, RefusesAMapOfAnotherMesh) {
+  const Mesh m = make_torus(48, 16), other = make_torus(24, 8);
+  ParamOptions o;
+  o.target_faces = 300;
+  const Pipeline r = run(m, {}, o);
+  FieldDesigner d(other.V, other.F);
+  try {
+    extract_quads(d, r.param);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "quad: the map does not belong to this mesh (4608 corner rows for 384 faces)");
+  }
+  Parametrization far = r.param;
+  far.uv(0, 0) = 1e12;
+  try {
+    extract_quads(*r.designer, far);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(std::string(e.what()).find("beyond 2^30") != std::string::npos) << e.what();
+  }
+}
+
+// A 100k-face torus at about 10k quads: the extraction is linear (the bound is loose for a loaded machine).
+TEST(Quad, LargeMeshIsFast) {
+  const Mesh m = make_torus(400, 125);
+  ParamOptions o;
+  o.target_faces = 10000;
+  const Pipeline r = run(m, {}, o);
+  expect_clean(r, "large torus", false);
+  EXPECT_LT(r.quads.quality.seconds_extract, 2.0);
+  std::printf(
+      "large torus: %d faces, %d quads, extract %.3f s, check %.3f s, map %.2f s\n", static_cast<int>(m.F.rows()),
+      static_cast<int>(r.quads.Q.rows()), r.quads.quality.seconds_extract, r.quads.quality.seconds_check,
+      r.param.quality.seconds_cut + r.param.quality.seconds_setup + r.param.quality.seconds_rounding + r.param.quality.seconds_stiffening);
+}
+
+}  // namespace
+}  // namespace trivcon
