@@ -1,0 +1,157 @@
+// `trivcon quad`, run as a separate process: the quad mesh file read back and checked on its own (only quads,
+// each edge in at most two, χ, boundary loops, valences at the written singularities), the report, --uv-out,
+// --sing-out, PLY output, usage errors.
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "support.h"
+#include "trivcon/io.h"
+
+namespace trivcon {
+namespace {
+
+using test::run_cli;
+using test::slurp;
+using test::temp_file;
+
+std::string mesh_file(const Mesh& m, const std::string& name) {
+  const std::string path = temp_file(name);
+  write_obj(path, m.V, m.F);
+  return path;
+}
+
+// A quad mesh file read back as its quads (each polygon of the file fanned into two triangles by the reader).
+struct QuadFile {
+  MatrixX3d V;
+  std::vector<std::array<int, 4>> quads;
+};
+
+QuadFile read_quads(const std::string& path) {
+  const MeshData m = read_mesh(path);
+  QuadFile out{m.V, {}};
+  EXPECT_EQ(static_cast<size_t>(m.F.rows()), 2 * static_cast<size_t>(m.polygon_count)) << "a polygon that is not a quad";
+  for (int p = 0; p < m.polygon_count; ++p) {
+    EXPECT_EQ(m.polygon_of_triangle[2 * p], p);
+    EXPECT_EQ(m.polygon_of_triangle[2 * p + 1], p);
+    out.quads.push_back({m.F(2 * p, 0), m.F(2 * p, 1), m.F(2 * p, 2), m.F(2 * p + 1, 2)});
+  }
+  return out;
+}
+
+struct Census {
+  int euler = 0, boundary_edges = 0, over_shared_edges = 0;
+  std::map<int, int> interior_valence;  // vertex -> valence, for vertices on no boundary edge
+};
+
+// χ = V − E + F, edges in more than two quads, valences of interior vertices: from the quads alone.
+Census census(const QuadFile& q) {
+  std::map<std::pair<int, int>, int> edge_uses;
+  for (const auto& quad : q.quads)
+    for (int k = 0; k < 4; ++k) ++edge_uses[std::minmax(quad[k], quad[(k + 1) % 4])];
+  Census c;
+  std::set<int> used, on_boundary;
+  std::map<int, int> valence;
+  for (const auto& [e, uses] : edge_uses) {
+    used.insert(e.first), used.insert(e.second);
+    ++valence[e.first], ++valence[e.second];
+    if (uses == 1) ++c.boundary_edges, on_boundary.insert(e.first), on_boundary.insert(e.second);
+    if (uses > 2) ++c.over_shared_edges;
+  }
+  c.euler = static_cast<int>(used.size()) - static_cast<int>(edge_uses.size()) + static_cast<int>(q.quads.size());
+  for (auto [v, n] : valence)
+    if (!on_boundary.count(v)) c.interior_valence[v] = n;
+  return c;
+}
+
+std::map<int, std::string> read_sing_file(const std::string& path) {
+  std::map<int, std::string> out;
+  for (const std::string& line : test::lines_of(slurp(path))) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    int v = 0;
+    std::string index;
+    s >> v >> index;
+    out[v] = index;
+  }
+  return out;
+}
+
+// A cube: 8 singularities of +1/4 at the corners, the only irregular vertices, of valence 3, each at the
+// position of its corner; the report agrees with the file; the map and the singularities are written.
+TEST(CliQuad, CubeGivesEightValenceThreeCornersAndNothingElseIrregular) {
+  const Mesh m = make_cube_sphere(8, false);
+  const std::string mesh = mesh_file(m, "cube.obj"), out = temp_file("q.obj"), report = temp_file("r.json"), uv = temp_file("uv.obj"),
+                    sings = temp_file("s.sing");
+  const auto r = run_cli("quad " + mesh + " --auto --target-faces 400 -o " + out + " --report " + report + " --uv-out " + uv + " --sing-out " + sings);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("irregular vertices: 8 (singularities: 8 of valence 3), exactly at the singularities"), std::string::npos) << r.out;
+  const QuadFile q = read_quads(out);
+  const Census c = census(q);
+  EXPECT_EQ(c.euler, 2);
+  EXPECT_EQ(c.boundary_edges, 0);
+  EXPECT_EQ(c.over_shared_edges, 0);
+  std::vector<int> irregular;
+  for (auto [v, n] : c.interior_valence)
+    if (n != 4) {
+      EXPECT_EQ(n, 3) << "vertex " << v;
+      irregular.push_back(v);
+    }
+  ASSERT_EQ(irregular.size(), 8u);
+  // Each irregular vertex is at a written singularity's position.
+  const std::map<int, std::string> written = read_sing_file(sings);
+  EXPECT_EQ(written.size(), 8u);
+  for (int v : irregular) {
+    double nearest = 1e300;
+    for (const auto& [s, index] : written) nearest = std::min(nearest, (q.V.row(v) - m.V.row(s)).norm());
+    EXPECT_LT(nearest, 1e-9) << "quad vertex " << v;
+  }
+  for (const auto& [s, index] : written) EXPECT_EQ(index, "1/4");
+  // Quads near the target, the report the file's numbers.
+  EXPECT_GT(q.quads.size(), 280u);
+  EXPECT_LT(q.quads.size(), 520u);
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j["quad"]["quads"].get<size_t>(), q.quads.size());
+  EXPECT_EQ(j["quad"]["irregular_vertices"], 8);
+  EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
+  EXPECT_EQ(j["quad"]["euler_characteristic"], 2);
+  EXPECT_TRUE(j["quad"]["manifold"].get<bool>());
+  EXPECT_TRUE(j["quad"]["problems"].empty());
+  EXPECT_GT(j["quad"]["min_scaled_jacobian"].get<double>(), 0.3);
+  EXPECT_TRUE(j["param"]["seamless"].get<bool>());
+  EXPECT_EQ(read_corner_uv(uv, m.F).rows(), m.F.rows());
+}
+
+// A square plate with holes, its boundary aligned: the quads end on every boundary loop (as many loops, same χ),
+// and binary PLY output reads back the same.
+TEST(CliQuad, HoledPlateEndsOnItsBoundaryLoops) {
+  const Mesh m = make_holed_grid(24, 3);
+  const std::string mesh = mesh_file(m, "plate.obj"), out = temp_file("q.ply"), report = temp_file("r.json");
+  const auto r = run_cli("quad " + mesh + " --align-boundary --auto --target-faces 600 -o " + out + " --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const QuadFile q = read_quads(out);
+  const Census c = census(q);
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(c.euler, j["euler_characteristic"].get<int>());
+  EXPECT_EQ(j["quad"]["boundary_loops"], j["boundary_loops"]);
+  EXPECT_GT(c.boundary_edges, 0);
+  EXPECT_EQ(c.over_shared_edges, 0);
+  int irregular = 0;
+  for (auto [v, n] : c.interior_valence) irregular += n != 4;
+  EXPECT_EQ(irregular, j["quad"]["irregular_vertices"].get<int>());
+  EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
+}
+
+TEST(CliQuad, UsageErrors) {
+  const std::string mesh = mesh_file(make_icosphere(2), "sphere.obj"), out = temp_file("q.obj");
+  EXPECT_EQ(run_cli("quad " + mesh + " --auto -o " + out).status, 2);                         // no scale
+  EXPECT_EQ(run_cli("quad " + mesh + " --auto --target-faces 100").status, 2);                // no -o
+  EXPECT_EQ(run_cli("quad " + mesh + " -N 6 --auto --target-faces 100 -o " + out).status, 2);  // N is 4
+  EXPECT_EQ(run_cli("quad " + mesh + " --auto --target-faces 100 --edge-length 1 -o " + out).status, 2);
+  const auto split = run_cli("quad " + mesh + " --auto --split-large-turns --target-faces 100 -o " + out);
+  EXPECT_EQ(split.status, 2);
+  EXPECT_NE(split.err.find("not needed by quad"), std::string::npos) << split.err;
+}
+
+}  // namespace
+}  // namespace trivcon
