@@ -53,7 +53,9 @@
 #include <utility>
 #include <vector>
 
+#include "report.h"
 #include "trivcon/auto.h"
+#include "trivcon/quad.h"
 #include "trivcon/blas.h"
 #include "trivcon/cancel.h"
 #include "trivcon/split_large_turns.h"
@@ -264,6 +266,10 @@ DoubleArray double_matrix3(const MatrixX3d& m) {
   std::copy(m.data(), m.data() + m.size(), out.mutable_data());  // both row-major
   return out;
 }
+
+// A report entry (report/report.h) as Python objects, through Python's json module: the dicts of the module and the
+// CLI's reports are written once.
+py::object json_to_python(const nlohmann::ordered_json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
 py::tuple mesh_tuple(const Mesh& mesh) { return py::make_tuple(double_matrix3(mesh.V), int64_matrix(mesh.F)); }
 
@@ -732,6 +738,13 @@ PYBIND11_MODULE(_core, m) {
           throw Error("cannot write '" + path + "': unknown mesh format (use .obj or .ply)");
       },
       py::arg("path"), py::arg("V"), py::arg("F"), "Writes OBJ or binary PLY by extension, atomically (trivcon/io.h).");
+  m.def(
+      "write_quad_mesh",
+      [](const std::string& path, const MatrixX3d& V, const Eigen::MatrixX4i& Q) {
+        py::gil_scoped_release release;
+        write_quad_mesh(path, V, Q);
+      },
+      py::arg("path"), py::arg("V"), py::arg("Q"), "Writes a quad mesh: binary PLY when the path ends in .ply, else OBJ (trivcon/io.h).");
   m.def(
       "read_field",
       [](const std::string& path, int num_faces) {
@@ -1251,27 +1264,25 @@ PYBIND11_MODULE(_core, m) {
               C(k, 0) = t.edge_vertices(e, 0), C(k, 1) = t.edge_vertices(e, 1);
               R(k) = p->rotation[e], T(k, 0) = p->translation(e, 0), T(k, 1) = p->translation(e, 1);
             }
-            const ParamQuality& q = p->quality;
-            py::dict d;
-            d["seamless"] = q.seamless, d["cones"] = q.cones, d["cut_edges"] = q.cut_edges, d["integer_unknowns"] = q.integer_unknowns;
-            d["rounding_rounds"] = q.rounding_rounds, d["factorizations"] = q.factorizations, d["stiffening_rounds"] = q.stiffening_rounds;
-            d["folds_real_valued"] = q.folds_real_valued, d["folds_rounded"] = q.folds_rounded, d["cones_moved"] = q.cones_moved;
-            d["flipped_faces"] = q.flipped_faces, d["degenerate_faces"] = q.degenerate_faces, d["first_flipped"] = q.first_flipped;
-            d["max_transition_residual"] = q.max_transition_residual, d["max_cone_offset"] = q.max_cone_offset;
-            d["max_cone_angle_error"] = q.max_cone_angle_error, d["aligned_edges"] = q.aligned_edges;
-            d["unaligned_edges"] = q.unaligned_edges, d["max_alignment_error"] = q.max_alignment_error;
-            d["mean_distortion"] = q.mean_distortion, d["max_distortion"] = q.max_distortion, d["unit_squares"] = q.unit_squares;
-            d["target_squares"] = q.target_squares, d["non_unimodular"] = q.non_unimodular;
-            py::dict seconds;
-            seconds["cut"] = q.seconds_cut, seconds["setup"] = q.seconds_setup, seconds["rounding"] = q.seconds_rounding;
-            seconds["stiffening"] = q.seconds_stiffening, seconds["check"] = q.seconds_check;
-            d["seconds"] = seconds;
-            return py::make_tuple(uv, cut, rotation, translation, int64_vector(p->cones), int64_vector(p->cone_index), p->edge_length, d,
-                                  param_warning(*p));
+            return py::make_tuple(uv, cut, rotation, translation, int64_vector(p->cones), int64_vector(p->cone_index), p->edge_length,
+                                  json_to_python(cli::param_report(*p)), param_warning(*p), p);
           },
           py::arg("edge_length"), py::arg("target_faces"), py::arg("align_boundary"), py::arg("aligned_edges"),
           "The integer-grid map (trivcon/param.h): (uv (F, 3, 2) in the input's corner order, cut edges (n, 2), their rotations, "
-          "translations (n, 2), cone vertices, their numerators (index n/4), edge length, quality dict, warning).")
+          "translations (n, 2), cone vertices, their numerators (index n/4), edge length, quality dict (param's report), warning, "
+          "the map itself for quads).")
+      .def(
+          "quads",
+          [](const DesignResultPtr& r, const std::shared_ptr<Parametrization>& p) {
+            if (!p) throw Error("quads: no map given");
+            QuadMesh q = interruptible(r->state->threads, [r, p] { return extract_quads(*r->state->designer, *p); });
+            return py::make_tuple(double_matrix3(q.V), int64_matrix(q.Q), int64_vector(std::vector<int>(q.vertex_face.data(), q.vertex_face.data() + q.vertex_face.size())),
+                                  int64_vector(std::vector<int>(q.vertex_cone.data(), q.vertex_cone.data() + q.vertex_cone.size())),
+                                  json_to_python(cli::quad_report(q)), quad_warning(q));
+          },
+          py::arg("param"),
+          "The quad mesh of a map (trivcon/quad.h): (V (n, 3), Q (m, 4), face of each vertex, input vertex under each vertex or -1, "
+          "quality dict (quad's report), warning).")
       .def(
           "render",
           [](const DesignResultPtr& r, const std::optional<std::vector<std::pair<int, int>>>& singular, const RenderArgs& args) {
@@ -1284,6 +1295,7 @@ PYBIND11_MODULE(_core, m) {
           },
           py::arg("singularities"), py::arg("options"));
 
+  py::class_<Parametrization, std::shared_ptr<Parametrization>>(m, "ParamCore", "A trivcon::Parametrization, kept for quads.");
   py::class_<AutoOut, AutoOutPtr>(m, "AutoResult", "A trivcon::AutoResult.")
       .def("get_state", &auto_state, "Everything the result holds (for pickling).")
       .def_static("restore", &restore_auto, py::arg("designer"), py::arg("state"), "An AutoResult of get_state()'s dict.")

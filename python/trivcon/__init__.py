@@ -70,6 +70,7 @@ __all__ = [
     "AutoResult",
     "RelaxResult",
     "Parametrization",
+    "QuadMesh",
     "read_mesh",
     "write_mesh",
     "field_indices",
@@ -1307,8 +1308,18 @@ class Result(_Cached):
             if pairs.size and (pairs.ndim != 2 or pairs.shape[1] != 2 or pairs.dtype.kind not in "iu"):
                 raise Error(f"aligned_edges: expected (n, 2) vertex ids, got an array of shape {pairs.shape} and type {pairs.dtype}")
         edge_pairs = [(int(a), int(b)) for a, b in _np.asarray(pairs).reshape(-1, 2)]
-        out = self._r.parametrize(float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs)
-        return Parametrization(self, *out)
+        args = (float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs)
+        return Parametrization(self, *self._r.parametrize(*args), args=args)
+
+    def quad(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None):
+        """The quad mesh of this cross field (N = 4), as `trivcon quad`: a QuadMesh (V, Q = result.quad(...) works too).
+
+        The map is made as by parametrize (same arguments), then its integer grid is extracted (trivcon/quad.h,
+        docs/quad.md): the quads' irregular vertices are this field's singularities, valence 4 - n at index n/4.
+        QuadMesh.quality has every guarantee checked on the result and QuadMesh.warning says what failed ("" when
+        nothing did); nothing is raised for a failed guarantee, so that the mesh can be looked at.
+        """
+        return self.parametrize(target_faces, edge_length, align_boundary, aligned_edges).quads()
 
     def render(self, size=(1200, 900), view=(30, 20), up="y", style="hedgehog", spacing=11, flat=False, legend=True,
                singularities=None, supersampling=3):
@@ -1364,6 +1375,45 @@ class RelaxResult:
                 f"{int(self.moves['cancelled'].sum())} cancelling a pair, converged={self.converged}>")
 
 
+class QuadMesh:
+    """The quad mesh of a seamless map (Result.quad, Parametrization.quads; trivcon/quad.h, docs/quad.md).
+
+      V            float64 (n, 3): the quad vertices, on the input surface
+      Q            int64 (m, 4): the quads, counter-clockwise seen from outside (the input faces' orientation)
+      vertex_face  int64 (n,): the face (of the designer's mesh) each vertex lies in
+      vertex_cone  int64 (n,): the mesh vertex under each quad vertex (a singularity, or a vertex on an integer
+                   point), else -1
+      quality      dict: quads, vertices, euler_characteristic (and input_...), boundary_loops, manifold,
+                   oriented, irregular_vertices, singular_mismatches, inverted_quads, min/mean_scaled_jacobian,
+                   hausdorff_relative, target_quads, extraction counts, problems, seconds (the `quad` object of
+                   `trivcon quad --report`)
+      warning      "" when every guarantee holds, else what failed, in one sentence
+    Unpacks as (V, Q); write(path) writes what `trivcon quad -o` writes (.ply binary, else OBJ).
+    """
+
+    def __init__(self, V, Q, vertex_face, vertex_cone, quality, warning):
+        self.V, self.Q = _frozen(V), _frozen(Q)
+        self.vertex_face, self.vertex_cone = _frozen(vertex_face), _frozen(vertex_cone)
+        self.quality, self.warning = quality, warning
+
+    def __iter__(self):
+        return iter((self.V, self.Q))
+
+    @property
+    def ok(self):
+        """Every guarantee holds (quality["problems"] is empty)."""
+        return not self.quality["problems"]
+
+    def write(self, path):
+        """Write the quad mesh: binary PLY when path ends in .ply, else OBJ (quads as 'f a b c d')."""
+        _core.write_quad_mesh(str(path), _np.ascontiguousarray(self.V, dtype=_np.float64), _np.ascontiguousarray(self.Q, dtype=_np.int64))
+
+    def __repr__(self):
+        q = self.quality
+        return (f"QuadMesh({q['quads']} quads, {q['vertices']} vertices, {q['irregular_vertices']} irregular, chi {q['euler_characteristic']}, "
+                f"scaled Jacobian min {q['min_scaled_jacobian']:.3g}, ok={self.ok})")
+
+
 class Parametrization:
     """A seamless integer-grid map (Result.parametrize; the conventions of trivcon/param.h, docs/param.md).
 
@@ -1380,11 +1430,23 @@ class Parametrization:
     write_obj(path) writes what `trivcon param -o` writes.
     """
 
-    def __init__(self, result, uv, cut, rotations, translations, cones, cone_index, edge_length, quality, warning):
+    def __init__(self, result, uv, cut, rotations, translations, cones, cone_index, edge_length, quality, warning, core=None, args=None):
         self._result = result
         self.uv, self.cut_edges, self.rotations, self.translations = (_frozen(a) for a in (uv, cut, rotations, translations))
         self.cones, self.cone_index = _frozen(cones), _frozen(cone_index)
         self.edge_length, self.quality, self.warning = edge_length, quality, warning
+        self._core, self._args = core, args
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state["_core"] = None  # made again from the result on the first quads() after unpickling
+        return state
+
+    def quads(self):
+        """The quad mesh of this map (trivcon/quad.h): a QuadMesh. See Result.quad."""
+        if self._core is None:
+            self._core = self._result._r.parametrize(*self._args)[-1]
+        return QuadMesh(*self._result._r.quads(self._core))
 
     @property
     def seamless(self):

@@ -3,7 +3,7 @@
 # name and every parameter here matches the module.
 import os
 from fractions import Fraction
-from typing import Any, Dict, Iterable, List, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Dict, Iterable, Iterator, List, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -268,6 +268,13 @@ class Result:
         align_boundary: Optional[bool] = ...,
         aligned_edges: Optional[npt.ArrayLike] = ...,
     ) -> Parametrization: ...
+    def quad(
+        self,
+        target_faces: Optional[float] = ...,
+        edge_length: Optional[float] = ...,
+        align_boundary: Optional[bool] = ...,
+        aligned_edges: Optional[npt.ArrayLike] = ...,
+    ) -> QuadMesh: ...
     def render(
         self,
         size: Tuple[int, int] = ...,
@@ -280,6 +287,19 @@ class Result:
         singularities: Optional[_Indices] = ...,
         supersampling: int = ...,
     ) -> _ImageArray: ...
+
+class QuadMesh:
+    V: _FloatArray
+    Q: _IntArray
+    vertex_face: _IntArray
+    vertex_cone: _IntArray
+    quality: Dict[str, Any]
+    warning: str
+    def __init__(self, V: Any, Q: Any, vertex_face: Any, vertex_cone: Any, quality: Dict[str, Any], warning: str) -> None: ...
+    def __iter__(self) -> Iterator[npt.NDArray[Any]]: ...
+    @property
+    def ok(self) -> bool: ...
+    def write(self, path: _Path) -> None: ...
 
 class Parametrization:
     uv: _FloatArray
@@ -303,9 +323,12 @@ class Parametrization:
         edge_length: float,
         quality: Dict[str, Any],
         warning: str,
+        core: Any = ...,
+        args: Any = ...,
     ) -> None: ...
     @property
     def seamless(self) -> bool: ...
+    def quads(self) -> QuadMesh: ...
     def write_obj(self, path: _Path) -> None: ...
 
 class RelaxResult:

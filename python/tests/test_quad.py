@@ -1,0 +1,78 @@
+"""Result.quad and Parametrization.quads: the quad mesh from Python, checked from (V, Q) alone and against
+`trivcon quad`."""
+
+import json
+import pickle
+from collections import Counter
+
+import numpy as np
+import pytest
+
+import trivcon
+
+
+def census(V, Q):
+    """(chi, boundary edges, edges in more than two quads, {interior vertex: valence}) from the quads alone."""
+    edges = Counter()
+    for quad in Q:
+        for k in range(4):
+            a, b = int(quad[k]), int(quad[(k + 1) % 4])
+            edges[(min(a, b), max(a, b))] += 1
+    used = {v for e in edges for v in e}
+    boundary = {v for e, n in edges.items() if n == 1 for v in e}
+    valence = Counter(v for e in edges for v in e)
+    chi = len(used) - len(edges) + len(Q)
+    return chi, sum(n == 1 for n in edges.values()), sum(n > 2 for n in edges.values()), {v: n for v, n in valence.items() if v not in boundary}
+
+
+def test_cube_quads_have_eight_valence_three_corners():
+    V, F = trivcon.make_cube_sphere(8, spherical=False)
+    r = trivcon.FieldDesigner(V, F).solve(4, "auto")
+    q = r.quad(target_faces=400)
+    QV, QQ = q  # unpacks as (V, Q)
+    assert QQ.shape[1] == 4 and QQ.dtype == np.int64 and QV.shape[1] == 3
+    chi, boundary, over, valence = census(QV, QQ)
+    assert (chi, boundary, over) == (2, 0, 0)
+    irregular = sorted(v for v, n in valence.items() if n != 4)
+    assert len(irregular) == 8 and all(valence[v] == 3 for v in irregular)
+    # The irregular quad vertices sit on the singular vertices of the field.
+    assert sorted(int(q.vertex_cone[v]) for v in irregular) == sorted(r.singularities)
+    assert q.ok and q.warning == "" and q.quality["singular_mismatches"] == 0
+    assert q.quality["quads"] == len(QQ) and q.quality["irregular_vertices"] == 8
+    assert 280 < len(QQ) < 520
+    assert "8 irregular" in repr(q)
+
+
+def test_same_as_the_program(cli, tmp_path):
+    V, F = trivcon.make_torus(48, 16)
+    mesh = tmp_path / "torus.obj"
+    trivcon.write_mesh(str(mesh), V, F)
+    report, out = tmp_path / "r.json", tmp_path / "q.obj"
+    cli("quad", mesh, "--target-faces", 500, "-o", out, "--report", report)  # no singularities: a torus needs none
+    j = json.loads(report.read_text())["quad"]
+    q = trivcon.FieldDesigner(V, F).solve(4, {}).parametrize(target_faces=500)
+    quads = q.quads()
+    assert quads.quality["quads"] == j["quads"] and quads.quality["irregular_vertices"] == j["irregular_vertices"] == 0
+    quads.write(tmp_path / "again.obj")
+    # The same quads; positions equal to rounding (the two solves may sum in another order on other threads).
+    V1, F1 = trivcon.read_mesh(str(out))
+    V2, F2 = trivcon.read_mesh(str(tmp_path / "again.obj"))
+    assert np.array_equal(F1, F2) and np.allclose(V1, V2, atol=1e-6)
+    chi, boundary, over, valence = census(*quads)
+    assert chi == 0 and boundary == 0 and over == 0 and set(valence.values()) == {4}
+
+
+def test_parametrization_pickles_and_still_gives_quads():
+    V, F = trivcon.make_cube_sphere(6, spherical=False)
+    p = trivcon.FieldDesigner(V, F).solve(4, "auto").parametrize(target_faces=200)
+    back = pickle.loads(pickle.dumps(p))
+    assert back.quads().quality["quads"] == p.quads().quality["quads"]
+
+
+def test_quad_needs_a_cross_field_and_a_scale():
+    V, F = trivcon.make_icosphere(2)
+    d = trivcon.FieldDesigner(V, F)
+    with pytest.raises(trivcon.Error, match="needs a cross field"):
+        d.solve(6, "auto").quad(target_faces=100)
+    with pytest.raises(trivcon.Error, match="give exactly one of target_faces and edge_length"):
+        d.solve(4, "auto").quad()
