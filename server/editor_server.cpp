@@ -33,6 +33,7 @@
 #include "summary.h"
 #include "trivcon/auto.h"
 #include "trivcon/cancel.h"
+#include "trivcon/quad.h"
 #include "trivcon/relax.h"
 #include "trivcon/request.h"
 #include "trivcon/constraints.h"
@@ -229,6 +230,48 @@ const json& pair_at(const json& list, size_t i, const char* key) {
 // process_and_close_socket): a thread per connection up to max_connections (WorkerPool), and this stream,
 // which gives the request line and headers, then the body, a deadline and a byte budget, and fails any wait
 // as soon as the server stops.
+
+// While it lives, the library's long work on the constructing thread stops (trivcon::Cancelled) once `seconds`
+// have passed or the server is stopping, whichever comes first (trivcon/cancel.h): the bound of a request's work.
+class Deadline {
+ public:
+  Deadline(double seconds, const std::atomic<bool>& stopping) : scope_(flag_) {
+    watcher_ = std::thread([this, seconds, &stopping] {
+      const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+      std::unique_lock lock(mutex_);
+      while (!done_) {
+        if (stopping || Clock::now() >= until) {
+          expired_ = !stopping;
+          flag_->store(true);
+          return;
+        }
+        wake_.wait_until(lock, std::min(until, Clock::now() + std::chrono::milliseconds(100)));  // polls `stopping`
+      }
+    });
+  }
+  ~Deadline() {
+    {
+      std::lock_guard lock(mutex_);
+      done_ = true;
+    }
+    wake_.notify_all();
+    watcher_.join();
+  }
+  Deadline(const Deadline&) = delete;
+  Deadline& operator=(const Deadline&) = delete;
+  bool expired() const {
+    std::lock_guard lock(mutex_);
+    return expired_;
+  }
+
+ private:
+  CancelFlag flag_ = std::make_shared<std::atomic<bool>>(false);
+  CancelScope scope_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  bool done_ = false, expired_ = false;
+  std::thread watcher_;
+};
 
 struct Limits {
   Clock::duration header, body, idle, keep_alive;
@@ -505,6 +548,7 @@ struct EditorServer::Impl {
     FieldRequest field;              // as asked (trivcon/request.h); field.prescription.fixed: the explicit directions of "fixed"
     IndexPrescription prescription;  // with every fixed face: the alignments' and the explicit ones (RequestConstraints::fixed)
     std::vector<int> fixed_faces;    // sorted: every face of prescription.fixed
+    std::vector<int> sharp_edges;    // the feature edges followed (align_features)
   };
   // The smoothest field of the last /api/auto: later solves of its N take their rotation from it.
   std::mutex auto_guide_mutex;
@@ -533,6 +577,7 @@ struct EditorServer::Impl {
     r.prescription = r.field.prescription;
     r.prescription.fixed = std::move(c.fixed);
     r.fixed_faces = std::move(c.fixed_faces);
+    r.sharp_edges = std::move(c.sharp_edges);
   }
 
   // The request in the API's own shape, ids and index texts normalized (GET /api/state, session files).
@@ -903,7 +948,7 @@ struct EditorServer::Impl {
         return refuse(res, 400, "a " + req.method + " request has no body", true);
       return httplib::Server::HandlerResponse::Unhandled;
     }
-    static const std::vector<std::string> posts = {"/api/solve", "/api/auto", "/api/relax", "/api/export", "/api/streamlines"};
+    static const std::vector<std::string> posts = {"/api/solve", "/api/auto", "/api/relax", "/api/quad", "/api/export", "/api/streamlines"};
     if (std::find(posts.begin(), posts.end(), req.path) == posts.end())
       return refuse(res, 404, "no such endpoint (see README.md, Editor)", has_body);
     // A form of any web page can POST text/plain, form data or multipart without asking; only a script of the
@@ -1212,6 +1257,57 @@ struct EditorServer::Impl {
                              {"out_of_time", x.out_of_time},
                              {"seconds", x.seconds}};
                 res.set_content(out.dump() + "\n", kJson);
+              }));
+    http.Post("/api/quad", api_post([this](const httplib::Request&, const std::string& text, httplib::Response& res) {
+                json body;
+                const Request r = parse_request(text, &body);
+                if (r.prescription.N != 4)
+                  throw BadRequest{400, "quads need a cross field (N = 4), not N = " + std::to_string(r.prescription.N)};
+                const json* target = body.contains("target_faces") ? &body["target_faces"] : nullptr;
+                if (!target || !target->is_number() || !(target->get<double>() >= 1 && target->get<double>() <= options.max_quads))
+                  throw BadRequest{400, "target_faces: expected the number of quads wanted, from 1 to " + std::to_string(options.max_quads) +
+                                            ", got " + (target ? brief(*target) : std::string("nothing"))};
+                try {
+                  validate_prescription(designer->topology(), num_generators(), r.prescription);
+                } catch (const Error& e) {
+                  throw BadRequest{400, e.what()};
+                }
+                Parametrization map;
+                QuadMesh quads;
+                {
+                  Deadline deadline(options.quad_seconds, stopping);
+                  try {
+                    with_designer(r.fixed_faces, [&](const FieldDesigner& d) {
+                      std::optional<Field> guide;
+                      {
+                        std::lock_guard guide_lock(auto_guide_mutex);
+                        guide = auto_guide;
+                      }
+                      const Design design = request_design(d, r.prescription, {}, guide ? &*guide : nullptr);
+                      if (!design_verified(design))
+                        throw Error("the field did not pass verification, so no map was made: " + verification_failure(d, design));
+                      map = parametrize(d, design, request_param_options(d, r.field, r.sharp_edges, 0, target->get<double>()));
+                      quads = extract_quads(d, map);
+                      return 0;
+                    });
+                  } catch (const Cancelled&) {
+                    if (deadline.expired())
+                      throw BadRequest{503, "making the quads took longer than the editor allows (" + number_text(options.quad_seconds) +
+                                                " s): ask for fewer quads, or use trivcon quad"};
+                    throw BadRequest{503, "the editor is stopping"};
+                  }
+                }
+                std::vector<float> V(3 * static_cast<size_t>(quads.V.rows()));
+                for (Eigen::Index v = 0; v < quads.V.rows(); ++v)
+                  for (int k = 0; k < 3; ++k) V[3 * v + k] = static_cast<float>(quads.V(v, k));
+                std::vector<uint32_t> Q(4 * static_cast<size_t>(quads.Q.rows()));
+                for (Eigen::Index f = 0; f < quads.Q.rows(); ++f)
+                  for (int k = 0; k < 4; ++k) Q[4 * f + k] = static_cast<uint32_t>(quads.Q(f, k));
+                std::string warning = param_warning(map);
+                if (const std::string w = quad_warning(quads); !w.empty()) warning += (warning.empty() ? "" : "; ") + w;
+                const ojson header = {{"quad", cli::quad_report(quads)}, {"param", cli::param_report(map)}, {"warning", warning}};
+                res.set_content(binary_container(header.dump(), {{V.data(), V.size() * 4}, {Q.data(), Q.size() * 4}}),
+                                "application/octet-stream");
               }));
     http.Post("/api/export", api_post([this](const httplib::Request& req, const std::string& body, httplib::Response& res) {
                 const std::string format = req.has_param("format") ? req.get_param_value("format") : "txt";

@@ -46,6 +46,8 @@ struct EditorOptions {
   // body_seconds after them; a read or write that makes no progress for io_idle_seconds fails; an idle
   // keep-alive connection is closed after keep_alive_seconds.
   double relax_seconds = 20;  // POST /api/relax stops after about this long, with the moves made so far
+  double quad_seconds = 60;   // POST /api/quad gives up (503) after about this long
+  int max_quads = 10000000;   // the largest target_faces it takes
   int max_connections = 128;
   double header_seconds = 10;
   double body_seconds = 60;

@@ -106,6 +106,9 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
 // the request aligns the boundary and the sharp edges the field followed (outcome.sharp_edges).
 ParamOptions request_param_options(const FieldDesigner& designer, const FieldRequest& request, const FieldOutcome& outcome,
                                    double edge_length, double target_faces);
+// The same with the sharp edges given (the designer's edge ids: RequestConstraints::sharp_edges).
+ParamOptions request_param_options(const FieldDesigner& designer, const FieldRequest& request, const std::vector<int>& sharp_edges,
+                                   double edge_length, double target_faces);
 
 // One unit of (u, v) in the mesh's units: edge_length when > 0, else √(area / target_faces). With automatic
 // placement a ± pair closer than that cannot sit on two integer points without folding the map, so the map's

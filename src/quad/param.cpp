@@ -20,6 +20,7 @@
 
 #include "linalg/sparse_cholesky.h"
 #include "linalg/timing.h"
+#include "trivcon/cancel.h"
 #include "trivcon/error.h"
 #include "trivcon/matching.h"
 
@@ -481,6 +482,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   auto stiffen = [&](int rounds) {
     int fewest = std::numeric_limits<int>::max(), stalled = 0;
     for (int round = 0; round < rounds; ++round) {
+      check_cancelled();
       int folds = 0;
       for (int f = 0; f < nF; ++f) folds += folded(f);
       if (folds == 0) return;
@@ -516,6 +518,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   // --- Greedy rounding: the integers nearest to whole numbers first, a fraction of those left per solve --------
   std::vector<int> left = integer_free;
   while (!left.empty()) {
+    check_cancelled();
     std::sort(left.begin(), left.end(), [&](int a, int c) {
       const double da = whole_offset(y[a]), dc = whole_offset(y[c]);
       return da != dc ? da < dc : a < c;

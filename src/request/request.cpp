@@ -186,14 +186,19 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
 
 ParamOptions request_param_options(const FieldDesigner& designer, const FieldRequest& request, const FieldOutcome& outcome,
                                    double edge_length, double target_faces) {
-  const Topology& t = outcome.designer(designer).topology();
+  return request_param_options(outcome.designer(designer), request, outcome.sharp_edges, edge_length, target_faces);
+}
+
+ParamOptions request_param_options(const FieldDesigner& designer, const FieldRequest& request, const std::vector<int>& sharp_edges,
+                                   double edge_length, double target_faces) {
+  const Topology& t = designer.topology();
   ParamOptions options;
   options.edge_length = edge_length;
   options.target_faces = target_faces;
   if (request.align_boundary)
     for (int e = 0; e < t.num_edges; ++e)
       if (t.is_boundary_edge(e)) options.aligned_edges.push_back(e);
-  options.aligned_edges.insert(options.aligned_edges.end(), outcome.sharp_edges.begin(), outcome.sharp_edges.end());
+  options.aligned_edges.insert(options.aligned_edges.end(), sharp_edges.begin(), sharp_edges.end());
   return options;
 }
 

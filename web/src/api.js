@@ -111,6 +111,16 @@ export async function relax(body) {
   return res.json();
 }
 
+// The quad mesh of the body's field (body.target_faces quads): {report: {quad, param, warning}, V (x y z per vertex), Q (4 per quad)}.
+export async function quads(body) {
+  const res = await post('/api/quad', body);
+  if (!res.ok) await fail(res);
+  const buffer = await res.arrayBuffer();
+  const { header, offset } = unpack(buffer);
+  const n = header.quad.vertices, m = header.quad.quads;
+  return { report: header, V: new Float32Array(buffer, offset, 3 * n), Q: new Uint32Array(buffer, offset + 12 * n, 4 * m) };
+}
+
 export async function streamlines(body) {
   const res = await post('/api/streamlines', body);
   if (!res.ok) await fail(res);

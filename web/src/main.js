@@ -514,6 +514,7 @@ function applySession(tEdit = performance.now()) {
     fieldVersion++;
   }
   requestSolve(tEdit); // first: the panel's updates below need not delay the solve
+  clearQuads('quads: the field changed; make them again');
   rebuildMarkers();
   rebuildFixedArrows();
   $('N').value = session.N;
@@ -585,6 +586,80 @@ function togglePin(v) {
 // replays the moves on the markers, then commits the end as one step of the history (one undo).
 let relaxing = false;
 let lastRelax = null;
+// --- quads (POST /api/quad) -----------------------------------------------------------------------------
+// The quad mesh of the field on screen, drawn as its edges; an edit makes it stale (removed, the panel says so).
+let quadMesh = null; // {V, Q, report}
+let quadObject = null;
+let quadding = false;
+function clearQuads(why) {
+  if (quadObject) overlay.remove(quadObject), quadObject.geometry.dispose(), (quadObject = null);
+  if (quadMesh && why) $('quadinfo').textContent = why;
+  quadMesh = null;
+  $('dl-quads').disabled = true;
+}
+function drawQuads() {
+  if (quadObject) overlay.remove(quadObject), quadObject.geometry.dispose(), (quadObject = null);
+  if (!quadMesh || !$('showquads').checked) return invalidate();
+  const { V, Q } = quadMesh;
+  // Each quad's edges, lifted off the surface along the quad's normal by a tenth of a mesh edge (no z-fighting).
+  const seg = new Float32Array(Q.length * 6);
+  const p = (i) => new THREE.Vector3(V[3 * i], V[3 * i + 1], V[3 * i + 2]);
+  const lift = 0.1 * meanEdge;
+  for (let f = 0; f < Q.length / 4; ++f) {
+    const c = [0, 1, 2, 3].map((k) => p(Q[4 * f + k]));
+    const n = c[2].clone().sub(c[0]).cross(c[3].clone().sub(c[1]));
+    const len = n.length();
+    if (len > 0) n.multiplyScalar(lift / len);
+    for (let k = 0; k < 4; ++k) {
+      const a = c[k].clone().add(n), b = c[(k + 1) % 4].clone().add(n);
+      seg.set([a.x, a.y, a.z, b.x, b.y, b.z], 24 * f + 6 * k);
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(seg, 3));
+  quadObject = new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: 0x202020 }));
+  overlay.add(quadObject);
+  invalidate();
+}
+async function makeQuads() {
+  if (quadding) return;
+  if (session.N !== 4) {
+    status('quads: they need a cross field, N = 4');
+    return;
+  }
+  quadding = true;
+  $('quads').disabled = true;
+  const target = Math.max(1, Math.round(parseFloat($('quadtarget').value) || 2000));
+  status(`quads: making about ${target}…`);
+  const made = session;
+  try {
+    const body = requestBody(session);
+    body.target_faces = target;
+    const r = await api.quads(body);
+    if (session !== made) return; // an edit meanwhile: these quads are of an older field
+    quadMesh = r;
+    const q = r.report.quad;
+    const irregular = q.singular_mismatches === 0 ? 'all at the singularities' : `${q.singular_mismatches} NOT at a singularity of their valence`;
+    $('quadinfo').textContent = `${q.quads} quads (target ${target}), ${q.irregular_vertices} irregular vertices (${irregular}), ` +
+      `chi ${q.euler_characteristic}, scaled Jacobian min ${q.min_scaled_jacobian.toFixed(3)}, mean ${q.mean_scaled_jacobian.toFixed(3)}` +
+      (r.report.warning ? `. ${r.report.warning}` : '');
+    $('dl-quads').disabled = false;
+    status(r.report.warning ? 'quads: made, with problems (see Quads)' : `quads: ${q.quads} made`);
+    drawQuads();
+  } catch (e) {
+    status(`quads: ${e.message}`);
+  } finally {
+    quadding = false;
+    $('quads').disabled = false;
+  }
+}
+function quadObj() {
+  const { V, Q } = quadMesh;
+  const lines = [`# trivcon quad mesh: ${V.length / 3} vertices, ${Q.length / 4} quads`];
+  for (let i = 0; i < V.length; i += 3) lines.push(`v ${V[i]} ${V[i + 1]} ${V[i + 2]}`);
+  for (let i = 0; i < Q.length; i += 4) lines.push(`f ${Q[i] + 1} ${Q[i + 1] + 1} ${Q[i + 2] + 1} ${Q[i + 3] + 1}`);
+  return lines.join('\n') + '\n';
+}
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 const energyText = (e) => (Math.abs(e) >= 1e-3 && Math.abs(e) < 1e5 ? e.toFixed(4) : e.toExponential(3));
 async function relax() {
@@ -969,6 +1044,9 @@ function wireControls() {
   $('mode-fix').onclick = () => setMode('fix');
   $('mode-pin').onclick = () => setMode('pin');
   $('relax').onclick = relax;
+  $('quads').onclick = makeQuads;
+  $('showquads').onchange = drawQuads;
+  $('dl-quads').onclick = () => quadMesh && download(new Blob([quadObj()], { type: 'text/plain' }), 'quads.obj');
   $('balance').onclick = balance;
   $('undo').onclick = undo;
   $('redo').onclick = redo;
@@ -1054,6 +1132,7 @@ function wireControls() {
     else if (key === 'f') setMode('fix');
     else if (key === 'p') setMode('pin');
     else if (key === 'r') relax();
+    else if (key === 'q') makeQuads();
     else if (key === 'b') balance();
     else if (key === 'l') ($('streamlines').checked = !$('streamlines').checked), refreshStreamlines();
   });
@@ -1202,6 +1281,10 @@ window.__trivcon = {
   // The vertices whose markers are drawn as pinned, and the last relaxation's answer (POST /api/relax).
   get pinnedMarkers() { return markers.children.filter((m) => m.userData.pinned).map((m) => m.userData.vertex).sort((a, b) => a - b); },
   get lastRelax() { return lastRelax; },
+  // The quad mesh on screen (POST /api/quad's answer) and the segments drawn for it (4 per quad, or 0 when hidden).
+  get quads() { return quadMesh ? { report: quadMesh.report, V: Array.from(quadMesh.V), Q: Array.from(quadMesh.Q) } : null; },
+  get quadSegments() { return quadObject ? quadObject.geometry.getAttribute('position').count / 2 : 0; },
+  get quadInfo() { return $('quadinfo').textContent; },
 };
 
 start();

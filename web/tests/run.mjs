@@ -346,6 +346,49 @@ async function main() {
       assert.equal((await api('/api/state')).solved, true);
     });
 
+    await check('quads: the quad mesh of the field is drawn with its numbers, its irregular vertices exactly the singularities', async () => {
+      const sing = await singularities();
+      await page.click('#quads');
+      await page.waitForFunction(() => window.__trivcon.quads !== null, { timeout: 60000 });
+      const q = await T(() => window.__trivcon.quads);
+      const r = q.report.quad;
+      assert.deepEqual(r.problems, []);
+      assert.equal(r.singular_mismatches, 0);
+      assert.equal(r.irregular_vertices, sing.length);
+      assert.equal(q.Q.length, 4 * r.quads);
+      assert.equal(q.V.length, 3 * r.vertices);
+      assert.ok(r.quads > 1000 && r.quads < 3000, `${r.quads} quads for a target of 2000`);
+      // From the quads alone: only quads of 4 distinct vertices, each edge in two quads, chi 2 (a sphere).
+      const edges = new Map();
+      for (let f = 0; f < r.quads; ++f) {
+        const c = q.Q.slice(4 * f, 4 * f + 4);
+        assert.equal(new Set(c).size, 4);
+        for (let k = 0; k < 4; ++k) {
+          const a = Math.min(c[k], c[(k + 1) % 4]), b = Math.max(c[k], c[(k + 1) % 4]);
+          edges.set(`${a},${b}`, (edges.get(`${a},${b}`) || 0) + 1);
+        }
+      }
+      assert.ok([...edges.values()].every((n) => n === 2));
+      assert.equal(r.vertices - edges.size + r.quads, 2);
+      assert.equal(await T(() => window.__trivcon.quadSegments), 4 * r.quads);
+      assert.match(await T(() => window.__trivcon.quadInfo), new RegExp(`^${r.quads} quads \\(target 2000\\), ${sing.length} irregular vertices \\(all at the singularities\\)`));
+      assert.equal(await T(() => document.getElementById('dl-quads').disabled), false);
+      await page.click('#showquads');
+      assert.equal(await T(() => window.__trivcon.quadSegments), 0);
+      await page.click('#showquads');
+      assert.equal(await T(() => window.__trivcon.quadSegments), 4 * r.quads);
+      // The API refuses what it cannot do, with a message.
+      const post = (body) => fetch(new URL('/api/quad', editor.url), {
+        method: 'POST', headers: { 'X-Trivcon-Token': editor.token, 'Content-Type': 'application/json' }, body: JSON.stringify(body),
+      });
+      const six = await post({ N: 6, singularities: [], target_faces: 100 });
+      assert.equal(six.status, 400);
+      assert.match((await six.json()).error, /quads need a cross field \(N = 4\), not N = 6/);
+      const none = await post({ N: 4, singularities: sing });
+      assert.equal(none.status, 400);
+      assert.match((await none.json()).error, /target_faces: expected the number of quads wanted, from 1 to \d+, got nothing/);
+    });
+
     await check('a fixed direction dragged on a face is held by the field', async () => {
       await page.keyboard.press('KeyF');
       const c = { x: view.x + 0.5 * view.w, y: view.y + 0.5 * view.h };
@@ -363,6 +406,8 @@ async function main() {
       await page.mouse.up();
       await idle();
       const seen = await page.evaluate(() => window.__progressSeen);
+      assert.equal(await T(() => window.__trivcon.quads), null, 'an edit leaves no stale quads on screen');
+      assert.match(await T(() => window.__trivcon.quadInfo), /the field changed; make them again/);
       assert.ok(seen.some((t) => /^re-factoring for 1 fixed face\(s\)… \d+\.\d s of about \d+\.\d s$/.test(t)), JSON.stringify(seen));
       assert.equal(await page.evaluate(() => document.getElementById('progress').hidden), true);
       assert.match(await page.evaluate(() => document.getElementById('status').textContent), /^solved: energy \S+ · field exact$/);
