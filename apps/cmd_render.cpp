@@ -23,6 +23,7 @@ struct RenderCommand {
   bool flat = false, no_legend = false;
   MeshOptions mesh_options;  // --no-repair, --weld
   FeatureOptions features;  // sharp edges to draw
+  bool polygon_edges = false;  // --polygon-edges
 };
 
 // Two numbers separated by `separator` ("1200x900", "30,20"), each parsed whole by `parse` (std::stoi,
@@ -98,6 +99,7 @@ void run_render(const RenderCommand& c) {
   o.smooth_shading = !c.flat;
   o.legend = !c.no_legend;
   o.sharp_edges = c.features.edges(mesh.V, t, g);
+  if (c.polygon_edges) o.polygon_edges = polygon_edges(t, mesh.polygon_of_triangle);
   if (!c.uv.empty()) {  // the file's corners in the input's order, the renderer's in the topology's
     // The file has the input's faces; on a repaired mesh each face reads its input face's corners.
     const Eigen::MatrixXd input =
@@ -142,10 +144,12 @@ void register_render(CLI::App& app) {
   cmd->add_option("--streamlines-out", c.streamlines_out, "Also write the streamlines as OBJ polylines");
   cmd->add_flag("--flat", c.flat, "Flat shading (one normal per face)");
   cmd->add_flag("--no-legend", c.no_legend, "Leave out the legend");
+  auto* polygons = cmd->add_flag("--polygon-edges", c.polygon_edges,
+                                 "Draw the edges of the file's polygons (not the diagonals of their fans): a quad mesh's quads (trivcon quad -o)");
   add_mesh_options(cmd, c.mesh_options);
   c.features.add_to(cmd, "drawn as lines");
-  cmd->callback([field, uv] {
-    if (field->count() == 0 && uv->count() == 0) throw CLI::RequiredError("--field or --uv");
+  cmd->callback([field, uv, polygons] {
+    if (field->count() == 0 && uv->count() == 0 && polygons->count() == 0) throw CLI::RequiredError("--field, --uv or --polygon-edges");
     run_render(c);
   });
 }

@@ -460,3 +460,25 @@ TEST(RenderCli, FailsClearlyOnBadInput) {
 
 }  // namespace
 }  // namespace trivcon
+
+namespace trivcon {
+namespace {
+
+// polygon_edges: the edges of the file's polygons, not the diagonals of their fans (two quads side by side:
+// 7 edges of 9), and every edge when the triangles are the file's own.
+TEST(PolygonEdges, LeavesOutTheFansDiagonals) {
+  MatrixX3i F(4, 3);
+  F << 0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4;
+  const Topology t = build_topology(F, 6);
+  const std::vector<int> quads = polygon_edges(t, {0, 0, 1, 1});
+  EXPECT_EQ(quads.size(), 7u);
+  for (int e : quads) {
+    const std::pair<int, int> ends(t.edge_vertices(e, 0), t.edge_vertices(e, 1));
+    EXPECT_NE(ends, std::make_pair(0, 4));
+    EXPECT_NE(ends, std::make_pair(1, 5));
+  }
+  EXPECT_EQ(polygon_edges(t, {}).size(), 9u);
+}
+
+}  // namespace
+}  // namespace trivcon

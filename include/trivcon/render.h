@@ -79,6 +79,7 @@ struct Palette {
   Rgb field{22, 28, 48};     // hedgehog glyphs and streamlines
   Rgb boundary{30, 150, 60};
   Rgb sharp{200, 40, 170};    // feature edges (RenderOptions::sharp_edges)
+  Rgb polygon{35, 35, 40};    // the file's polygon edges (RenderOptions::polygon_edges), e.g. a quad mesh's
   Rgb positive{215, 35, 35};  // singularity with index > 0
   Rgb negative{30, 80, 215};  // index < 0
   Rgb text{40, 40, 40};
@@ -94,6 +95,7 @@ struct RenderOptions {
   bool smooth_shading = true;
   bool legend = true;
   std::vector<int> sharp_edges;  // edge ids (trivcon/topology.h) drawn as feature lines; empty: none
+  std::vector<int> polygon_edges;  // edge ids drawn thin and dark: the edges of the file's polygons (polygon_edges below)
   int supersampling = 3;         // samples per pixel along each axis (anti-aliasing)
   // Empty, or F × 6: (u, v) of corners 0, 1, 2 of each face of Topology::F (trivcon/param.h). The surface is then
   // a checkerboard of unit squares of (u, v), interpolated perspective-correctly: the grid of a seamless map.
@@ -134,5 +136,10 @@ std::vector<std::pair<int, int>> singular_vertices(const std::vector<int>& verte
 
 // Writes an 8-bit RGB PNG atomically (trivcon/io.h); errors are trivcon::Error naming the path.
 void write_png(const std::string& path, const Image& image);
+
+// The edges of a fanned mesh that are edges of the file's polygons (boundary edges, and interior edges between
+// triangles of two different polygons; not the diagonals the fanning added): what a quad mesh's picture draws.
+// polygon_of_triangle: MeshData's (empty: every triangle its own polygon).
+std::vector<int> polygon_edges(const Topology& topology, const std::vector<int>& polygon_of_triangle);
 
 }  // namespace trivcon

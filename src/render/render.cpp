@@ -169,6 +169,7 @@ class Renderer {
     if (t_.num_faces > 0) {
       draw_surface();
       draw_boundary();
+      draw_polygon_edges();
       draw_sharp_edges();
       if (!o_.draw_field) {
       } else if (streamlines != nullptr) {
@@ -321,6 +322,13 @@ class Renderer {
         draw_segment(vertex(V_, loop[k]), vertex(V_, loop[(k + 1) % loop.size()]), 1.3, 1.3, o_.palette.boundary);
   }
 
+  // Thinner than the boundary; ids outside the mesh are skipped.
+  void draw_polygon_edges() {
+    for (int e : o_.polygon_edges)
+      if (e >= 0 && e < t_.num_edges)
+        draw_segment(vertex(V_, t_.edge_vertices(e, 0)), vertex(V_, t_.edge_vertices(e, 1)), 0.8, 0.8, o_.palette.polygon);
+  }
+
   // Drawn like the boundary, in their own colour; ids outside the mesh or of boundary edges are skipped.
   void draw_sharp_edges() {
     for (int e : o_.sharp_edges)
@@ -436,6 +444,7 @@ class Renderer {
     if (count.empty()) rows.push_back({LegendRow::None, 0, "no singular vertices"});
     if (!t_.boundary_loops.empty()) rows.push_back({LegendRow::Line, 0, "boundary"});
     if (!o_.sharp_edges.empty()) rows.push_back({LegendRow::Line, 1, "sharp edges"});
+    if (!o_.polygon_edges.empty()) rows.push_back({LegendRow::Line, 2, "polygon edges"});
     return rows;
   }
 
@@ -472,7 +481,9 @@ class Renderer {
                   rows[r].index > 0 ? o_.palette.positive : o_.palette.negative);
       if (rows[r].key == LegendRow::Line)
         canvas_.for_samples(x0, middle - 1.3 * scale_, x0 + key - 10 * scale_, middle + 1.3 * scale_,
-                            [&](size_t i, double, double) { canvas_.set(i, rows[r].index == 1 ? o_.palette.sharp : o_.palette.boundary); });
+                            [&](size_t i, double, double) {
+                              canvas_.set(i, rows[r].index == 1 ? o_.palette.sharp : rows[r].index == 2 ? o_.palette.polygon : o_.palette.boundary);
+                            });
       draw_text(text_x, y, rows[r].text, unit);
     }
   }
@@ -606,6 +617,15 @@ void write_png(const std::string& path, const Image& image) {
     if (best.empty() || png.size() < best.size()) best.swap(png);
   }
   write_file_atomically(path, [&](std::ostream& out) { out.write(best.data(), static_cast<std::streamsize>(best.size())); });
+}
+
+std::vector<int> polygon_edges(const Topology& t, const std::vector<int>& polygon_of_triangle) {
+  std::vector<int> out;
+  for (int e = 0; e < t.num_edges; ++e) {
+    const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
+    if (L < 0 || R < 0 || polygon_of_triangle.empty() || polygon_of_triangle[L] != polygon_of_triangle[R]) out.push_back(e);
+  }
+  return out;
 }
 
 }  // namespace trivcon
