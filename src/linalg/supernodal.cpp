@@ -349,23 +349,15 @@ std::vector<int> supernode_parents(const Supernodes& L, const std::vector<int>& 
 
 namespace {
 
+// The numeric factorization into the values x of the supernodal factor S, whose column k is matrix row perm[k].
+// Returns the first factor column not positive definite, or n.
 template <class T>
-int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const T* values, cholmod_common& c) {
-  const int n = static_cast<int>(L.n);
-  if (!L.is_super) throw Error("internal: the numeric factorization needs a supernodal symbolic factor");
-  // The super, pi, px and s arrays are read as int (CHOLMOD's int API; src/linalg/cholmod.h checks the version).
-  if (L.itype != CHOLMOD_INT) throw Error("internal: the numeric factorization needs a factor of CHOLMOD's int API");
-  // Allocates the values (L.xsize entries of T, interleaved for complex) and marks L numeric LLᵀ (LLᴴ), as
-  // cholmod_super_numeric does.
-  const int xtype = std::is_same<T, double>::value ? CHOLMOD_REAL : CHOLMOD_COMPLEX;
-  if (!cholmod_change_factor(xtype, 1, 1, 1, 1, &L, &c) || L.x == nullptr)
-    throw Error("CHOLMOD could not allocate the factor (status " + std::to_string(c.status) + ")");
-  const int* perm = static_cast<const int*>(L.Perm);
+int factor_values(const Supernodes& S, const int* perm, int n, T* x, const std::vector<int>& outer, const std::vector<int>& inner,
+                  const T* values) {
   std::vector<int> position(n);
   for (int k = 0; k < n; ++k) position[perm[k]] = k;
   const PermutedLower<T> A = permuted_lower(outer, inner, values, position);
 
-  const Supernodes S(&L);
   const std::vector<int> owner = S.owners();
   std::vector<double> work(S.count);  // flops of its own factorization and of the updates it sends, and a fixed cost
   for (int s = 0; s < S.count; ++s) {
@@ -374,7 +366,7 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
   }
   const TreeSplit split = split_tree(supernode_parents(S, owner), work, 1e5, linalg::max_threads());
   const int parts = static_cast<int>(split.part.size());
-  Numeric<T> numeric(S, owner, static_cast<T*>(L.x), A);
+  Numeric<T> numeric(S, owner, x, A);
   // Below the top, one thread per part (OpenMP's thread count): a subtree needs only its own descendants. Each thread keeps its own
   // lists of pending updates (`head`); its lists for the supernodes of the top are handed over when both
   // are done. Then the top, one supernode at a time, with OpenBLAS's threads inside the large dense
@@ -393,7 +385,7 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
 #pragma omp parallel for schedule(static, 1) num_threads(parts) if (several)
     for (int k = 0; k < parts; ++k) {
       try {
-        head[k].assign(L.nsuper, -1);
+        head[k].assign(S.count, -1);
         Workspace<T> w = numeric.workspace();
         for (int s : split.part[k]) {
           check_cancelled(cancel);
@@ -410,7 +402,7 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
   for (int f : failed)
     if (f >= 0) minor = std::min(minor, f);
   if (minor == n) {
-    std::vector<int> top_head(L.nsuper, -1);
+    std::vector<int> top_head(S.count, -1);
     for (int t : split.top)
       for (auto& h : head) numeric.move_list(t, h, top_head);
     Workspace<T> w = numeric.workspace();
@@ -422,8 +414,33 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
       }
     }
   }
+  return minor;
+}
+
+template <class T>
+int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const T* values, cholmod_common& c) {
+  if (!L.is_super) throw Error("internal: the numeric factorization needs a supernodal symbolic factor");
+  // The super, pi, px and s arrays are read as int (CHOLMOD's int API; src/linalg/cholmod.h checks the version).
+  if (L.itype != CHOLMOD_INT) throw Error("internal: the numeric factorization needs a factor of CHOLMOD's int API");
+  // Allocates the values (L.xsize entries of T, interleaved for complex) and marks L numeric LLᵀ (LLᴴ), as
+  // cholmod_super_numeric does.
+  const int xtype = std::is_same<T, double>::value ? CHOLMOD_REAL : CHOLMOD_COMPLEX;
+  if (!cholmod_change_factor(xtype, 1, 1, 1, 1, &L, &c) || L.x == nullptr)
+    throw Error("CHOLMOD could not allocate the factor (status " + std::to_string(c.status) + ")");
+  const int minor =
+      factor_values<T>(Supernodes(&L), static_cast<const int*>(L.Perm), static_cast<int>(L.n), static_cast<T*>(L.x), outer, inner, values);
   L.minor = static_cast<size_t>(minor);
   return minor;
+}
+
+template <class T>
+int factorize_own(const SymbolicFactor& L, std::vector<T>& x, const std::vector<int>& outer, const std::vector<int>& inner,
+                  const T* values) {
+  if (static_cast<int>(L.super.size()) != L.nsuper + 1 || L.pi.size() != L.super.size() || L.px.size() != L.super.size() ||
+      static_cast<int>(L.perm.size()) != L.n)
+    throw Error("internal: the numeric factorization was given an incomplete symbolic factor");
+  x.assign(L.xsize, T(0));
+  return factor_values<T>(Supernodes(L, reinterpret_cast<const double*>(x.data())), L.perm.data(), L.n, x.data(), outer, inner, values);
 }
 
 }  // namespace
@@ -436,6 +453,16 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
 int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
                       cholmod_common& c) {
   return factorize_as<Complex>(L, outer, inner, reinterpret_cast<const Complex*>(values.data()), c);
+}
+
+int factorize(const SymbolicFactor& L, std::vector<double>& x, const std::vector<int>& outer, const std::vector<int>& inner,
+              const std::vector<double>& values) {
+  return factorize_own<double>(L, x, outer, inner, values.data());
+}
+
+int factorize_complex(const SymbolicFactor& L, std::vector<Complex>& x, const std::vector<int>& outer, const std::vector<int>& inner,
+                      const std::vector<double>& values) {
+  return factorize_own<Complex>(L, x, outer, inner, reinterpret_cast<const Complex*>(values.data()));
 }
 
 }  // namespace trivcon::linalg

@@ -2,7 +2,8 @@
 //
 // CHOLMOD does the ordering and the symbolic factorization (docs/solver.md); this computes the values of
 // CHOLMOD's own supernodal factor object, so that everything else (CHOLMOD's solves, the solver's sparse
-// forward update and backward substitution) reads it unchanged. Why not cholmod_factorize: CHOLMOD 3
+// forward update and backward substitution) reads it unchanged. It fills the factor of trivcon's own symbolic
+// analysis (src/linalg/symbolic.h) the same way: the arrays mean the same. Why not cholmod_factorize: CHOLMOD 3
 // (Debian 12) visits the supernodes one after another and uses the second core only inside BLAS calls on
 // large supernodes, while on a mesh most of the time goes to the many small supernodes near the leaves of
 // the elimination tree. Here independent subtrees are factored on OpenMP's threads (one set of subtrees per thread), then the top of the
@@ -14,7 +15,10 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <complex>
 #include <vector>
+
+#include "linalg/symbolic.h"
 
 namespace trivcon::linalg {
 
@@ -31,12 +35,12 @@ struct TreeSplit {
   std::vector<int> top;
   std::vector<std::vector<int>> part;
 };
-TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& work, double min_split, int parts = 2,
-                     bool deepen = false);
+TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& work, double min_split, int parts = 2, bool deepen = false);
 
-// CHOLMOD's supernodal factor, read in place: supernode s holds the columns first(s) … first(s) + cols(s)
-// − 1; its rows (its own columns first, then rows of its ancestors) are row(s, 0 … height(s) − 1), its
-// entries the height(s) × cols(s) column-major block values(s), starting at x + px[s].
+// A supernodal factor, read in place (CHOLMOD's, or one of src/linalg/symbolic.h, whose arrays mean the same):
+// supernode s holds the columns first(s) … first(s) + cols(s) − 1; its rows (its own columns first, then rows
+// of its ancestors) are row(s, 0 … height(s) − 1), its entries the height(s) × cols(s) column-major block
+// values(s), starting at x + px[s].
 struct Supernodes {
   const int *super, *pi, *px, *rows;
   const double* x;
@@ -48,6 +52,10 @@ struct Supernodes {
         rows(static_cast<const int*>(L->s)),
         x(static_cast<const double*>(L->x)),
         count(static_cast<int>(L->nsuper)) {}
+  // `x`: the factor's values (L.xsize entries; for a complex factor, the (real, imaginary) pairs), or null
+  // where only the structure is read.
+  Supernodes(const SymbolicFactor& L, const double* x)
+      : super(L.super.data()), pi(L.pi.data()), px(L.px.data()), rows(L.s.data()), x(x), count(L.nsuper) {}
   int first(int s) const { return super[s]; }
   int cols(int s) const { return super[s + 1] - super[s]; }
   int height(int s) const { return pi[s + 1] - pi[s]; }
@@ -72,5 +80,13 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
 // Used by the smoothest field of trivcon/auto.h.
 int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
                       cholmod_common& c);
+
+// The same two into a factor of trivcon's own symbolic analysis (src/linalg/symbolic.h, permutation L.perm):
+// `x` becomes its values, L.xsize entries. Returns n on success, or the first factor column found not
+// positive definite.
+int factorize(const SymbolicFactor& L, std::vector<double>& x, const std::vector<int>& outer, const std::vector<int>& inner,
+              const std::vector<double>& values);
+int factorize_complex(const SymbolicFactor& L, std::vector<std::complex<double>>& x, const std::vector<int>& outer,
+                      const std::vector<int>& inner, const std::vector<double>& values);
 
 }  // namespace trivcon::linalg
