@@ -32,43 +32,24 @@ std::string fmt(double v) {
 
 void run_param(const ParamCommand& o) {
   const MapRun run = run_map(o.map);
-  const RepairedMesh* repair = run.repaired();
   const double read_seconds = run.read_seconds;
   const FieldOutcome& out = run.out;
-  const Topology& t = run.designer->topology();
   const Parametrization& param = run.param;
   const ParamQuality& q = param.quality;
 
   const auto t1 = Clock::now();
   StagedOutputs staged;
   staged.write(o.output, [&](const std::string& path) { write_map_obj(path, run); });
-  if (!o.sing_out.empty())
-    staged.write(o.sing_out, [&](const std::string& path) { write_singularities(path, input_singularities(out.prescription.vertex, repair), 4); });
+  if (!o.sing_out.empty()) staged.write(o.sing_out, [&](const std::string& path) { write_map_singularities(path, run); });
   if (!o.report.empty()) {
-    nlohmann::ordered_json report = {{"mesh", o.map.mesh},
-                                     {"vertices", t.num_vertices},
-                                     {"faces", t.num_faces},
-                                     {"components", t.components.size()},
-                                     {"euler_characteristic", t.euler_characteristic()},
-                                     {"boundary_loops", t.boundary_loops.size()},
-                                     {"N", 4},
-                                     {"singularities", nlohmann::ordered_json::array()},
-                                     {"field", {{"verified", out.verified}, {"energy", out.design.connection.energy}}},
-                                     {"param", param_report(param)},
-                                     {"seconds", {{"read", read_seconds}, {"write", seconds_since(t1)}}}};
-    if (repair) report["repair"] = repair_summary_json(*repair);
-    if (out.relax_result) report["relax"] = relax_summary_json(*out.relax_result);
-    for (size_t i = 0; i < param.cones.size(); ++i)
-      report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
+    nlohmann::ordered_json report = map_report(o.map, run);
+    report["seconds"] = {{"read", run.read_seconds}, {"write", seconds_since(t1)}};
     staged.write(o.report, [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& s) { s << report.dump(2) << "\n"; }); });
   }
   staged.commit();
 
   if (!o.map.quiet)
-    std::cout << "mesh " << o.map.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
-              << " component(s), chi " << t.euler_characteristic() << ", " << t.boundary_loops.size() << " boundary loop(s)\n"
-              << (out.relax_result ? relax_summary_line(*out.relax_result) + "\n" : std::string())
-              << "field: N 4, " << param.cones.size() << " singular vertices, verified\n"
+    std::cout << map_summary(o.map, run)
               << "map: edge length " << fmt(param.edge_length) << ", " << fmt(q.unit_squares) << " unit squares (target " << fmt(q.target_squares)
               << "), " << q.cut_edges << " cut edges, " << q.integer_unknowns << " integers rounded in " << q.rounding_rounds << " solves\n"
               << "seamless: " << (q.seamless ? "yes" : "NO") << " (transition residual " << fmt(q.max_transition_residual) << ", cones off integer points by "

@@ -32,8 +32,6 @@ std::string fmt(double v) {
 
 void run_quad(const QuadCommand& o) {
   const MapRun run = run_map(o.map);
-  const RepairedMesh* repair = run.repaired();
-  const Topology& t = run.designer->topology();
   const Parametrization& param = run.param;
   const ParamQuality& p = param.quality;
   const QuadMesh quads = extract_quads(*run.designer, param);
@@ -43,27 +41,13 @@ void run_quad(const QuadCommand& o) {
   StagedOutputs staged;
   staged.write(o.output, [&](const std::string& path) { write_quad_mesh(path, quads.V, quads.Q); });
   if (!o.uv_out.empty()) staged.write(o.uv_out, [&](const std::string& path) { write_map_obj(path, run); });
-  if (!o.sing_out.empty())
-    staged.write(o.sing_out, [&](const std::string& path) { write_singularities(path, input_singularities(run.out.prescription.vertex, repair), 4); });
+  if (!o.sing_out.empty()) staged.write(o.sing_out, [&](const std::string& path) { write_map_singularities(path, run); });
   if (!o.report.empty()) {
-    nlohmann::ordered_json report = {{"mesh", o.map.mesh},
-                                     {"vertices", t.num_vertices},
-                                     {"faces", t.num_faces},
-                                     {"components", t.components.size()},
-                                     {"euler_characteristic", t.euler_characteristic()},
-                                     {"boundary_loops", t.boundary_loops.size()},
-                                     {"N", 4},
-                                     {"singularities", nlohmann::ordered_json::array()},
-                                     {"field", {{"verified", run.out.verified}, {"energy", run.out.design.connection.energy}}},
-                                     {"param", param_report(param)},
-                                     {"quad", quad_report(quads)},
-                                     {"seconds", {{"read", run.read_seconds},
-                                                  {"field", run.out.design.solve_seconds + run.out.design.field_seconds},
-                                                  {"write", seconds_since(t1)}}}};
-    if (repair) report["repair"] = repair_summary_json(*repair);
-    if (run.out.relax_result) report["relax"] = relax_summary_json(*run.out.relax_result);
-    for (size_t i = 0; i < param.cones.size(); ++i)
-      report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
+    nlohmann::ordered_json report = map_report(o.map, run);
+    report["quad"] = quad_report(quads);
+    report["seconds"] = {{"read", run.read_seconds},
+                         {"field", run.out.design.solve_seconds + run.out.design.field_seconds},
+                         {"write", seconds_since(t1)}};
     staged.write(o.report, [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& s) { s << report.dump(2) << "\n"; }); });
   }
   staged.commit();
@@ -73,10 +57,7 @@ void run_quad(const QuadCommand& o) {
     for (size_t i = 0; i < param.cones.size(); ++i) ++valences[4 - param.cone_index[i]];
     std::ostringstream irregular;
     for (auto [valence, count] : valences) irregular << (irregular.tellp() > 0 ? ", " : "") << count << " of valence " << valence;
-    std::cout << "mesh " << o.map.mesh << ": " << t.num_vertices << " vertices, " << t.num_faces << " faces, " << t.components.size()
-              << " component(s), chi " << t.euler_characteristic() << ", " << t.boundary_loops.size() << " boundary loop(s)\n"
-              << (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string())
-              << "field: N 4, " << param.cones.size() << " singular vertices, verified\n"
+    std::cout << map_summary(o.map, run)
               << "map: edge length " << fmt(param.edge_length) << ", seamless " << (p.seamless ? "yes" : "NO") << ", flipped faces "
               << p.flipped_faces << ", degenerate " << p.degenerate_faces << "\n"
               << "quads: " << q.quads << " (target " << std::llround(q.target_quads) << "), " << q.vertices << " vertices, chi "

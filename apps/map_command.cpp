@@ -1,7 +1,10 @@
 #include "map_command.h"
 
+#include "outputs.h"
+#include "report.h"
 #include "summary.h"
 #include "trivcon/error.h"
+#include "trivcon/indices.h"
 
 namespace trivcon::cli {
 
@@ -48,6 +51,39 @@ void write_map_obj(const std::string& path, const MapRun& run) {
     write_uv_obj(path, run.loaded.input.V, run.loaded.input.F, corner_rows_on_input(*repair, run.loaded.input.F, uv));
   else
     write_uv_obj(path, mesh.V, mesh.F, uv);
+}
+
+void write_map_singularities(const std::string& path, const MapRun& run) {
+  write_singularities(path, input_singularities(run.out.prescription.vertex, run.repaired()), 4);
+}
+
+nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
+  const Topology& t = run.designer->topology();
+  const Parametrization& param = run.param;
+  nlohmann::ordered_json report = {{"mesh", o.mesh},
+                                   {"vertices", t.num_vertices},
+                                   {"faces", t.num_faces},
+                                   {"components", t.components.size()},
+                                   {"euler_characteristic", t.euler_characteristic()},
+                                   {"boundary_loops", t.boundary_loops.size()},
+                                   {"N", 4},
+                                   {"singularities", nlohmann::ordered_json::array()},
+                                   {"field", {{"verified", run.out.verified}, {"energy", run.out.design.connection.energy}}},
+                                   {"param", param_report(param)}};
+  if (const RepairedMesh* repair = run.repaired()) report["repair"] = repair_summary_json(*repair);
+  if (run.out.relax_result) report["relax"] = relax_summary_json(*run.out.relax_result);
+  for (size_t i = 0; i < param.cones.size(); ++i)
+    report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
+  return report;
+}
+
+std::string map_summary(const MapCommand& o, const MapRun& run) {
+  const Topology& t = run.designer->topology();
+  return "mesh " + o.mesh + ": " + std::to_string(t.num_vertices) + " vertices, " + std::to_string(t.num_faces) + " faces, " +
+         std::to_string(t.components.size()) + " component(s), chi " + std::to_string(t.euler_characteristic()) + ", " +
+         std::to_string(t.boundary_loops.size()) + " boundary loop(s)\n" +
+         (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string()) + "field: N 4, " +
+         std::to_string(run.param.cones.size()) + " singular vertices, verified\n";
 }
 
 }  // namespace trivcon::cli

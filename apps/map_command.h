@@ -3,6 +3,7 @@
 #pragma once
 #include <CLI/CLI.hpp>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "commands.h"
@@ -45,5 +46,12 @@ MapRun run_map(const MapCommand& command);
 
 // The map as `param -o` writes it: the input file's mesh (repaired or not) with one vt per corner.
 void write_map_obj(const std::string& path, const MapRun& run);
+// --sing-out: the singularities used, by the input's vertex ids.
+void write_map_singularities(const std::string& path, const MapRun& run);
+// What both reports hold: the mesh, the singularities (the map's cones), the field, the map (param_report), and
+// repair and relax when they ran; the caller adds its own entries and "seconds".
+nlohmann::ordered_json map_report(const MapCommand& command, const MapRun& run);
+// What both print first: the mesh's line, the relaxation's when it ran, the field's.
+std::string map_summary(const MapCommand& command, const MapRun& run);
 
 }  // namespace trivcon::cli
