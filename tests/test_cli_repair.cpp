@@ -99,7 +99,9 @@ TEST(CliRepair, NonManifoldMeshesSolveByDefaultWithInputIds) {
       EXPECT_NEAR(d.row(f).norm(), 1.0, 1e-9) << "face " << f;
       const Eigen::Vector3d a = input.V.row(input.F(f, 0)), b = input.V.row(input.F(f, 1)), e = input.V.row(input.F(f, 2));
       const Eigen::Vector3d n = (b - a).cross(e - a);
-      if (n.norm() > 0) EXPECT_NEAR(d.row(f).dot(n.normalized()), 0.0, 1e-9) << "face " << f;
+      if (n.norm() > 0) {
+        EXPECT_NEAR(d.row(f).dot(n.normalized()), 0.0, 1e-9) << "face " << f;
+      }
     }
     // The repaired mesh: manifold, the input's distinct faces in order at their input positions.
     const MeshData m = read_mesh(repaired);
@@ -121,7 +123,9 @@ TEST(CliRepair, NonManifoldMeshesSolveByDefaultWithInputIds) {
     const std::string s = slurp(sing);
     std::istringstream lines(s);
     for (std::string line; std::getline(lines, line);)
-      if (!line.empty() && line[0] != '#') EXPECT_LT(std::stoi(line), input.V.rows()) << line;
+      if (!line.empty() && line[0] != '#') {
+        EXPECT_LT(std::stoi(line), input.V.rows()) << line;
+      }
   }
 }
 
