@@ -173,6 +173,7 @@ struct Spread {
   int across = 0;                // steps across an edge of a generator
   double low = 1e300, high = 0;  // range of estimated / exact second order (the others)
   std::vector<double> real;      // real ΔE per candidate, in rank order
+  double bound_ratio = 0;        // largest (lower_bound − first order) / exact second order (≤ 1)
 };
 Spread compare_with_solves(const FieldDesigner& designer, const IndexPrescription& p, const RelaxOptions& options = {}) {
   const Topology& t = designer.topology();
@@ -205,6 +206,12 @@ Spread compare_with_solves(const FieldDesigner& designer, const IndexPrescriptio
       s.worst_carried = std::max(s.worst_carried, std::abs(carried - local) / std::max(1.0, c0.energy));
       continue;
     }
+    // The shorted bound is below the real second order wherever every cycle index is held.
+    if (designer.cycles().generators.empty() && solver.fixed_paths().empty())
+      EXPECT_LE(m.lower_bound - m.first_order, second * (1 + 1e-9) + 1e-12) << m.from << " -> " << m.to;
+    EXPECT_LE(m.lower_bound, m.first_order + (m.estimate - m.first_order) * 10) << "a bound far above the estimate";
+    if (m.distance == 1 && !m.cancels && designer.cycles().generators.empty() && solver.fixed_paths().empty())
+      s.bound_ratio = std::max(s.bound_ratio, (m.lower_bound - m.first_order) / second);
     const double ratio = (m.estimate - m.first_order) / second;
     s.low = std::min(s.low, ratio), s.high = std::max(s.high, ratio);
   }
@@ -221,6 +228,7 @@ TEST(Relax, DualsGiveTheExactFirstOrderAndTheEstimateTheSecond) {
     EXPECT_LT(s.worst_first, 1e-8);
     EXPECT_GT(s.low, 0.9);
     EXPECT_LT(s.high, 1.1);
+    EXPECT_GT(s.bound_ratio, 0.6) << "the shorted bound is close: most of R on an even mesh";
     // The top-ranked move gains at least half what the best one does.
     EXPECT_LE(s.real[0], 0.5 * *std::min_element(s.real.begin(), s.real.end()));
   }
@@ -325,7 +333,7 @@ TEST(Relax, OppositeIndicesCancelWhenThatLowersTheEnergy) {
   EXPECT_FALSE(near.moves.front().cancelled);
 }
 
-// Random placements on surfaces of genus 1 and 2, N = 4 and 6 (indices summing to χ, opposite ones among
+// Random placements on surfaces of genus 0, 1 and 2, N = 4 and 6 (indices summing to χ, opposite ones among
 // them): the result is a local minimum checked by brute force (every single move of every singularity to a
 // free interior neighbour, each a real solve, raises the energy), and much lower than where it started.
 TEST(Relax, RandomPlacementsEndWhereNoSingleMoveLowersTheEnergy) {
@@ -333,7 +341,9 @@ TEST(Relax, RandomPlacementsEndWhereNoSingleMoveLowersTheEnergy) {
     Mesh mesh;
     int N;
   };
-  const std::vector<Case> cases = {{make_torus(24, 12), 4}, {make_torus(24, 12), 6}, {make_genus_surface(2, 12), 4}};
+  // The sphere has no generator: there every prediction is exact or a bound and nothing is solved twice
+  // (trivcon/relax.h); on the others free generator indices make relax end with a checking pass.
+  const std::vector<Case> cases = {{make_icosphere(3), 4}, {make_torus(24, 12), 4}, {make_torus(24, 12), 6}, {make_genus_surface(2, 12), 4}};
   unsigned seed = 7;
   auto next = [&seed] { return seed = seed * 1103515245u + 12345u, static_cast<int>((seed >> 8) % 1000003u); };
   for (const Case& c : cases) {

@@ -29,8 +29,12 @@
 // instead, which R̃ does not see). Candidates are ranked by first order + c² R̃, and only those whose
 // first order is negative are solved, in that order: since R_vu ≥ 0 no other can lower E unless a solve
 // chooses other free indices than the move carries. Each accepted move is the first candidate in rank
-// order whose real energy is lower; the duals are then recomputed and the candidates ranked again. The
-// result is a local minimum for single moves (greedy: e.g. a cancellation taken early is not undone).
+// order whose real energy is lower; the duals are then recomputed and the candidates ranked again. A solved
+// move's second-order term is kept (exact with the cycles held) and ranks it from then on. When every cycle
+// index is held (no free generator, no fixed-face path), a candidate whose lower_bound (or exact prediction) is
+// not negative is not solved: it cannot lower the energy; otherwise relax ends with a pass that solves every
+// candidate with a negative first order again. Either way the result is a local minimum for single moves
+// (greedy: e.g. a cancellation taken early is not undone).
 #pragma once
 #include <vector>
 
@@ -73,6 +77,11 @@ struct RelaxCandidate {
   // of a free cycle, the smaller of that and 2c s x_e / w_e (the index carried along).
   double first_order = 0;
   double estimate = 0;  // first_order + c² R̃
+  // A bound below ΔE when the cycle indices are held: first_order + c² R_lb, R_lb ≤ R_vu the resistance between
+  // v and u with every other vertex shorted to one node (Rayleigh's monotonicity: shorting, and the cycle rows'
+  // Schur complement, only lower it): 1 / (w_vu + 1 / (1/(d_v − w_vu) + 1/(d_u − w_vu))) for neighbours; for a
+  // cancellation further away, and across an edge of a free cycle, just first_order (R ≥ 0).
+  double lower_bound = 0;
 };
 
 // Every candidate move of `prescription` whose connection from designer.solver() is `connection`, lowest

@@ -17,6 +17,9 @@ namespace {
 
 // A move must lower the energy by more than this fraction of it.
 constexpr double kRelativeDecrease = 1e-12;
+// A move predicted (or bounded) to raise it by more than this fraction is not solved: round-off in the
+// predictions stays well below it.
+constexpr double kBoundMargin = 1e-9;
 
 std::vector<char> pinned_vertices(const Topology& t, const RelaxOptions& options) {
   if (options.max_moves < 0) throw Error("relax: max_moves must be at least 0, not " + std::to_string(options.max_moves));
@@ -81,6 +84,12 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
     }
     const double resistance = (spread(v) + spread(u)) * (1 + std::sqrt(3.0) / kPi * std::log(static_cast<double>(distance)));
     m.estimate = m.first_order + c * c * resistance;
+    m.lower_bound = m.first_order;
+    if (distance == 1 && edge >= 0 && !free_cycle_edge[edge]) {  // shorted bound (trivcon/relax.h)
+      const double direct = std::max(0.0, w(edge)), rest_v = degree(v) - direct, rest_u = degree(u) - direct;
+      const double conductance = direct + (rest_v > 0 && rest_u > 0 ? 1 / (1 / rest_v + 1 / rest_u) : 0.0);
+      if (conductance > 0) m.lower_bound += c * c / conductance;
+    }
     out.push_back(m);
   };
   auto other_end = [&](int e, int v) { return t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0); };
@@ -129,23 +138,41 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
   // indices held it is R_vu exactly, a property of the mesh and not of the placement, so a move solved once is
   // ranked exactly ever after (keyed by its unordered pair of vertices; a cancellation has its own entry).
   std::map<std::pair<int, int>, double> measured;
+  // R_vu / R̃_vu of the measured moves: their median scales the estimate of the moves not measured yet (R̃ is off
+  // by a factor that depends on the mesh: its triangulation's regularity and anisotropy), so that a move whose
+  // estimate looks negative only because R̃ is too small is tried later.
+  std::vector<double> ratios;
+  double scale = 1;
   auto key = [](const RelaxCandidate& m) { return std::make_pair(std::min(m.from, m.to), std::max(m.from, m.to)); };
   // A candidate whose measured estimate is not negative is not solved again, except in the check before
   // stopping: only a full pass that solves every candidate with a negative first order ends the search.
   bool checking = false;
+  // With every cycle index held, each prediction is exact or a true bound below ΔE, and nothing needs checking.
+  const Cycles& cycles = designer.cycles();
+  bool held = solver.fixed_paths().empty();
+  for (int g = 0; g < static_cast<int>(cycles.generators.size()); ++g) held = held && start.generator.count(g);
   while (static_cast<int>(r.moves.size()) < options.max_moves) {
     std::vector<RelaxCandidate> candidates = relax_candidates(designer, r.prescription, current, options);
     for (RelaxCandidate& m : candidates)
       if (const auto it = measured.find(key(m)); it != measured.end()) {
         const double c = step * m.index;
         m.estimate = m.first_order + c * c * it->second;
+      } else {
+        m.estimate = m.first_order + scale * (m.estimate - m.first_order);
       }
     std::stable_sort(candidates.begin(), candidates.end(),
                      [](const RelaxCandidate& a, const RelaxCandidate& b) { return a.estimate < b.estimate; });
     bool moved = false;
     for (const RelaxCandidate& move : candidates) {
       if (!(move.first_order < 0)) continue;  // ΔE = first order + c² R with R ≥ 0: cannot lower E
-      if (!checking && !(move.estimate < 0) && measured.count(key(move))) continue;
+      if (held) {
+        const double c = step * move.index;
+        const auto it = measured.find(key(move));
+        const double lowest = it != measured.end() ? move.first_order + c * c * it->second : move.lower_bound;
+        if (lowest > kBoundMargin * std::abs(current.energy)) continue;  // cannot lower E
+      } else if (!checking && !(move.estimate < 0) && measured.count(key(move))) {
+        continue;
+      }
       check_cancelled();
       if (options.max_seconds > 0 && linalg::seconds_since(t0) > options.max_seconds) {
         r.out_of_time = true;
@@ -156,7 +183,16 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
       Connection next = solver.solve(p);
       ++r.candidates_evaluated;
       const double c = step * move.index;
-      measured[key(move)] = std::max(0.0, (next.energy - current.energy - move.first_order) / (c * c));
+      const double second = std::max(0.0, (next.energy - current.energy - move.first_order) / (c * c));
+      if (!measured.count(key(move)) && move.estimate > move.first_order) {  // R̃ (as scaled) against R
+        ratios.push_back(scale * second * c * c / (move.estimate - move.first_order));
+        if (ratios.size() >= 8) {
+          std::vector<double> sorted = ratios;
+          std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+          scale = sorted[sorted.size() / 2];
+        }
+      }
+      measured[key(move)] = second;
       if (!(next.energy < current.energy - kRelativeDecrease * std::abs(current.energy))) continue;
       r.prescription = std::move(p);
       current = std::move(next);
@@ -168,7 +204,7 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
     if (r.out_of_time) break;
     if (moved) {
       checking = false;
-    } else if (!checking) {
+    } else if (!checking && !held) {
       checking = true;  // nothing found among the unmeasured and the promising: solve every candidate once more
     } else {
       r.converged = true;
