@@ -492,6 +492,14 @@ TEST(Quad, RefusesAMapOfAnotherMesh) {
   } catch (const Error& e) {
     EXPECT_TRUE(std::string(e.what()).find("beyond 2^30") != std::string::npos) << e.what();
   }
+  Parametrization huge = r.param;
+  huge.uv *= 1e4;  // still seamless off the cut, but 10⁸ times the squares
+  try {
+    extract_quads(*r.designer, huge);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_TRUE(test::contains(e.what(), "unit squares (at most 2^27")) << e.what();
+  }
 }
 
 // A 100k-face torus at about 10k quads: the extraction is linear (the bound is loose for a loaded machine).

@@ -87,8 +87,9 @@ struct QuadMesh {
 
 // The quad mesh of `param` (made by parametrize on `designer` for one design). Throws trivcon::Error when the
 // map does not belong to the designer's mesh (sizes, a cut edge on the boundary), a transition is not a quarter
-// turn, or a (u, v) or translation is not finite or too large (≥ 2³⁰); every other failure (folds, traces that
-// do not meet, faces that are not quads) is reported in quality.problems.
+// turn, a (u, v) or translation is not finite or too large (≥ 2³⁰), or the faces' (u, v) bounding boxes cover more
+// than 2²⁷ unit squares (a broken map); every other failure (folds, traces that do not meet, faces that are not
+// quads) is reported in quality.problems.
 QuadMesh extract_quads(const FieldDesigner& designer, const Parametrization& param, const QuadOptions& options = {});
 
 // Measures the quad mesh (V, Q, vertex_cone) against the input surface and the map's cones, from the quads

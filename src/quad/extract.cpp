@@ -23,8 +23,9 @@ namespace {
 using i64 = long long;
 using i128 = __int128;
 
-constexpr i64 kUnit = i64{1} << 20;        // one unit of (u, v) in chart coordinates
-constexpr double kLargest = 1073741824.0;  // 2³⁰: |u|, |v| beyond this would overflow the exact predicates
+constexpr i64 kUnit = i64{1} << 20;           // one unit of (u, v) in chart coordinates
+constexpr double kLargest = 1073741824.0;     // 2³⁰: |u|, |v| beyond this would overflow the exact predicates
+constexpr double kMostSquares = 134217728.0;  // 2²⁷: the most unit squares the faces' (u, v) boxes may cover
 
 struct P2 {
   i64 x = 0, y = 0;
@@ -259,7 +260,21 @@ void Extractor::find_points() {
   }
   edge_node_offsets_[nE] = static_cast<int>(nodes_.size());
   // Inside faces: row by row (whole v), the candidates of the row's span tested exactly. Points inside a folded
-  // or degenerate triangle are counted and dropped.
+  // or degenerate triangle are counted and dropped. The candidates are bounded by the triangles' boxes: a map
+  // whose boxes cover more than 2^27 unit squares is refused before any work (no mesh needs that many quads).
+  double boxes = 0;
+  for (int f = 0; f < nF; ++f) {
+    const P2 A = at(f, 0), B = at(f, 1), C = at(f, 2);
+    const double rows = static_cast<double>(std::max({A.y, B.y, C.y}) - std::min({A.y, B.y, C.y})) / kUnit + 1;
+    const double columns = static_cast<double>(std::max({A.x, B.x, C.x}) - std::min({A.x, B.x, C.x})) / kUnit + 3;
+    boxes += rows * columns;
+  }
+  if (boxes > kMostSquares) {
+    std::ostringstream s;
+    s << "quad: the map's (u, v) triangles span about " << boxes << " unit squares (at most 2^27 = " << kMostSquares
+      << "): the map is broken, or its edge length far too small for the mesh";
+    throw Error(s.str());
+  }
   face_node_offsets_.assign(nF + 1, 0);
   for (int f = 0; f < nF; ++f) {
     face_node_offsets_[f] = static_cast<int>(nodes_.size());
