@@ -97,7 +97,7 @@ TEST(CliExit, MissingArgumentIsTwo) {
   expect_usage_error("solve", "mesh is required");
   expect_usage_error("check", "mesh is required");
   expect_usage_error("check " + q(mesh), "field is required");
-  expect_usage_error("render " + q(mesh) + " -o p.png", "--field or --uv is required");
+  expect_usage_error("render " + q(mesh) + " -o p.png", "--field, --uv or --polygon-edges is required");
   // An option without its value.
   expect_usage_error("solve " + q(mesh) + " --field-out", "--field-out: 1 required TEXT missing");
   expect_usage_error("solve " + q(mesh) + " --sing", "--sing: 1 required TEXT missing");

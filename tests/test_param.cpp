@@ -64,7 +64,9 @@ void expect_seamless(const MapRun& r) {
       const Eigen::Vector2d ta = ra - J * la, tb = rb - J * lb;
       const double residual = std::max({(ta - tb).lpNorm<Eigen::Infinity>(), whole_offset(ta.x()), whole_offset(ta.y())});
       if (!cut.count(e) && q != 0) continue;
-      if (!cut.count(e)) EXPECT_LT(ta.lpNorm<Eigen::Infinity>(), 1e-9) << "edge " << e << " is off the cut but its sides differ";
+      if (!cut.count(e)) {
+        EXPECT_LT(ta.lpNorm<Eigen::Infinity>(), 1e-9) << "edge " << e << " is off the cut but its sides differ";
+      }
       best = std::min(best, residual);
     }
     worst = std::max(worst, best);
