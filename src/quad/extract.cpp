@@ -135,6 +135,7 @@ class Extractor {
   int find_slot(int node, int face, int code) const;
   int arrive_at_vertex(int node, int face, int code) const;
   int arrive(int node, int face, int code) const;
+  int node_at(int begin, int end, P2 p) const;
   int node_on_edge(int e, int face, P2 p) const;
   int node_in_face(int f, P2 p) const;
   State start(int node, int slot) const;
@@ -259,7 +260,10 @@ void Extractor::find_points() {
     }
   }
   edge_node_offsets_[nE] = static_cast<int>(nodes_.size());
-  // Inside faces: row by row (whole v), the candidates of the row's span tested exactly. Points inside a folded
+  auto by_row = [](const Node& a, const Node& b) { return a.p.y != b.p.y ? a.p.y < b.p.y : a.p.x < b.p.x; };
+  for (int e = 0; e < nE; ++e) std::sort(nodes_.begin() + edge_node_offsets_[e], nodes_.begin() + edge_node_offsets_[e + 1], by_row);
+  // Inside faces: row by row (whole v), the candidates of the row's span tested exactly (so that a face's points
+  // come sorted by (v, u), as node_at needs). Points inside a folded
   // or degenerate triangle are counted and dropped. The candidates are bounded by the triangles' boxes: a map
   // whose boxes cover more than 2^27 unit squares is refused before any work (no mesh needs that many quads).
   double boxes = 0;
@@ -395,19 +399,20 @@ int Extractor::arrive(int node, int face, int code) const {
   return find_slot(node, face, code);
 }
 
-int Extractor::node_on_edge(int e, int face, P2 p) const {
-  const int f = chart_face(e);
-  if (face != f) p = across(e, face, p);
-  for (int i = edge_node_offsets_[e]; i < edge_node_offsets_[e + 1]; ++i)
-    if (nodes_[i].p == p) return i;
-  return -1;
+// The node at p among nodes_[begin, end), which are sorted by (y, x) (a binary search: an element of a broken map
+// can hold very many points).
+int Extractor::node_at(int begin, int end, P2 p) const {
+  const auto first = nodes_.begin() + begin, last = nodes_.begin() + end;
+  const auto it = std::lower_bound(first, last, p, [](const Node& n, P2 q) { return n.p.y != q.y ? n.p.y < q.y : n.p.x < q.x; });
+  return it != last && it->p == p ? static_cast<int>(it - nodes_.begin()) : -1;
 }
 
-int Extractor::node_in_face(int f, P2 p) const {
-  for (int i = face_node_offsets_[f]; i < face_node_offsets_[f + 1]; ++i)
-    if (nodes_[i].p == p) return i;
-  return -1;
+int Extractor::node_on_edge(int e, int face, P2 p) const {
+  if (face != chart_face(e)) p = across(e, face, p);
+  return node_at(edge_node_offsets_[e], edge_node_offsets_[e + 1], p);
 }
+
+int Extractor::node_in_face(int f, P2 p) const { return node_at(face_node_offsets_[f], face_node_offsets_[f + 1], p); }
 
 State Extractor::start(int node, int slot) const {
   const Node& n = nodes_[node];
@@ -659,8 +664,8 @@ QuadMesh Extractor::run() {
   const int nS = static_cast<int>(slots_.size());
 
   // One trace per direction. A unit iso-line crosses a few faces where the mesh is finer than the quads; the
-  // limit on all of them together is generous (64 per direction and face), reached only on wildly folded maps.
-  step_budget_ = 64LL * (static_cast<long long>(nS) + nF) + 1000000;
+  // limit on all of them together is generous (16 per direction and face), reached only on wildly folded maps.
+  step_budget_ = 16LL * (static_cast<long long>(nS) + nF) + 1000000;
   std::vector<int> target(nS, -1);
   for (int i = 0; i < nN; ++i)
     for (int s = slot_offsets_[i]; s < slot_offsets_[i + 1]; ++s) target[s] = trace(i, s);
