@@ -29,10 +29,10 @@ void FieldOptions::add_to(CLI::App* cmd, bool fixed_N) {
   cmd->add_option("--weight-floor", weight_floor,
                   "with cotan weights, every interior edge gets at least this fraction of the median weight (default 0: none)")
       ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--solver", solver, "cholesky (default) or qr (the paper's SuiteSparseQR route)")
+  cmd->add_option("--solver", solver, "cholesky (default) or qr (the paper's SuiteSparseQR route; only in a build with -DTRIVCON_WITH_SUITESPARSE=ON)")
       ->check(CLI::IsMember({"cholesky", "qr"}));
   cmd->add_option("--factorization", factorization,
-                  "Cholesky route's numeric factor: own (default: trivcon's, on several threads) or cholmod (CHOLMOD's cholmod_factorize)")
+                  "Cholesky route's numeric factor: own (default: trivcon's, on several threads) or cholmod (CHOLMOD's cholmod_factorize; only in a build with -DTRIVCON_WITH_SUITESPARSE=ON)")
       ->check(CLI::IsMember({"own", "cholmod"}));
   cmd->add_option("--fix", fixes,
                   "Fixed direction: F:x,y,z (world, projected to the face), F:angle=A (radians, face frame), or a file with "

@@ -876,7 +876,13 @@ int driver(const std::string& cache, const std::string& dragon, const std::strin
     r["fit"] = e.fit;
     r["target_class"] = e.target_class;
     runs.push_back(r);
-    if (e.mesh.qr) {
+#ifdef TRIVCON_WITH_SUITESPARSE
+    const bool with_qr = e.mesh.qr;
+#else
+    const bool with_qr = false;  // the QR route needs a build with -DTRIVCON_WITH_SUITESPARSE=ON (GPL)
+    if (e.mesh.qr) std::cerr << "bench: " << e.mesh.name << ": no QR comparison in a build without -DTRIVCON_WITH_SUITESPARSE=ON\n";
+#endif
+    if (with_qr) {
       const std::string qout = stem + ".qr.json";
       fs::remove(qout, ec);
       std::vector<std::string> qargs{"--child",

@@ -647,6 +647,7 @@ TEST(CliSolve, CrossFieldOnACubeFromASingularityFile) {
   EXPECT_TRUE(contains(r.out, "index 1/4\n")) << r.out;
 }
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 TEST(CliSolve, FactorizationCholmodGivesTheSameConnection) {
   // --factorization cholmod (CHOLMOD's own numeric factorization) against the default, on a genus-2
   // surface (cycle rows): the same x on every edge to round-off, the same energy line.
@@ -684,6 +685,16 @@ TEST(CliSolve, FactorizationCholmodGivesTheSameConnection) {
   EXPECT_GT(lines, 1000);
   EXPECT_LE(worst, 1e-10);
 }
+#else
+TEST(CliSolve, FactorizationCholmodIsRefusedWithoutCholmod) {
+  const std::string dir = test::temp_dir("cli_solve_factorization");
+  const std::string mesh = save(dir, "genus2", make_genus_surface(2, 2), true);
+  const CommandResult r = run_cli("solve " + q(mesh) + " -N 4 --factorization cholmod");
+  EXPECT_NE(r.status, 0);
+  EXPECT_TRUE(contains(r.err, "the cholmod factorization needs CHOLMOD")) << r.err;
+  EXPECT_TRUE(contains(r.err, "GPL")) << r.err;
+}
+#endif
 
 TEST(CliSolve, TorusWithoutSingularities) {
   const std::string dir = test::temp_dir("cli_solve_torus");

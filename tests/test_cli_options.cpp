@@ -438,9 +438,22 @@ TEST(CliOptions, UnitWeightsEnergyIsTheSumOfSquares) {
   }
 }
 
-// x from the connection files of both routes.
+// x from the connection files of both routes. Without SuiteSparseQR in the build, --solver qr is refused with the
+// reason, and the Cholesky route's solution is verified.
 void expect_qr_matches_cholesky(const std::string& dir, const std::string& args, const std::string& what) {
   SCOPED_TRACE(what);
+#ifndef TRIVCON_WITH_SUITESPARSE
+  {
+    const std::string ra = dir + "/chol.json";
+    expect_ok(run_cli("solve " + args + " -q --report " + q(ra)));
+    EXPECT_EQ(read_json(ra)["verified"], true);
+    const CommandResult r = run_cli("solve " + args + " -q --solver qr");
+    EXPECT_NE(r.status, 0);
+    EXPECT_TRUE(contains(r.err, "the QR solver needs SuiteSparseQR")) << r.err;
+    EXPECT_TRUE(contains(r.err, "-DTRIVCON_WITH_SUITESPARSE=ON")) << r.err;
+    return;
+  }
+#endif
   const std::string a = dir + "/chol.txt", b = dir + "/qr.txt", ra = dir + "/chol.json", rb = dir + "/qr.json";
   expect_ok(run_cli("solve " + args + " -q --connection-out " + q(a) + " --report " + q(ra)));
   expect_ok(run_cli("solve " + args + " -q --solver qr --connection-out " + q(b) + " --report " + q(rb)));

@@ -1,7 +1,10 @@
 // trivcon's own symbolic analysis (src/linalg/symbolic.h, internal) against a brute-force symbolic Cholesky
 // factorization and against CHOLMOD's (cholmod_analyze_p with the same order), its AMD and CAMD orders against
-// CHOLMOD's, and the numeric factorization of src/linalg/supernodal.h on its structure.
+// CHOLMOD's, and the numeric factorization of src/linalg/supernodal.h on its structure. The comparisons with
+// CHOLMOD are compiled only in a build with TRIVCON_WITH_SUITESPARSE; the brute force and the solves always.
+#ifdef TRIVCON_WITH_SUITESPARSE
 #include <cholmod.h>
+#endif
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -20,7 +23,9 @@
 #include <tuple>
 #include <vector>
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 #include "linalg/cholmod.h"
+#endif
 #include "linalg/ordering.h"
 #include "linalg/supernodal.h"
 #include "linalg/symbolic.h"
@@ -188,6 +193,7 @@ std::vector<Case> mesh_cases() {
           {"random 2000 x4 with dense rows", random_spd(2000, 4, 22, 5)}};
 }
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 // CHOLMOD's supernodal symbolic factor for a given order (cholmod_analyze_p), with CHOLMOD's parameters set
 // to `o`'s.
 struct CholmodSymbolic {
@@ -231,6 +237,7 @@ void expect_same_as_cholmod(const Upper& A, const std::vector<int>& order, const
   EXPECT_EQ(ours.maxcsize, L.maxcsize);
   EXPECT_EQ(static_cast<size_t>(ours.maxesize), L.maxesize);
 }
+#endif
 
 // x ← (L Lᴴ)⁻¹ x for a factor of ours (values `x` of the scalar T), b and the result in the matrix's order: the
 // supernodal forward and backward substitutions, written out.
@@ -282,6 +289,7 @@ double relative_residual(const Upper& A, const std::vector<T>& entries, const st
   return std::sqrt(rr / bb);
 }
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 double seconds_of(const std::function<void()>& f, int repeats = 3) {
   double best = 1e300;
   for (int r = 0; r < repeats; ++r) {
@@ -316,6 +324,7 @@ void print_times(const Case& c) {
   std::printf("%s: n %d, nnz(L) %zu, %d supernodes; symbolic analysis %.1f ms, cholmod_analyze_p %.1f ms (AMD itself %.1f ms)\n",
               c.name.c_str(), A.n, ours.nnz, ours.nsuper, 1e3 * t_ours, 1e3 * t_theirs, 1e3 * t_amd);
 }
+#endif
 
 }  // namespace
 
@@ -376,6 +385,7 @@ TEST(Symbolic, PostorderAndFundamentalSupernodes) {
   }
 }
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 // The same factor as cholmod_analyze_p given the same order, array for array: postordered or not, with CHOLMOD's
 // default amalgamation, with the smoothest field's (trivcon/auto.h), and with none (nrelax and zrelax 0, where
 // CHOLMOD still merges a child into its parent when that adds no zeros). The rule and the order in which pairs are
@@ -572,6 +582,8 @@ TEST(Symbolic, OrdersAndAnalysesALeadingBlock) {
   expect_same_as_cholmod(block, order, SymbolicOptions{}, "leading block");
 }
 
+#endif
+
 // A numeric factorization by src/linalg/supernodal.cpp's code on our structure solves A x = b, real (L Lᵀ) and
 // complex Hermitian (L Lᴴ, a connection Laplacian as the smoothest field's), and its values are CHOLMOD's symbolic
 // factor's filled by the same code.
@@ -587,6 +599,7 @@ TEST(Symbolic, NumericFactorizationOnItSolves) {
     for (int i = 0; i < A.n; ++i) b[i] = std::sin(0.37 * i + 1);
     EXPECT_LT(relative_residual(A, A.values, solve_with(F, x, b), b), 1e-10);
 
+#ifdef TRIVCON_WITH_SUITESPARSE
     // The same values as the factor CHOLMOD's analysis gives the same code (the structures are the same).
     CholmodSymbolic theirs(A, linalg::amd_ordering(A.outer, A.inner, A.n), SymbolicOptions{});
     ASSERT_EQ(linalg::factorize(*theirs.L, A.outer, A.inner, A.values, *theirs.context), A.n);
@@ -596,6 +609,7 @@ TEST(Symbolic, NumericFactorizationOnItSolves) {
     for (size_t k = 0; k < x.size(); ++k)
       largest = std::max(largest, std::abs(y[k])), difference = std::max(difference, std::abs(x[k] - y[k]));
     EXPECT_LE(difference, 1e-14 * largest);
+#endif
 
     // Hermitian: each off-diagonal entry turned by a random phase.
     std::mt19937 rng(9);
@@ -622,8 +636,10 @@ TEST(Symbolic, NumericFactorizationReportsTheColumnNotPositiveDefinite) {
   const SymbolicFactor F = linalg::symbolic_analysis(A.outer, A.inner, A.n, order);
   std::vector<double> x;
   const int minor = linalg::factorize(F, x, A.outer, A.inner, A.values);
+#ifdef TRIVCON_WITH_SUITESPARSE
   CholmodSymbolic theirs(A, order, SymbolicOptions{});
   EXPECT_EQ(minor, linalg::factorize(*theirs.L, A.outer, A.inner, A.values, *theirs.context));
+#endif
   EXPECT_LT(minor, A.n);
 }
 
@@ -644,6 +660,7 @@ TEST(Symbolic, EmptyAndOneByOne) {
   EXPECT_DOUBLE_EQ(x[0], 2.0);
 }
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 // cholmod_postorder's order, weighted and not, on a forest.
 TEST(Symbolic, PostorderAsCholmods) {
   std::mt19937 rng(4);
@@ -662,6 +679,8 @@ TEST(Symbolic, PostorderAsCholmods) {
     }
   }
 }
+
+#endif
 
 TEST(Symbolic, RejectsBadInputWithSpecificMessages) {
   const Upper A = vertex_laplacian(make_icosphere(1));
@@ -696,6 +715,7 @@ TEST(Symbolic, RejectsBadInputWithSpecificMessages) {
   EXPECT_NE(message([&] { linalg::postorder({5, -1}); }).find("node 0 has an invalid parent"), std::string::npos);
 }
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 // Ours against cholmod_analyze_p on meshes of 330k to 400k faces (vertex and face Laplacians), printed.
 TEST(Symbolic, TimeAgainstCholmod) {
   for (const Case& c : {Case{"vertex Laplacian, torus 500x400 (400k faces)", vertex_laplacian(make_torus(500, 400))},
@@ -711,3 +731,4 @@ TEST(Symbolic, TimeAgainstCholmodOnAScan) {
   print_times({"vertex Laplacian, dragon_vrip (871k faces)", vertex_laplacian(dragon)});
   print_times({"face Laplacian, dragon_vrip (871k faces)", face_laplacian(dragon)});
 }
+#endif

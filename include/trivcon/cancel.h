@@ -5,8 +5,8 @@
 // CancelScope on that thread, and sets the flag from anywhere. The library polls the flag at safe points
 // (between the stages of a set-up and of the geometry, per supernode of the numeric factorization, per
 // iteration of the smoothest field, per round of refinement) and throws trivcon::Cancelled there; everything
-// the call built so far is released as for any other error. Parts that run inside another library (CHOLMOD's
-// ordering and symbolic analysis) finish first, so a call stops within about the longest such part (BENCHMARKS.md,
+// the call built so far is released as for any other error. Parts that run inside another library (the AMD /
+// CAMD orders of libamd / libcamd) finish first, so a call stops within about the longest such part (BENCHMARKS.md,
 // "Figures that were in code comments", has how long that is). Without a scope nothing is polled. The Python
 // module uses this for KeyboardInterrupt (python/src/module.cpp).
 #pragma once

@@ -33,10 +33,10 @@ enum class WeightKind { Cotan, Unit };
 enum class SolverKind { Cholesky, QR };
 // Who computes the Cholesky route's numeric factor: trivcon's own supernodal factorization on several
 // threads (Parallel: the default, independent subtrees of the elimination tree on OpenMP threads, then the
-// top of the tree with multithreaded BLAS), or CHOLMOD's cholmod_factorize (Cholmod: one supernode after
-// another, slower on a mesh, the reference). Both fill the same factor and give the same results to
-// round-off. Construction throws trivcon::Error if the CHOLMOD or BLAS library loaded is not the kind the
-// library was built for (src/linalg/cholmod.h).
+// top of the tree with multithreaded BLAS), or CHOLMOD's cholmod_factorize (Cholmod: the reference, slower; it and
+// SolverKind::QR only in a build with -DTRIVCON_WITH_SUITESPARSE=ON, as CHOLMOD's Debian build has GPL modules and
+// SuiteSparseQR is GPL: elsewhere asking for them throws trivcon::Error saying so). Construction throws trivcon::Error
+// if the BLAS (or CHOLMOD, where linked) loaded is not the kind the library was built for (src/linalg/numeric_libraries.h).
 enum class Factorization { Parallel, Cholmod };
 
 struct SolverOptions {
@@ -85,7 +85,7 @@ namespace connection {
 struct AnalysisState;
 }
 
-// The fill-reducing order and CHOLMOD's symbolic factorization of the Cholesky route's A W Aᵀ for a mesh
+// The fill-reducing order and the symbolic factorization of the Cholesky route's A W Aᵀ for a mesh
 // without fixed faces. The pattern of A W Aᵀ is that of the mesh's vertices, interior edges and cycles
 // (an edge of zero weight is an explicit zero): it does not depend on the geometry or the weights, so
 // this part of the set-up can run on another thread while the geometry is computed (FieldDesigner does).

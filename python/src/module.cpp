@@ -663,6 +663,13 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "trivcon's C++ library (the pybind11 extension behind the trivcon package; use the package, not this module).";
   py::register_exception<Error>(m, "Error", PyExc_ValueError);
   m.attr("__version__") = TRIVCON_VERSION;
+  // Whether solver="qr" and factorization="cholmod" exist in this build (they need SuiteSparse's GPL parts, which a
+  // default build does not link: CMakeLists.txt, TRIVCON_WITH_SUITESPARSE).
+#ifdef TRIVCON_WITH_SUITESPARSE
+  m.attr("with_suitesparse") = true;
+#else
+  m.attr("with_suitesparse") = false;
+#endif
   m.attr("pi") = kPi;
   main_thread_ident = py::module_::import("threading").attr("main_thread")().attr("ident").cast<unsigned long>();
 

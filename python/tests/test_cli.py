@@ -114,6 +114,7 @@ def test_auto(cli, tmp_path):
     agree(cli, tmp_path, path, 4, ["--auto", "--auto-cancel", "2"], r)
 
 
+@pytest.mark.skipif(not trivcon.with_suitesparse, reason="the QR route needs a build with TRIVCON_WITH_SUITESPARSE")
 def test_unit_weights_and_qr(cli, tmp_path):
     V, F = trivcon.make_icosphere(2)
     path = str(tmp_path / "ico.obj")

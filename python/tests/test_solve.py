@@ -106,6 +106,7 @@ def test_unit_weights(cube):
     check_result(V, d, r, {v: Fraction(1, 4) for v in corners})
 
 
+@pytest.mark.skipif(not trivcon.with_suitesparse, reason="the QR route needs a build with TRIVCON_WITH_SUITESPARSE")
 def test_qr_route_agrees(cube):
     V, F, corners, d = cube
     q = trivcon.FieldDesigner(V, F, solver="qr")

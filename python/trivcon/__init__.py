@@ -62,6 +62,9 @@ import numpy as _np
 from . import _core
 
 __version__ = _core.__version__
+# Whether solver="qr" and factorization="cholmod" are in this build: they need SuiteSparseQR and CHOLMOD (GPL),
+# which the default build does not link; asking for them otherwise raises trivcon.Error saying so.
+with_suitesparse = bool(_core.with_suitesparse)
 
 __all__ = [
     "Error",
@@ -619,7 +622,8 @@ class FieldDesigner(_Cached):
     (non-finite coordinate, vertex id out of range, non-manifold edge or vertex with repair=False,
     non-orientable component) raise trivcon.Error with the library's message. weights: "cotan" (clamped cotangent weights,
     default) or "unit"; solver: "cholesky" (default) or "qr" (the paper's SuiteSparseQR route);
-    factorization: "own" (trivcon's, on several threads) or "cholmod". weight_floor: with cotan
+    factorization: "own" (trivcon's, on several threads) or "cholmod" ("qr" and "cholmod" only when
+    trivcon.with_suitesparse). weight_floor: with cotan
     weights, every interior edge gets at least this fraction of the median weight (0 to 1; default 0,
     none): fewer large turns on meshes with many obtuse angles, at some cost in smoothness (README
     "Weights and energy"). threads: how many threads its calls use (None: trivcon.set_threads's default;

@@ -11,6 +11,7 @@ import numpy.typing as npt
 from . import batch as batch
 
 __version__: str
+with_suitesparse: bool
 __all__: List[str]
 
 _Path = Union[str, "os.PathLike[str]"]

@@ -6,73 +6,70 @@
 #include <memory>
 #include <string>
 
+#ifdef TRIVCON_WITH_SUITESPARSE
+#include "linalg/cholmod.h"
+#endif
+#include "linalg/numeric_libraries.h"
 #include "linalg/ordering.h"
 #include "linalg/parallel.h"
 #include "linalg/substitution.h"
 #include "linalg/supernodal.h"
+#include "linalg/symbolic.h"
 #include "linalg/timing.h"
 #include "trivcon/cancel.h"
 #include "trivcon/error.h"
 
 namespace trivcon::connection {
 
-AnalysisState::~AnalysisState() {
-  if (factor) cholmod_free_factor(&factor, cc.get());
-}
-
 namespace {
 
 // A fill-reducing order of the nD vertex rows of M (the nC cycle rows come last). Minimum degree (AMD;
 // CAMD when there are cycle rows, constrained to order them last, so that it sees how they couple the
 // vertices: fewer flops on meshes with many cycles), then postordered by the vertex block's elimination
-// tree so that CHOLMOD finds large supernodes without postordering the whole system (which could move
+// tree so that the analysis finds large supernodes without postordering the whole system (which could move
 // the cycle rows). Not CHOLMOD's default choice, which tries METIS on large meshes: its analysis alone
 // takes longer than the fill it saves. (A nested dissection by vertex coordinates, tried as a second
 // candidate, cut the flops on smooth closed surfaces but not the time with AVX-512 BLAS kernels, and lost
 // on scanned meshes.) The figures: BENCHMARKS.md, "What changed since the first measurement" and "Tried
-// and dropped".
-std::vector<int> vertex_order(const Csc& M, int nD, int nC, cholmod_common& cc) {
-  std::vector<int> order(nD);
+// and dropped". libamd / libcamd with CHOLMOD's options give cholmod_amd's and cholmod_camd's orders
+// (tests/test_symbolic.cpp).
+std::vector<int> vertex_order(const Csc& M, int nD, int nC) {
+  std::vector<int> order;
   if (nD == 0) return order;
   if (nC > 0) {
-    cholmod_sparse A = linalg::upper_view(M.outer, M.inner, M.values, nD + nC);
-    std::vector<int> last(nD + nC, 0), full(nD + nC);
-    std::fill(last.begin() + nD, last.end(), 1);
-    linalg::require(cholmod_camd(&A, nullptr, 0, last.data(), full.data(), &cc) != 0, "CHOLMOD could not order the constraint system", cc);
-    std::copy(full.begin(), full.begin() + nD, order.begin());
-    for (int k = 0; k < nD; ++k) linalg::require(order[k] < nD, "CHOLMOD did not order the cycle rows last", cc);
+    std::vector<int> set(nD + nC, 0);
+    std::fill(set.begin() + nD, set.end(), 1);
+    order = linalg::camd_ordering(M.outer, M.inner, nD + nC, set);
+    order.resize(nD);
+    for (int k = 0; k < nD; ++k)
+      if (order[k] >= nD) throw Error("internal: CAMD did not order the cycle rows last");
   } else {
-    cholmod_sparse A = linalg::upper_view(M.outer, M.inner, M.values, nD);
-    linalg::require(cholmod_amd(&A, nullptr, 0, order.data(), &cc) != 0, "CHOLMOD could not order the vertex Laplacian", cc);
+    order = linalg::amd_ordering(M.outer, M.inner, nD);
   }
-  const linalg::Pattern pattern = linalg::leading_block_pattern(M.outer, M.inner, nD);
-  std::vector<int> parent = linalg::elimination_tree(pattern, order), post(nD);
-  linalg::require(cholmod_postorder(parent.data(), nD, nullptr, post.data(), &cc) == nD, "CHOLMOD could not postorder the elimination tree", cc);
+  const std::vector<int> post = linalg::postorder(linalg::elimination_tree(linalg::leading_block_pattern(M.outer, M.inner, nD), order));
   std::vector<int> postordered(nD);
   for (int k = 0; k < nD; ++k) postordered[k] = order[post[k]];
   return postordered;
 }
 
-// Symbolic analysis of the whole system: the vertex rows in `order`, then the cycle rows.
-cholmod_factor* symbolic(const Csc& M, std::vector<int> order, int nD, int nC, cholmod_common& c) {
+// Symbolic analysis of the whole system: the vertex rows in `order`, then the cycle rows, not postordered
+// again (that keeps the cycle rows last; the vertex order is postordered already).
+linalg::SymbolicFactor symbolic(const Csc& M, std::vector<int> order, int nD, int nC) {
   const int n = nD + nC;
   for (int r = nD; r < n; ++r) order.push_back(r);
-  cholmod_sparse A = linalg::upper_view(M.outer, M.inner, M.values, n);
-  c.nmethods = 1;
-  c.method[0].ordering = CHOLMOD_GIVEN;
-  c.postorder = 0;  // keep the cycle rows last (the vertex order is postordered already)
-  cholmod_factor* L = cholmod_analyze_p(&A, order.data(), nullptr, 0, &c);
-  linalg::require(L != nullptr, "CHOLMOD could not analyse the constraint system", c);
-  return L;
+  linalg::SymbolicOptions options;
+  options.postorder = false;
+  return linalg::symbolic_analysis(M.outer, M.inner, n, order, options);
 }
 
 }  // namespace
 
 void analyse(const Csc& M, int nD, int nC, AnalysisState& state) {
   if (nD + nC == 0) return;
-  std::vector<int> order = vertex_order(M, nD, nC, *state.cc);
+  std::vector<int> order = vertex_order(M, nD, nC);
   check_cancelled();  // trivcon/cancel.h
-  state.factor = symbolic(M, std::move(order), nD, nC, *state.cc);
+  state.symbolic = symbolic(M, std::move(order), nD, nC);
+  state.analysed = true;
 }
 
 namespace {
@@ -82,13 +79,14 @@ using linalg::Supernodes;
 // See src/connection/cholesky_engine.h.
 class CholeskyEngine : public SolverEngine {
  public:
-  // CHOLMOD's workspace, and the symbolic factorization when one was given (see factorize). Mutable:
-  // CHOLMOD's solves write to their workspace.
-  mutable std::unique_ptr<AnalysisState> cholmod_ = std::make_unique<AnalysisState>();
-  cholmod_common& cc() const { return *cholmod_->cc; }
+  // The symbolic factorization (given, see adopt, or the engine's own) and the factor's values in its
+  // supernodal blocks.
+  std::unique_ptr<AnalysisState> analysis_ = std::make_unique<AnalysisState>();
+  std::vector<double> values_;
+  const linalg::SymbolicFactor& symbolic_factor() const { return analysis_->symbolic; }
+  Supernodes supernodes() const { return Supernodes(analysis_->symbolic, values_.data()); }
   Factorization factorization_;
   const char* numeric_by_ = "";  // who computed the factor's values (SetupTimings::numeric_factorization)
-  cholmod_factor* factor = nullptr;
   bool analysis_adopted = false;
   Eigen::VectorXd w;
   int m = 0, nD = 0, nC = 0;
@@ -97,7 +95,7 @@ class CholeskyEngine : public SolverEngine {
   EdgeRows edge_rows_;
   Eigen::MatrixXd R_CC, R_inv;  // lower triangular; P = R_invᵀ R_inv
   // Sparse forward substitution (see forward_update).
-  std::vector<int> position_;  // factor position of each row of M (the inverse of factor->Perm)
+  std::vector<int> position_;  // factor position of each row of M (the inverse of the factor's perm)
   std::vector<int> super_of_col_, super_parent_;
   Eigen::VectorXd base_b_, base_z_;  // base right-hand side of the vertex rows, and L⁻¹ Π [base_b; 0]
   mutable std::vector<int> super_stamp_;
@@ -116,75 +114,101 @@ class CholeskyEngine : public SolverEngine {
     linalg::check_numeric_libraries();
     m = static_cast<int>(ends.size()), nD = num_vertex_rows + static_cast<int>(Et.cols()), nC = static_cast<int>(Ct.cols());
     const int n = nD + nC;
-    try {
-      auto t0 = linalg::Clock::now();
-      Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct, w, edge_rows_);
-      timings.assemble += linalg::seconds_since(t0);
-      if (n == 0) return;
-      check_cancelled();
-      if (analysis) {
-        t0 = linalg::Clock::now();
-        adopt(M, analysis());
-        timings.analysis_wait += linalg::seconds_since(t0);
-        timings.analysis_adopted = analysis_adopted;
-        check_cancelled();
-      }
+    auto t0 = linalg::Clock::now();
+    Csc M = normal_matrix(ends, num_vertex_rows, Et, Ct, w, edge_rows_);
+    timings.assemble += linalg::seconds_since(t0);
+    if (n == 0) return;
+    check_cancelled();
+    if (analysis) {
       t0 = linalg::Clock::now();
-      factorize(M);
-      timings.factor += linalg::seconds_since(t0);
-      timings.numeric_factorization = numeric_by_;
+      adopt(M, analysis());
+      timings.analysis_wait += linalg::seconds_since(t0);
+      timings.analysis_adopted = analysis_adopted;
       check_cancelled();
-      t0 = linalg::Clock::now();
-      prepare_schur();
-      timings.schur += linalg::seconds_since(t0);
-    } catch (...) {  // the destructor does not run for an object whose constructor throws
-      release();
-      throw;
     }
-  }
-  ~CholeskyEngine() override { release(); }
-  void release() {
-    if (factor) cholmod_free_factor(&factor, &cc());
+    t0 = linalg::Clock::now();
+    factorize(M);
+    timings.factor += linalg::seconds_since(t0);
+    timings.numeric_factorization = numeric_by_;
+    check_cancelled();
+    t0 = linalg::Clock::now();
+    prepare_schur();
+    timings.schur += linalg::seconds_since(t0);
   }
 
   // Takes a symbolic factorization made for exactly this pattern (compared entry by entry; a different
   // one is dropped and the factorization analyses its own).
   void adopt(const Csc& M, std::unique_ptr<AnalysisState> given) {
-    if (!given || !given->factor || given->nD != nD || given->nC != nC || given->outer != M.outer || given->inner != M.inner) return;
-    factor = given->factor, given->factor = nullptr;
-    cholmod_ = std::move(given);
-    std::vector<int>().swap(cholmod_->outer), std::vector<int>().swap(cholmod_->inner);  // compared: not needed any more
+    if (!given || !given->analysed || given->nD != nD || given->nC != nC || given->outer != M.outer || given->inner != M.inner) return;
+    analysis_ = std::move(given);
+    std::vector<int>().swap(analysis_->outer), std::vector<int>().swap(analysis_->inner);  // compared: not needed any more
     analysis_adopted = true;
   }
 
   // The numeric factorization into the symbolic factor: ours (OpenMP's threads) or CHOLMOD's own. Returns
   // the first column not positive definite, or n.
   int numeric(const Csc& M) {
-    const int n = nD + nC;
     if (factorization_ == Factorization::Parallel) {
       numeric_by_ = "trivcon";
-      return linalg::factorize(*factor, M.outer, M.inner, M.values, cc());
+      return linalg::factorize(symbolic_factor(), values_, M.outer, M.inner, M.values);
     }
+#ifdef TRIVCON_WITH_SUITESPARSE
     numeric_by_ = "cholmod";
-    cholmod_sparse A = linalg::upper_view(M.outer, M.inner, M.values, n);
-    const int ok = cholmod_factorize(&A, factor, &cc());
-    check(ok && (cc().status == CHOLMOD_OK || cc().status == CHOLMOD_NOT_POSDEF), "CHOLMOD factorization failed");
-    return cc().status == CHOLMOD_NOT_POSDEF ? static_cast<int>(factor->minor) : n;
+    return cholmod_numeric(M);
+#else
+    throw Error("the cholmod factorization needs CHOLMOD, which this build of trivcon does not link (Debian's CHOLMOD contains "
+                "GPL-licensed modules); rebuild with -DTRIVCON_WITH_SUITESPARSE=ON");
+#endif
   }
+
+#ifdef TRIVCON_WITH_SUITESPARSE
+  // Factorization::Cholmod: cholmod_factorize into CHOLMOD's own factor, analysed by cholmod_analyze_p in the
+  // same order without a postorder, which gives the same supernodal structure (tests/test_symbolic.cpp;
+  // checked here array for array), then its values copied into values_.
+  int cholmod_numeric(const Csc& M) {
+    const linalg::SymbolicFactor& S = symbolic_factor();
+    const int n = nD + nC;
+    linalg::CholmodContext context;
+    cholmod_common& c = *context;
+    c.nmethods = 1;
+    c.method[0].ordering = CHOLMOD_GIVEN;
+    c.postorder = 0;
+    cholmod_sparse A = linalg::upper_view(M.outer, M.inner, M.values, n);
+    cholmod_factor* L = cholmod_analyze_p(&A, const_cast<int*>(S.perm.data()), nullptr, 0, &c);
+    linalg::require(L != nullptr, "CHOLMOD could not analyse the constraint system", c);
+    struct Free {
+      cholmod_factor*& L;
+      cholmod_common& c;
+      ~Free() { cholmod_free_factor(&L, &c); }
+    } free_factor{L, c};
+    auto same = [](const std::vector<int>& ours, const void* theirs) {
+      return std::equal(ours.begin(), ours.end(), static_cast<const int*>(theirs));
+    };
+    if (static_cast<int>(L->nsuper) != S.nsuper || L->xsize != S.xsize || !same(S.perm, L->Perm) || !same(S.super, L->super) ||
+        !same(S.pi, L->pi) || !same(S.px, L->px) || !same(S.s, L->s))
+      throw Error("internal: CHOLMOD's symbolic factor of the constraint system differs from trivcon's");
+    const int ok = cholmod_factorize(&A, L, &c);
+    linalg::require(ok && (c.status == CHOLMOD_OK || c.status == CHOLMOD_NOT_POSDEF), "CHOLMOD factorization failed", c);
+    if (c.status == CHOLMOD_NOT_POSDEF) return static_cast<int>(L->minor);
+    linalg::require(L->is_super && L->is_ll && L->x != nullptr, "CHOLMOD factorization failed", c);
+    const double* x = static_cast<const double*>(L->x);
+    values_.assign(x, x + S.xsize);
+    return n;
+  }
+#endif
 
   void factorize(const Csc& M) {
     const int n = nD + nC;
-    if (!factor) factor = symbolic(M, vertex_order(M, nD, nC, cc()), nD, nC, cc());
-    const int* perm = static_cast<const int*>(factor->Perm);
-    if (numeric(M) < n) {
-      const int row = static_cast<int>(factor->minor);
-      throw Error(row < n && perm[row] >= nD
+    if (!analysis_->analysed) analyse(M, nD, nC, *analysis_);
+    const std::vector<int>& perm = symbolic_factor().perm;
+    if (const int row = numeric(M); row < n) {
+      throw Error(perm[row] >= nD
                       ? "the holonomy of the generators, boundary loops or fixed-direction paths cannot be controlled independently "
                         "with these weights (the constraint system is singular); try --weights unit"
                       : "the constraint system is not positive definite with these weights; try --weights unit");
     }
-    check(cc().status == CHOLMOD_OK && factor->is_super && factor->is_ll, "CHOLMOD factorization failed");
-    for (int k = nD; k < n; ++k) check(perm[k] == k, "CHOLMOD did not keep the cycle rows last");
+    for (int k = nD; k < n; ++k)
+      if (perm[k] != k) throw Error("internal: the symbolic analysis did not keep the cycle rows last");
     prepare_sparse_forward();
   }
 
@@ -204,20 +228,18 @@ class CholeskyEngine : public SolverEngine {
 
   std::string ordering() const override { return nC > 0 ? "CAMD" : "AMD"; }
 
-  void check(bool ok, const char* what) const { linalg::require(ok, what, cc()); }
-
   // Supernodal elimination tree and the factor position of each row, for forward_update.
   void prepare_sparse_forward() {
     const int n = nD + nC;
-    const int* perm = static_cast<const int*>(factor->Perm);
+    const std::vector<int>& perm = symbolic_factor().perm;
     position_.resize(n);
     for (int k = 0; k < n; ++k) position_[perm[k]] = k;
-    const Supernodes L(factor);
+    const Supernodes L = supernodes();
     super_of_col_ = L.owners();
     super_parent_ = linalg::supernode_parents(L, super_of_col_);
     super_stamp_.assign(L.count, -1);
     for (int& r : edge_rows_.row) r = position_[r];
-    substitution_ = std::make_unique<linalg::Substitution<double>>(*factor);
+    substitution_ = std::make_unique<linalg::Substitution<double>>(symbolic_factor(), values_);
   }
 
   // z ← L⁻ᵀ z (in factor order), on OpenMP's threads: the top of the tree, then one set of disjoint subtrees
@@ -227,7 +249,7 @@ class CholeskyEngine : public SolverEngine {
   // z += L⁻¹ d for d with the few nonzeros `entries` (factor positions, values): only the supernodes on
   // the paths from those entries to the root of the elimination tree are touched, in increasing order.
   void forward_update(const std::vector<std::pair<int, double>>& entries, Eigen::VectorXd& z) const {
-    const Supernodes L(factor);
+    const Supernodes L = supernodes();
     ++stamp_;
     std::vector<int> path;
     for (const auto& [k, value] : entries)
@@ -260,7 +282,7 @@ class CholeskyEngine : public SolverEngine {
   void extract_cycle_block() {
     R_CC = Eigen::MatrixXd::Zero(nC, nC);
     if (nC == 0) return;
-    const Supernodes L(factor);
+    const Supernodes L = supernodes();
     for (int s = 0; s < L.count; ++s) {
       const auto Ls = L.values(s);
       for (int c = 0; c < L.cols(s); ++c) {
@@ -271,13 +293,11 @@ class CholeskyEngine : public SolverEngine {
     }
   }
 
-  // L⁻¹ b by CHOLMOD (in factor order), for a right-hand side that is not an update of the base one.
+  // L⁻¹ b (in factor order), for a right-hand side that is not an update of the base one: the forward half of
+  // the parallel substitution (src/linalg/substitution.h).
   Eigen::VectorXd lower_solve(const Eigen::VectorXd& b) const {
-    cholmod_dense B = linalg::dense_view(b);
-    cholmod_dense* X = cholmod_solve(CHOLMOD_L, factor, &B, &cc());
-    check(X != nullptr && cc().status == CHOLMOD_OK, "CHOLMOD solve failed");
-    Eigen::VectorXd out = Eigen::Map<Eigen::VectorXd>(static_cast<double*>(X->x), b.size());
-    cholmod_free_dense(&X, &cc());
+    Eigen::VectorXd out = b;
+    substitution_->forward_in_factor_order(out.data());
     return out;
   }
   // L⁻¹ Π [b_D; 0]: the forward substitution with the cycle right-hand sides zero.

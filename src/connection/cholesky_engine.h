@@ -10,35 +10,29 @@
 // sparse too: with a base right-hand side set (set_base_rhs), a new b_D that differs from it in a few
 // rows (a new set of singular vertices) only updates the supernodes on their paths to the root.
 //
-// CHOLMOD orders (AMD / CAMD, see vertex_order) and analyses; the numeric factorization is ours on two
-// threads (src/linalg/supernodal.h) or, with Factorization::Cholmod, cholmod_factorize. Both fill the same
-// CHOLMOD factor object, which the substitutions read.
+// libamd / libcamd order (see vertex_order) and trivcon's own symbolic analysis (src/linalg/symbolic.h) gives
+// the supernodal structure; the numeric factorization is ours on OpenMP's threads (src/linalg/supernodal.h)
+// or, with Factorization::Cholmod in a build with TRIVCON_WITH_SUITESPARSE, cholmod_factorize into a factor
+// of the same structure, whose values are copied. The substitutions read the values in that structure.
 #pragma once
-#include <cholmod.h>
-
 #include <functional>
 #include <memory>
 #include <vector>
 
 #include "connection/assembly.h"
-#include "linalg/cholmod.h"
 #include "connection/solver_engine.h"
+#include "linalg/symbolic.h"
 #include "trivcon/solver.h"
 
 namespace trivcon::connection {
 
-// A symbolic factorization and the pattern it was computed for (behind trivcon::SolverAnalysis), or just
-// the CHOLMOD workspace of an engine that analyses its own.
+// A symbolic factorization and the pattern it was computed for (behind trivcon::SolverAnalysis).
 struct AnalysisState {
-  linalg::CholmodContext cc;
-  cholmod_factor* factor = nullptr;
+  linalg::SymbolicFactor symbolic;
+  bool analysed = false;  // `symbolic` holds an analysis (false for an empty system)
   int nD = 0, nC = 0;
   std::vector<int> outer, inner;
   double seconds = 0;
-  AnalysisState() = default;
-  ~AnalysisState();
-  AnalysisState(const AnalysisState&) = delete;
-  AnalysisState& operator=(const AnalysisState&) = delete;
 };
 
 // Orders and analyses M (nD vertex rows, then nC cycle rows kept last) into `state`.

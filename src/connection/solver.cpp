@@ -144,6 +144,15 @@ void ConnectionSolver::Impl::set_weights_and_paths(const std::vector<int>& fixed
   weights.setZero(nE);
   for (int e = 0; e < nE; ++e)
     if (!t.is_boundary_edge(e)) weights(e) = options.weights == WeightKind::Unit ? 1.0 : geometry.cotan_weight(e);
+#ifndef TRIVCON_WITH_SUITESPARSE
+  // The reference routes need CHOLMOD or SuiteSparseQR, which a default build does not link (CMakeLists.txt).
+  if (options.solver == SolverKind::QR)
+    throw Error("the QR solver needs SuiteSparseQR, which this build of trivcon does not link (it is GPL-licensed); rebuild with "
+                "-DTRIVCON_WITH_SUITESPARSE=ON, or use the Cholesky solver (the default)");
+  if (options.factorization == Factorization::Cholmod)
+    throw Error("the cholmod factorization needs CHOLMOD, which this build of trivcon does not link (Debian's CHOLMOD contains "
+                "GPL-licensed modules); rebuild with -DTRIVCON_WITH_SUITESPARSE=ON, or use trivcon's own factorization (the default)");
+#endif
   if (!(options.weight_floor >= 0 && options.weight_floor <= 1))
     throw Error("the weight floor must be in [0, 1] (a fraction of the median weight), not " + std::to_string(options.weight_floor));
   if (options.weights == WeightKind::Cotan && options.weight_floor > 0) {
@@ -250,6 +259,7 @@ void ConnectionSolver::Impl::factor(const std::function<SolverAnalysis()>& analy
   for (int a = 0; a < m; ++a) w(a) = weights(active_edges[a]);
   timings.assemble += seconds_since(t0);
   if (options.solver == SolverKind::QR) {
+#ifdef TRIVCON_WITH_SUITESPARSE
     SparseMatrix Dt(m, num_vertex_rows);
     std::vector<Triplet> trip;
     for (int a = 0; a < m; ++a)
@@ -257,6 +267,7 @@ void ConnectionSolver::Impl::factor(const std::function<SolverAnalysis()>& analy
         if (ends[a][end] >= 0) trip.emplace_back(a, ends[a][end], end == 0 ? -1.0 : 1.0);
     Dt.setFromTriplets(trip.begin(), trip.end());
     engine = connection::make_qr_engine(Dt, Ct, w, timings);
+#endif
   } else if (!sparse_paths) {
     // A symbolic factorization made beforehand fits the system without fixed faces only.
     std::function<std::unique_ptr<connection::AnalysisState>()> given;

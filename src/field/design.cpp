@@ -166,7 +166,11 @@ std::string verification_failure(const FieldDesigner& designer, const Design& d,
       << " steps of iterative refinement: the normal equations A W A^T are too ill-conditioned on this mesh (weights from "
       << designer.solver().weights().minCoeff() << " to " << designer.solver().weights().maxCoeff() << "; " << g.mollified_faces
       << " faces mollified, " << g.zero_weight_edges << " edges of zero weight, " << designer.solver().regularized_edges()
+#ifdef TRIVCON_WITH_SUITESPARSE
       << " regularized); try --solver qr, which solves the constraints without the normal equations, or --weights unit";
+#else  // no QR route in this build (CMakeLists.txt, TRIVCON_WITH_SUITESPARSE)
+      << " regularized); try --weights unit";
+#endif
     parts.push_back(p.str());
   }
   if (d.transport_mismatch > limit) {

@@ -13,12 +13,12 @@
 #include <random>
 #include <string>
 
-#include "linalg/cholmod.h"
 #include "linalg/ordering.h"
 #include "linalg/parallel.h"
 #include "linalg/inverse_iteration.h"
 #include "linalg/substitution.h"
 #include "linalg/supernodal.h"
+#include "linalg/symbolic.h"
 #include "linalg/timing.h"
 #include "trivcon/constraints.h"
 #include "trivcon/curvature.h"
@@ -66,60 +66,48 @@ Complex off_diagonal(const Topology& t, const Geometry& g, const Weights& k, int
   return -k.w[e] * (row_face == t.edge_faces(e, 1) ? r : std::conj(r));
 }
 
-struct FactorDeleter {
-  cholmod_common* c;
-  void operator()(cholmod_factor* L) const { cholmod_free_factor(&L, c); }
-};
-
 // The symbolic factorization of the smoothest-field matrix (its upper triangle's pattern: outer, inner;
-// rows are the unknown faces face_of), with the CHOLMOD workspace it belongs to and the name of its order.
+// rows are the unknown faces face_of; src/linalg/symbolic.h) and the name of its order.
 //
 // Two candidate orders, analysed side by side on two threads, and the one with fewer flops (CHOLMOD's
-// count) kept: AMD, and a nested dissection by the faces' centroids (src/linalg/ordering.h). Neither wins
-// everywhere: on a regular grid of faces (AMD's worst case) the dissection needs far fewer flops; on scans
-// it needs several times AMD's. (METIS would need fewer flops on both, but METIS_NodeND alone takes
-// several times as long as either analysis here.) Small meshes, or one thread, take AMD alone. Supernodes
-// are amalgamated less than CHOLMOD's default (zrelax 0.8, 0.1, 0.05): the explicit zeros that buys are
-// read again by each solve and first-touched by the factorization (the factor has a sixth fewer entries);
-// the factorization itself did not get measurably slower. The figures: BENCHMARKS.md, "Figures that were
-// in code comments".
-struct SymbolicFactor {
-  std::unique_ptr<linalg::CholmodContext> context;
-  std::unique_ptr<cholmod_factor, FactorDeleter> factor{nullptr, FactorDeleter{nullptr}};
+// count, SymbolicFactor::flops) kept: AMD, and a nested dissection by the faces' centroids
+// (src/linalg/ordering.h). Neither wins everywhere: on a regular grid of faces (AMD's worst case) the
+// dissection needs far fewer flops; on scans it needs several times AMD's. (METIS would need fewer flops on
+// both, but METIS_NodeND alone takes several times as long as either analysis here.) Small meshes, or one
+// thread, take AMD alone. Both are postordered (as cholmod_analyze with postorder = 1, which this replaces).
+// Supernodes are amalgamated less than CHOLMOD's default (zrelax 0.8, 0.1, 0.05): the explicit zeros that
+// buys are read again by each solve and first-touched by the factorization (the factor has a sixth fewer
+// entries); the factorization itself did not get measurably slower. The figures: BENCHMARKS.md, "Figures
+// that were in code comments".
+struct SmoothestAnalysis {
+  linalg::SymbolicFactor factor;
   std::string ordering;
+  bool done = false;
 };
 
-SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, const std::vector<int>& face_of, const std::vector<int>& outer,
-                                        const std::vector<int>& inner) {
+SmoothestAnalysis analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, const std::vector<int>& face_of,
+                                           const std::vector<int>& outer, const std::vector<int>& inner) {
   const int n = static_cast<int>(face_of.size());
-  SymbolicFactor candidate[2];  // by AMD, by the dissection
-  for (SymbolicFactor& s : candidate) {
-    s.context = std::make_unique<linalg::CholmodContext>();
-    cholmod_common* c = s.context->get();
-    c->nmethods = 1;
-    c->postorder = 1;
-    c->supernodal = CHOLMOD_SUPERNODAL;  // the numeric factorization fills a supernodal factor
-    c->zrelax[0] = 0.4, c->zrelax[1] = 0.05, c->zrelax[2] = 0.02;
-    s.factor = std::unique_ptr<cholmod_factor, FactorDeleter>(nullptr, FactorDeleter{c});
-  }
-  candidate[0].context->get()->method[0].ordering = CHOLMOD_AMD, candidate[0].ordering = "AMD";
-  candidate[1].context->get()->method[0].ordering = CHOLMOD_GIVEN, candidate[1].ordering = "coordinate dissection";
-  // The pattern alone (with the complex values the analyses copied them too, a cost that grows with the mesh).
-  cholmod_sparse A = linalg::upper_pattern_view(outer, inner, n);
+  linalg::SymbolicOptions options;
+  options.zrelax = {0.4, 0.05, 0.02};
+  SmoothestAnalysis candidate[2];  // by AMD, by the dissection
+  candidate[0].ordering = "AMD", candidate[1].ordering = "coordinate dissection";
   const bool compare = n >= linalg::kParallelMinElements && linalg::max_threads() > 1;
   std::exception_ptr error;
 #pragma omp parallel num_threads(2) if (compare)
   {
     try {
       if (omp_get_thread_num() == 0) {
-        candidate[0].factor.reset(cholmod_analyze(&A, candidate[0].context->get()));
+        candidate[0].factor = linalg::symbolic_analysis(outer, inner, n, linalg::amd_ordering(outer, inner, n), options);
+        candidate[0].done = true;
       } else if (compare) {
         std::vector<std::array<double, 3>> centroid(n);
         for (int j = 0; j < n; ++j)
           for (int a = 0; a < 3; ++a)
             centroid[j][a] = (V(t.F(face_of[j], 0), a) + V(t.F(face_of[j], 1), a) + V(t.F(face_of[j], 2), a)) / 3;
-        std::vector<int> order = linalg::coordinate_dissection(linalg::leading_block_pattern(outer, inner, n), centroid);
-        candidate[1].factor.reset(cholmod_analyze_p(&A, order.data(), nullptr, 0, candidate[1].context->get()));
+        const std::vector<int> order = linalg::coordinate_dissection(linalg::leading_block_pattern(outer, inner, n), centroid);
+        candidate[1].factor = linalg::symbolic_analysis(outer, inner, n, order, options);
+        candidate[1].done = true;
       }
     } catch (...) {  // an exception must not leave an OpenMP region
 #pragma omp critical
@@ -127,9 +115,7 @@ SymbolicFactor analyse_smoothest_matrix(const MatrixX3d& V, const Topology& t, c
     }
   }
   if (error) std::rethrow_exception(error);
-  linalg::require(candidate[0].factor != nullptr, "automatic singularities: CHOLMOD could not analyse the smoothest-field matrix",
-                  candidate[0].context->common());
-  const bool dissect = candidate[1].factor && candidate[1].context->common().fl < candidate[0].context->common().fl;
+  const bool dissect = candidate[1].done && candidate[1].factor.flops < candidate[0].factor.flops;
   return std::move(candidate[dissect ? 1 : 0]);
 }
 
@@ -206,8 +192,8 @@ SmoothestSystem assemble_smoothest_system(const Topology& t, const Geometry& g, 
 // Curvature alignment (docs/auto.md): the field x found so far is replaced, on each component with curvature,
 // by the solution of (A − t·λ̂ M) u = M q + b_D toward the guidance q; with t ≠ 0 the factor L is refactored.
 void align_to_guidance(const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o, const std::vector<Complex>& guidance,
-                       SmoothestSystem& S, cholmod_factor& L, cholmod_common& c, const linalg::Substitution<Complex>& substitution,
-                       std::vector<double>& x) {
+                       SmoothestSystem& S, const linalg::SymbolicFactor& L, std::vector<Complex>& Lx,
+                       const linalg::Substitution<Complex>& substitution, std::vector<double>& x) {
   const int N = o.N, n = S.size(), components = static_cast<int>(t.components.size());
   // Per component: the Rayleigh quotient λ̂ of the field found so far (the smoothest field's eigenvalue, or the
   // energy of the Dirichlet solution) and the guidance's scale (area-weighted mean |q| = 1).
@@ -236,7 +222,7 @@ void align_to_guidance(const Topology& t, const Geometry& g, const Weights& k, c
       const double lambda = norm[comp] > 0 ? energy[comp] / norm[comp] : 0.0;
       S.values[2 * (S.outer[j + 1] - 1)] = S.diag[f] + (S.eps - o.curvature_t * lambda) * k.mass[f];
     }
-    if (linalg::factorize_complex(L, S.outer, S.inner, S.values, c) < n)
+    if (linalg::factorize_complex(L, Lx, S.outer, S.inner, S.values) < n)
       throw Error("automatic singularities: curvature alignment with t = " + std::to_string(o.curvature_t) +
                   " makes the system indefinite (t must be below 1, and a little below 1 can already exceed the smallest "
                   "eigenvalue's estimate): use a smaller t");
@@ -264,18 +250,18 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   check_cancelled();  // trivcon/cancel.h: here, after the analysis, per iteration
 
   t0 = Clock::now();
-  const SymbolicFactor symbolic = analyse_smoothest_matrix(V, t, S.face_of, S.outer, S.inner);
+  const SmoothestAnalysis analysis = analyse_smoothest_matrix(V, t, S.face_of, S.outer, S.inner);
   check_cancelled();
-  cholmod_common& c = **symbolic.context;
-  cholmod_factor* const L = symbolic.factor.get();
-  ordering_used = symbolic.ordering;
+  const linalg::SymbolicFactor& L = analysis.factor;
+  ordering_used = analysis.ordering;
   // The numeric factor by trivcon's own supernodal code (src/linalg/supernodal.h, the same that factors the
   // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another.
-  if (const int minor = linalg::factorize_complex(*L, S.outer, S.inner, S.values, c); minor < n)
+  std::vector<Complex> Lx;  // the factor's values
+  if (const int minor = linalg::factorize_complex(L, Lx, S.outer, S.inner, S.values); minor < n)
     throw Error("automatic singularities: the smoothest-field matrix is not positive definite (column " + std::to_string(minor) +
                 " of " + std::to_string(n) + "): a non-finite or degenerate weight");
   // The solves below on both cores (src/linalg/substitution.h): CHOLMOD's own, on one core, were several times slower.
-  const linalg::Substitution<Complex> substitution(*L);
+  const linalg::Substitution<Complex> substitution(L, Lx);
   time.factor = seconds_since(t0);
 
   t0 = Clock::now();
@@ -309,7 +295,7 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   time.iterate = seconds_since(t0);
   if (guidance) {
     t0 = Clock::now();
-    align_to_guidance(t, g, k, o, *guidance, S, *L, c, substitution, x);
+    align_to_guidance(t, g, k, o, *guidance, S, L, Lx, substitution, x);
     time.align = seconds_since(t0);
   }
   for (int j = 0; j < n; ++j) {

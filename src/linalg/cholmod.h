@@ -1,4 +1,6 @@
-// src/linalg/cholmod.h (internal): the one adaptor between trivcon and CHOLMOD / SuiteSparseQR.
+// src/linalg/cholmod.h (internal): the one adaptor between trivcon and CHOLMOD / SuiteSparseQR, in a build with
+// TRIVCON_WITH_SUITESPARSE only (CHOLMOD's Debian build contains GPL modules, SuiteSparseQR is GPL: the default
+// build links neither; docs/solver.md).
 //
 // - CholmodContext: a CHOLMOD workspace (cholmod_common) for the int API, started and finished with the
 //   object, set up for a supernodal LLᵀ factorization (the Cholesky route); CholmodLongContext the same
@@ -6,11 +8,10 @@
 // - Views: cholmod_sparse / cholmod_dense headers over memory the caller owns (no copy; CHOLMOD only
 //   reads them). An upper-triangle view (stype = 1) of compressed columns with int indices, and a general
 //   view (stype = 0) of an Eigen column-major sparse matrix with int or SuiteSparse_long indices.
-// - The library check: the hand-written numeric factorization (src/linalg/supernodal.h) writes into
-//   CHOLMOD's supernodal factor object with int indices and calls Fortran BLAS with 32-bit integers. The
-//   build refuses a CHOLMOD whose major version differs from the one that layout was written against, and
-//   check_numeric_libraries() verifies at run time that the CHOLMOD loaded is the one compiled against and
-//   that the BLAS takes 32-bit integers (LP64), throwing trivcon::Error otherwise.
+// - The library check: the hand-written numeric factorization (src/linalg/supernodal.h) can write into
+//   CHOLMOD's supernodal factor object with int indices. The build refuses a CHOLMOD whose major version
+//   differs from the one that layout was written against; check_numeric_libraries()
+//   (src/linalg/numeric_libraries.h) verifies at run time that the CHOLMOD loaded is the one compiled against.
 #pragma once
 #include <cholmod.h>
 
@@ -18,6 +19,12 @@
 #include <Eigen/SparseCore>
 #include <string>
 #include <vector>
+
+#include "linalg/numeric_libraries.h"
+
+#ifndef TRIVCON_WITH_SUITESPARSE
+#error "src/linalg/cholmod.h is for a build with TRIVCON_WITH_SUITESPARSE only"
+#endif
 
 // CHOLMOD 3 (SuiteSparse 5, Debian 12) is what src/linalg/supernodal.cpp's use of the factor object (super, pi, px,
 // s, x as int / double arrays, cholmod_change_factor to allocate values) was written and tested against.
@@ -82,8 +89,5 @@ cholmod_sparse sparse_view(const Eigen::SparseMatrix<double, Eigen::ColMajor, In
 cholmod_dense dense_view(const Eigen::VectorXd& b);
 // A single dense complex column over b's memory: (real, imaginary) per row, b.size() / 2 rows.
 cholmod_dense dense_view_complex(const Eigen::VectorXd& b);
-
-// See the top of this file. Cheap after the first call (the result is remembered).
-void check_numeric_libraries();
 
 }  // namespace trivcon::linalg

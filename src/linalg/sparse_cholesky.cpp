@@ -1,27 +1,22 @@
 #include "linalg/sparse_cholesky.h"
 
-#include <cholmod.h>
-
 #include <string>
 
-#include "linalg/cholmod.h"
+#include "linalg/numeric_libraries.h"
 #include "linalg/substitution.h"
 #include "linalg/supernodal.h"
+#include "linalg/symbolic.h"
 #include "trivcon/error.h"
 
 namespace trivcon::linalg {
 
 struct SparseCholesky::State {
-  CholmodContext context;
-  cholmod_factor* factor = nullptr;
+  SymbolicFactor symbolic;
+  std::vector<double> x;               // the factor's values
   std::vector<int> outer, inner;       // the upper triangle's pattern, compressed columns
   std::vector<double> values;
   std::unique_ptr<Substitution<double>> substitution;
   std::string what;
-  ~State() {
-    substitution.reset();
-    if (factor) cholmod_free_factor(&factor, context.get());
-  }
 };
 
 namespace {
@@ -50,14 +45,13 @@ SparseCholesky::SparseCholesky(const Eigen::SparseMatrix<double>& A, const char*
   n_ = static_cast<int>(A.cols());
   state_->what = what;
   upper_triangle(A, state_->outer, state_->inner, nullptr);
-  cholmod_common* c = state_->context.get();
-  c->nmethods = 1;
-  c->method[0].ordering = CHOLMOD_AMD;
-  c->postorder = 1;
-  c->supernodal = CHOLMOD_SUPERNODAL;  // linalg::factorize fills a supernodal factor
-  cholmod_sparse pattern = upper_pattern_view(state_->outer, state_->inner, n_);
-  state_->factor = cholmod_analyze(&pattern, c);
-  require(state_->factor != nullptr, std::string(what) + ": CHOLMOD could not analyse the matrix", state_->context.common());
+  // AMD, then the postordered supernodal analysis with the default amalgamation: cholmod_analyze's factor
+  // with AMD and postorder = 1 (tests/test_symbolic.cpp).
+  try {
+    state_->symbolic = symbolic_analysis(state_->outer, state_->inner, n_, amd_ordering(state_->outer, state_->inner, n_));
+  } catch (const Error& e) {
+    throw Error(std::string(what) + ": " + e.what());
+  }
 }
 
 SparseCholesky::~SparseCholesky() = default;
@@ -68,12 +62,9 @@ int SparseCholesky::factorize(const Eigen::SparseMatrix<double>& A) {
   if (A.cols() != n_ || outer != state_->outer || inner != state_->inner)
     throw Error(state_->what + ": the matrix's pattern changed after its analysis");
   state_->substitution.reset();
-  const int minor = linalg::factorize(*state_->factor, state_->outer, state_->inner, state_->values, *state_->context);
-  if (minor < n_) {
-    const int* perm = static_cast<const int*>(state_->factor->Perm);
-    return perm ? perm[minor] : minor;
-  }
-  state_->substitution = std::make_unique<Substitution<double>>(*state_->factor);
+  const int minor = linalg::factorize(state_->symbolic, state_->x, state_->outer, state_->inner, state_->values);
+  if (minor < n_) return state_->symbolic.perm[minor];
+  state_->substitution = std::make_unique<Substitution<double>>(state_->symbolic, state_->x);
   return -1;
 }
 

@@ -1,7 +1,8 @@
 // src/linalg/sparse_cholesky.h (internal): a sparse symmetric positive definite solve, A x = b, for the
 // layers that need one without the trivial-connection solver's structure (the integer-grid map of
-// src/quad/). The order (AMD) and the symbolic analysis are CHOLMOD's, the numeric factorization and the
-// substitutions ours (src/linalg/supernodal.h, substitution.h), as for the connection and the smoothest field.
+// src/quad/). The order (AMD, through libamd), the symbolic analysis, the numeric factorization and the
+// substitutions are trivcon's (src/linalg/symbolic.h, supernodal.h, substitution.h), as for the connection and
+// the smoothest field; no CHOLMOD.
 //
 // The pattern is analysed once; factorize() may be called again with new values on the same pattern (a
 // row and column replaced by the identity to fix an unknown keeps the pattern).
@@ -17,7 +18,7 @@ namespace trivcon::linalg {
 class SparseCholesky {
  public:
   // `A`: a symmetric matrix; only its upper triangle (row ≤ column) is read. Throws trivcon::Error naming
-  // `what` if CHOLMOD cannot analyse it.
+  // `what` if it is not square or cannot be ordered and analysed.
   SparseCholesky(const Eigen::SparseMatrix<double>& A, const char* what);
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;

@@ -10,14 +10,38 @@
 namespace trivcon::linalg {
 
 template <class T>
-Substitution<T>::Substitution(const cholmod_factor& L) : L_(L) {
+Substitution<T>::Substitution(const SymbolicFactor& L, const std::vector<T>& values) : S_(L, nullptr), values_(&values) {
+  if (values.size() != L.xsize || static_cast<int>(L.perm.size()) != L.n)
+    throw Error("internal: the parallel substitution needs a numeric supernodal LL' factor of the right type");
+  n_ = L.n;
+  perm_ = L.perm;
+  plan();
+}
+
+#ifdef TRIVCON_WITH_SUITESPARSE
+template <class T>
+Substitution<T>::Substitution(const cholmod_factor& L) : S_(&L), cholmod_(&L) {
   const int xtype = std::is_same<T, double>::value ? CHOLMOD_REAL : CHOLMOD_COMPLEX;
   if (!L.is_super || !L.is_ll || L.xtype != xtype || L.x == nullptr || L.itype != CHOLMOD_INT)
     throw Error("internal: the parallel substitution needs a numeric supernodal LL' factor of the right type");
   n_ = static_cast<int>(L.n);
   const int* perm = static_cast<const int*>(L.Perm);
   perm_.assign(perm, perm + n_);
-  const Supernodes S(&L);
+  plan();
+}
+#endif
+
+template <class T>
+const T* Substitution<T>::values() const {
+#ifdef TRIVCON_WITH_SUITESPARSE
+  if (cholmod_) return static_cast<const T*>(cholmod_->x);
+#endif
+  return values_->data();
+}
+
+template <class T>
+void Substitution<T>::plan() {
+  const Supernodes& S = S_;
   const std::vector<int> owner = S.owners();
   // Balanced by the entries each supernode holds: a solve reads each once.
   std::vector<double> entries(S.count);
@@ -78,9 +102,15 @@ void Substitution<T>::solve(T* x) const {
 
 template <class T>
 void Substitution<T>::solve_in_factor_order(T* z) const {
+  forward_in_factor_order(z);
+  backward_in_factor_order(z);
+}
+
+template <class T>
+void Substitution<T>::forward_in_factor_order(T* z) const {
   if (n_ == 0) return;
-  const Supernodes S(&L_);
-  const T* values = static_cast<const T*>(L_.x);
+  const Supernodes& S = S_;
+  const T* values = this->values();
 
   // Forward: L y = z. Supernode s solves its own columns (its diagonal block is lower triangular with a
   // real positive diagonal), accumulating L_below · y_s in `sent`, then sends it to its rows below; what
@@ -128,14 +158,13 @@ void Substitution<T>::solve_in_factor_order(T* z) const {
       for (int c = S.first(s); c < S.first(s) + S.cols(s); ++c) z[c] -= send_[k][top_slot_[c]];
   std::vector<T> scratch;
   for (int s : top_) forward(s, scratch, nullptr);
-  backward_in_factor_order(z);
 }
 
 template <class T>
 void Substitution<T>::backward_in_factor_order(T* z) const {
   if (n_ == 0) return;
-  const Supernodes S(&L_);
-  const T* values = static_cast<const T*>(L_.x);
+  const Supernodes& S = S_;
+  const T* values = this->values();
   // Backward: Lᴴ z = y. Supernode s gathers its rows below (its ancestors', done) after a copy of its own
   // entries (v: its rows, in its row order), then solves its columns last to first, each column read from
   // its last row up: the supernodes come in decreasing order, so the whole pass reads the factor as one

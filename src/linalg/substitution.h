@@ -17,9 +17,11 @@
 // is more than most supernodes' work). The split is balanced by entries and goes down the tree while that
 // shortens top + heaviest part (split_tree's `deepen`). It is several times faster than cholmod_solve
 // (BENCHMARKS.md, "Figures that were in code comments").
-// solve and solve_in_factor_order are not for concurrent calls on one object (their work vectors are shared).
+// solve, solve_in_factor_order and forward_in_factor_order are not for concurrent calls on one object (their work vectors are shared).
 #pragma once
+#ifdef TRIVCON_WITH_SUITESPARSE
 #include <cholmod.h>
+#endif
 
 #include <complex>
 #include <vector>
@@ -29,17 +31,26 @@
 namespace trivcon::linalg {
 
 // T is double for a real (LLᵀ) factor, std::complex<double> for a complex (LLᴴ) one; the factor must be
-// supernodal and numeric with that type (linalg::factorize / factorize_complex). The plan (tree split,
-// permutation) is made once; the factor's values are read at each solve, so a refactorization with the same
-// symbolic factor (the curvature alignment of trivcon/auto.h) needs no new plan.
+// supernodal and numeric with that type (linalg::factorize / factorize_complex): trivcon's own symbolic factor
+// (src/linalg/symbolic.h) with its values, or, in a build with SuiteSparse, CHOLMOD's factor object. The plan
+// (tree split, permutation) is made once; the factor's values are read at each solve, so a refactorization
+// with the same symbolic factor (the curvature alignment of trivcon/auto.h) needs no new plan. The factor
+// (and `values`) must outlive the object.
 template <class T>
 class Substitution {
  public:
+  // `values`: the factor's entries (L.xsize), as factorize / factorize_complex fill them; read at each solve.
+  Substitution(const SymbolicFactor& L, const std::vector<T>& values);
+#ifdef TRIVCON_WITH_SUITESPARSE
   explicit Substitution(const cholmod_factor& L);
+#endif
   // x ← A⁻¹ x for A = Pᵀ L Lᴴ P, x in the matrix's own order (as cholmod_solve(CHOLMOD_A, …)); x has n entries.
   void solve(T* x) const;
   // The same in the factor's order: z ← (L Lᴴ)⁻¹ z, z[k] the entry of matrix row permutation()[k].
   void solve_in_factor_order(T* z) const;
+  // Its first half alone: z ← L⁻¹ z in the factor's order (the trivial-connection solver's full forward
+  // substitution, before its own choice of the cycle rows' right-hand side).
+  void forward_in_factor_order(T* z) const;
   // Its second half alone: z ← L⁻ᴴ z in the factor's order (the trivial-connection solver's backward
   // substitution, after its own sparse forward update). Uses no member work vector.
   void backward_in_factor_order(T* z) const;
@@ -47,7 +58,13 @@ class Substitution {
   int size() const { return n_; }
 
  private:
-  const cholmod_factor& L_;
+  void plan();
+  const T* values() const;
+  Supernodes S_;                              // the structure (stable); values through values()
+#ifdef TRIVCON_WITH_SUITESPARSE
+  const cholmod_factor* cholmod_ = nullptr;   // CHOLMOD's factor, whose x may be reallocated by a refactorization
+#endif
+  const std::vector<T>* values_ = nullptr;    // the values of trivcon's own factor
   int n_ = 0;
   std::vector<int> perm_;                     // factor position k holds matrix row perm_[k]
   std::vector<int> top_;                      // supernodes above the split, increasing

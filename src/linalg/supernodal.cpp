@@ -417,6 +417,7 @@ int factor_values(const Supernodes& S, const int* perm, int n, T* x, const std::
   return minor;
 }
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 template <class T>
 int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const T* values, cholmod_common& c) {
   if (!L.is_super) throw Error("internal: the numeric factorization needs a supernodal symbolic factor");
@@ -432,6 +433,7 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
   L.minor = static_cast<size_t>(minor);
   return minor;
 }
+#endif
 
 template <class T>
 int factorize_own(const SymbolicFactor& L, std::vector<T>& x, const std::vector<int>& outer, const std::vector<int>& inner,
@@ -445,6 +447,7 @@ int factorize_own(const SymbolicFactor& L, std::vector<T>& x, const std::vector<
 
 }  // namespace
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
               cholmod_common& c) {
   return factorize_as<double>(L, outer, inner, values.data(), c);
@@ -454,6 +457,7 @@ int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const st
                       cholmod_common& c) {
   return factorize_as<Complex>(L, outer, inner, reinterpret_cast<const Complex*>(values.data()), c);
 }
+#endif
 
 int factorize(const SymbolicFactor& L, std::vector<double>& x, const std::vector<int>& outer, const std::vector<int>& inner,
               const std::vector<double>& values) {

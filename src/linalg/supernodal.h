@@ -1,16 +1,18 @@
 // Internal: the numeric supernodal Cholesky factorization behind ConnectionSolver, on several threads.
 //
-// CHOLMOD does the ordering and the symbolic factorization (docs/solver.md); this computes the values of
-// CHOLMOD's own supernodal factor object, so that everything else (CHOLMOD's solves, the solver's sparse
-// forward update and backward substitution) reads it unchanged. It fills the factor of trivcon's own symbolic
-// analysis (src/linalg/symbolic.h) the same way: the arrays mean the same. Why not cholmod_factorize: CHOLMOD 3
+// trivcon's own symbolic analysis (src/linalg/symbolic.h, docs/solver.md) gives the supernodal structure; this
+// computes the factor's values in it, which the substitutions (src/linalg/substitution.h) and the solver's
+// sparse forward update read. In a build with TRIVCON_WITH_SUITESPARSE it can fill CHOLMOD's own supernodal
+// factor object the same way (the arrays mean the same; the tests compare). Why not cholmod_factorize: CHOLMOD 3
 // (Debian 12) visits the supernodes one after another and uses the second core only inside BLAS calls on
 // large supernodes, while on a mesh most of the time goes to the many small supernodes near the leaves of
 // the elimination tree. Here independent subtrees are factored on OpenMP's threads (one set of subtrees per thread), then the top of the
 // tree with multithreaded BLAS. Same algorithm as CHOLMOD's (left-looking supernodal: each supernode gathers the updates of its
 // descendants, then a dense Cholesky of its diagonal block and a triangular solve of the rows below), same storage.
 #pragma once
+#ifdef TRIVCON_WITH_SUITESPARSE
 #include <cholmod.h>
+#endif
 
 #include <Eigen/Core>
 
@@ -45,6 +47,7 @@ struct Supernodes {
   const int *super, *pi, *px, *rows;
   const double* x;
   int count;
+#ifdef TRIVCON_WITH_SUITESPARSE
   explicit Supernodes(const cholmod_factor* L)
       : super(static_cast<const int*>(L->super)),
         pi(static_cast<const int*>(L->pi)),
@@ -52,6 +55,7 @@ struct Supernodes {
         rows(static_cast<const int*>(L->s)),
         x(static_cast<const double*>(L->x)),
         count(static_cast<int>(L->nsuper)) {}
+#endif
   // `x`: the factor's values (L.xsize entries; for a complex factor, the (real, imaginary) pairs), or null
   // where only the structure is read.
   Supernodes(const SymbolicFactor& L, const double* x)
@@ -68,6 +72,7 @@ struct Supernodes {
 // Parent of each supernode in the supernodal elimination tree (−1 at a root), given owners().
 std::vector<int> supernode_parents(const Supernodes& L, const std::vector<int>& owner);
 
+#ifdef TRIVCON_WITH_SUITESPARSE
 // Computes the numeric LLᵀ factor in L (a supernodal symbolic factor from cholmod_analyze_p, with its
 // permutation L.Perm) of the symmetric n × n matrix whose upper triangle is given in compressed columns
 // (outer, inner, values; rows ≤ column, in the matrix's own numbering). Returns n on success, or the
@@ -80,6 +85,7 @@ int factorize(cholmod_factor& L, const std::vector<int>& outer, const std::vecto
 // Used by the smoothest field of trivcon/auto.h.
 int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const std::vector<int>& inner, const std::vector<double>& values,
                       cholmod_common& c);
+#endif
 
 // The same two into a factor of trivcon's own symbolic analysis (src/linalg/symbolic.h, permutation L.perm):
 // `x` becomes its values, L.xsize entries. Returns n on success, or the first factor column found not
