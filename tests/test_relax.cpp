@@ -207,8 +207,9 @@ Spread compare_with_solves(const FieldDesigner& designer, const IndexPrescriptio
       continue;
     }
     // The shorted bound is below the real second order wherever every cycle index is held.
-    if (designer.cycles().generators.empty() && solver.fixed_paths().empty())
+    if (designer.cycles().generators.empty() && solver.fixed_paths().empty()) {
       EXPECT_LE(m.lower_bound - m.first_order, second * (1 + 1e-9) + 1e-12) << m.from << " -> " << m.to;
+    }
     EXPECT_LE(m.lower_bound, m.first_order + (m.estimate - m.first_order) * 10) << "a bound far above the estimate";
     if (m.distance == 1 && !m.cancels && designer.cycles().generators.empty() && solver.fixed_paths().empty())
       s.bound_ratio = std::max(s.bound_ratio, (m.lower_bound - m.first_order) / second);
