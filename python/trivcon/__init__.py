@@ -95,6 +95,7 @@ __all__ = [
     "set_threads",
     "get_threads",
     "batch",
+    "with_suitesparse",
 ]
 
 Error = _core.Error
