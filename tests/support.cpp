@@ -446,4 +446,17 @@ std::vector<int> vertex_ring(const Topology& t, int v, int distance) {
   return frontier;
 }
 
+std::map<int, std::string> read_singularity_texts(const std::string& path) {
+  std::map<int, std::string> out;
+  for (const std::string& line : lines_of(slurp(path))) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    int v = 0;
+    std::string index;
+    s >> v >> index;
+    out[v] = index;
+  }
+  return out;
+}
+
 }  // namespace trivcon::test

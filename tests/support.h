@@ -38,6 +38,8 @@ bool starts_with(const std::string& s, const std::string& prefix);
 bool contains(const std::string& s, const std::string& part);
 std::vector<std::string> lines_of(const std::string& text);
 std::string save(const std::string& dir, const std::string& name, const Mesh& m, bool ply = false);
+// A singularity file (`--sing-out`'s) as vertex -> index text ("1/4"), comments left out.
+std::map<int, std::string> read_singularity_texts(const std::string& path);
 // The bytes of a file ("" when it cannot be read), and a file written with exactly `text`.
 std::string slurp(const std::string& path);
 void write_text(const std::string& path, const std::string& text);

@@ -64,19 +64,6 @@ Census census(const QuadFile& q) {
   return c;
 }
 
-std::map<int, std::string> read_sing_file(const std::string& path) {
-  std::map<int, std::string> out;
-  for (const std::string& line : test::lines_of(slurp(path))) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream s(line);
-    int v = 0;
-    std::string index;
-    s >> v >> index;
-    out[v] = index;
-  }
-  return out;
-}
-
 // A cube: 8 singularities of +1/4 at the corners, the only irregular vertices, of valence 3, each at the
 // position of its corner; the report agrees with the file; the map and the singularities are written.
 TEST(CliQuad, CubeGivesEightValenceThreeCornersAndNothingElseIrregular) {
@@ -99,7 +86,7 @@ TEST(CliQuad, CubeGivesEightValenceThreeCornersAndNothingElseIrregular) {
     }
   ASSERT_EQ(irregular.size(), 8u);
   // Each irregular vertex is at a written singularity's position.
-  const std::map<int, std::string> written = read_sing_file(sings);
+  const std::map<int, std::string> written = test::read_singularity_texts(sings);
   EXPECT_EQ(written.size(), 8u);
   for (int v : irregular) {
     double nearest = 1e300;

@@ -24,20 +24,6 @@ std::string mesh_file(const Mesh& m, const std::string& name) {
 // The smallest vertex `distance` edges from v.
 int vertex_at_distance(const Topology& t, int v, int distance) { return test::vertex_ring(t, v, distance).front(); }
 
-// The singularity file's vertex -> index text.
-std::map<int, std::string> read_sing_file(const std::string& path) {
-  std::map<int, std::string> out;
-  for (const std::string& line : test::lines_of(slurp(path))) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream s(line);
-    int v = 0;
-    std::string index;
-    s >> v >> index;
-    out[v] = index;
-  }
-  return out;
-}
-
 struct Box {
   std::string mesh;
   std::vector<int> corners, start;  // the 8 valence-3 corners; a vertex one or two edges from each
@@ -83,7 +69,7 @@ TEST(CliRelax, QuarterSingularitiesOffTheBoxCornersGoToTheCorners) {
   EXPECT_NEAR(j["energy"].get<double>(), x["energy_after"].get<double>(), 1e-12);
   std::map<int, std::string> expected;
   for (int v : b.corners) expected[v] = "1/4";
-  EXPECT_EQ(read_sing_file(sings), expected);
+  EXPECT_EQ(test::read_singularity_texts(sings), expected);
   std::set<int> reported;
   for (const auto& s : j["singularities"]) reported.insert(s["vertex"].get<int>());
   EXPECT_EQ(reported, std::set<int>(b.corners.begin(), b.corners.end()));
@@ -96,7 +82,7 @@ TEST(CliRelax, PinsHoldAndMaxMovesStops) {
   const auto r = run_cli("solve " + b.mesh + " -N 4" + sing_options(b.start, "1/4") + " --relax --relax-pin " + std::to_string(b.start[1]) +
                          " --relax-pin " + std::to_string(b.corners[0]) + " --report " + report + " --sing-out " + sings);
   ASSERT_EQ(r.status, 0) << r.err;
-  const std::map<int, std::string> relaxed = read_sing_file(sings);
+  const std::map<int, std::string> relaxed = test::read_singularity_texts(sings);
   EXPECT_EQ(relaxed.count(b.start[1]), 1u);
   EXPECT_EQ(relaxed.count(b.corners[0]), 0u);
   EXPECT_EQ(relaxed.size(), 8u);
@@ -122,7 +108,7 @@ TEST(CliRelax, CancelAnnihilatesAnOppositePairOnlyWhenAsked) {
   const auto kept = run_cli(base);
   ASSERT_EQ(kept.status, 0) << kept.err;
   std::multiset<std::string> indices;
-  for (const auto& [v, n] : read_sing_file(sings)) indices.insert(n);
+  for (const auto& [v, n] : test::read_singularity_texts(sings)) indices.insert(n);
   EXPECT_EQ(indices.count("-1/4"), 1u);
   EXPECT_EQ(indices.count("1/4"), 9u);
   const auto cancelled = run_cli(base + " --relax-cancel 2");
@@ -130,7 +116,7 @@ TEST(CliRelax, CancelAnnihilatesAnOppositePairOnlyWhenAsked) {
   EXPECT_NE(cancelled.out.find("(1 cancelling a pair)"), std::string::npos) << cancelled.out;
   const nlohmann::json j = nlohmann::json::parse(slurp(report));
   EXPECT_EQ(j["relax"]["cancelled_pairs"], 1);
-  const std::map<int, std::string> after = read_sing_file(sings);
+  const std::map<int, std::string> after = test::read_singularity_texts(sings);
   EXPECT_EQ(after.size(), 8u);
   for (const auto& [v, n] : after) EXPECT_EQ(n, "1/4") << v;
 }
@@ -145,7 +131,7 @@ TEST(CliRelax, ParamUsesTheRelaxedSingularities) {
   EXPECT_NE(r.out.find("relax: energy "), std::string::npos) << r.out;
   std::map<int, std::string> expected;
   for (int v : b.corners) expected[v] = "1/4";
-  EXPECT_EQ(read_sing_file(sings), expected);
+  EXPECT_EQ(test::read_singularity_texts(sings), expected);
   const nlohmann::json j = nlohmann::json::parse(slurp(report));
   EXPECT_TRUE(j["relax"]["converged"].get<bool>());
   EXPECT_TRUE(j["param"]["seamless"].get<bool>());
