@@ -3,6 +3,8 @@
 // listed in ../shared/notes/peers.md.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -183,6 +185,74 @@ TEST(Solver, QrRouteAgreesWithCholesky) {
   }
 }
 #endif
+
+// The paper's problem (min Σ x_e² / w_e subject to the holonomy rows A x = b) solved from scratch, dense,
+// with Eigen's complete orthogonal decomposition (the minimum-norm solution of A W^½ z = b, x = W^½ z):
+// an independent check of the Cholesky route that every build runs (the QR route above needs
+// SuiteSparse). A is built here from the topology alone (a row per interior vertex: its edges with a sign
+// that is consistent around the vertex; a row per generator and per boundary loop: their dual cycles),
+// and b = A x of the solver's own x, whose rows expect_exact checks; so a wrong x cannot pass by a wrong
+// right-hand side, and the rows' overall signs, and dependent rows (a component's last loop), do not matter.
+TEST(Solver, DenseMinimumNormSolutionAgrees) {
+  struct Small {
+    std::string name;
+    Mesh mesh;
+    int N;
+  };
+  const std::vector<Small> meshes = {{"cube_sphere", make_cube_sphere(5, true), 4},
+                                     {"torus", make_torus(18, 9), 4},
+                                     {"genus2", make_genus_surface(2, 2), 4},
+                                     {"grid_two_holes", make_holed_grid(14, 2), 4},
+                                     {"annulus_N1", make_annulus(4, 24), 1}};
+  for (const Small& m : meshes) {
+    SCOPED_TRACE(m.name);
+    FieldDesigner d(m.mesh.V, m.mesh.F);
+    const Topology& t = d.topology();
+    IndexPrescription p = gauss_bonnet_prescription(t, m.N);
+    int placed = 0;
+    for (int v : spread_interior_vertices(t, 12))
+      if (!p.vertex.count(v) && placed < 4) p.vertex[v] = placed++ % 2 ? -1 : 1;
+    const Design r = d.design(p);
+    expect_exact(d, r, p, /*expect_field_indices=*/false);  // coarse meshes: a few edges turn by π/N or more
+    const Eigen::VectorXd& w = d.solver().weights();
+    std::vector<int> column(t.num_edges, -1), edge;
+    for (int e = 0; e < t.num_edges; ++e)
+      if (!t.is_boundary_edge(e) && w(e) > 0) column[e] = static_cast<int>(edge.size()), edge.push_back(e);
+    std::vector<std::vector<std::pair<int, double>>> rows;
+    for (int v = 0; v < t.num_vertices; ++v) {
+      if (!t.is_interior_vertex(v)) continue;
+      std::vector<std::pair<int, double>> row;
+      for (int k = t.vertex_edge_offsets[v]; k < t.vertex_edge_offsets[v + 1]; ++k) {
+        const int e = t.vertex_edges[k];
+        if (column[e] >= 0) row.push_back({column[e], t.edge_vertices(e, 0) == v ? -1.0 : 1.0});
+      }
+      rows.push_back(row);
+    }
+    for (const auto* cycles : {&d.cycles().generators, &d.cycles().loops})
+      for (const DualCycle& c : *cycles) {
+        std::vector<std::pair<int, double>> row;
+        for (size_t k = 0; k < c.edges.size(); ++k)
+          if (column[c.edges[k]] >= 0) row.push_back({column[c.edges[k]], static_cast<double>(c.signs[k])});
+        rows.push_back(row);
+      }
+    const int n = static_cast<int>(edge.size());
+    Eigen::MatrixXd AW = Eigen::MatrixXd::Zero(static_cast<int>(rows.size()), n);
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(static_cast<int>(rows.size()));
+    for (size_t i = 0; i < rows.size(); ++i)
+      for (const auto& [j, sign] : rows[i]) {
+        AW(static_cast<int>(i), j) += sign * std::sqrt(w(edge[j]));
+        b(static_cast<int>(i)) += sign * r.connection.x(edge[j]);
+      }
+    const Eigen::VectorXd z = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(AW).solve(b);
+    double worst = 0, scale = 1;
+    for (int j = 0; j < n; ++j) {
+      worst = std::max(worst, std::abs(std::sqrt(w(edge[j])) * z(j) - r.connection.x(edge[j])));
+      scale = std::max(scale, std::abs(r.connection.x(edge[j])));
+    }
+    EXPECT_LE(worst, 1e-9 * scale) << rows.size() << " rows, " << n << " edges";
+    EXPECT_LE((AW * z - b).norm(), 1e-9 * std::max(1.0, b.norm()));
+  }
+}
 
 // An edit that moves a few singularities updates the stored forward substitution along the elimination
 // tree only (CholeskyEngine::forward_update); one that changes many rows redoes it. Both must give the

@@ -242,7 +242,7 @@ void expect_same_as_cholmod(const Upper& A, const std::vector<int>& order, const
 // x ← (L Lᴴ)⁻¹ x for a factor of ours (values `x` of the scalar T), b and the result in the matrix's order: the
 // supernodal forward and backward substitutions, written out.
 template <class T>
-std::vector<T> solve_with(const SymbolicFactor& F, const std::vector<T>& values, const std::vector<T>& b) {
+std::vector<T> solve_with(const SymbolicFactor& F, const linalg::FactorValues<T>& values, const std::vector<T>& b) {
   using Matrix = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic>;
   using Vector = Eigen::Matrix<T, Eigen::Dynamic, 1>;
   Vector y(F.n);
@@ -592,7 +592,7 @@ TEST(Symbolic, NumericFactorizationOnItSolves) {
     SCOPED_TRACE(c.name);
     const Upper& A = c.A;
     const SymbolicFactor F = linalg::symbolic_analysis(A.outer, A.inner, A.n, linalg::amd_ordering(A.outer, A.inner, A.n));
-    std::vector<double> x;
+    linalg::FactorValues<double> x;
     ASSERT_EQ(linalg::factorize(F, x, A.outer, A.inner, A.values), A.n);
     ASSERT_EQ(x.size(), F.xsize);
     std::vector<double> b(A.n);
@@ -621,7 +621,8 @@ TEST(Symbolic, NumericFactorizationOnItSolves) {
         entries[q] = A.inner[q] == col ? A.values[q] : std::polar(A.values[q], angle(rng));
         interleaved.push_back(entries[q].real()), interleaved.push_back(entries[q].imag());
       }
-    std::vector<std::complex<double>> z, bz(A.n);
+    linalg::FactorValues<std::complex<double>> z;
+    std::vector<std::complex<double>> bz(A.n);
     ASSERT_EQ(linalg::factorize_complex(F, z, A.outer, A.inner, interleaved), A.n);
     for (int i = 0; i < A.n; ++i) bz[i] = {std::sin(0.37 * i + 1), std::cos(0.11 * i)};
     EXPECT_LT(relative_residual(A, entries, solve_with(F, z, bz), bz), 1e-10);
@@ -634,7 +635,7 @@ TEST(Symbolic, NumericFactorizationReportsTheColumnNotPositiveDefinite) {
   A.values[A.outer[100 + 1] - 1] = -1.0;  // the diagonal of row 100
   const std::vector<int> order = linalg::amd_ordering(A.outer, A.inner, A.n);
   const SymbolicFactor F = linalg::symbolic_analysis(A.outer, A.inner, A.n, order);
-  std::vector<double> x;
+  linalg::FactorValues<double> x;
   const int minor = linalg::factorize(F, x, A.outer, A.inner, A.values);
 #ifdef TRIVCON_WITH_SUITESPARSE
   CholmodSymbolic theirs(A, order, SymbolicOptions{});
@@ -655,7 +656,7 @@ TEST(Symbolic, EmptyAndOneByOne) {
   const SymbolicFactor G = linalg::symbolic_analysis(one.outer, one.inner, 1, {0});
   EXPECT_EQ(G.super, (std::vector<int>{0, 1}));
   EXPECT_EQ(G.s, std::vector<int>{0});
-  std::vector<double> x;
+  linalg::FactorValues<double> x;
   ASSERT_EQ(linalg::factorize(G, x, one.outer, one.inner, one.values), 1);
   EXPECT_DOUBLE_EQ(x[0], 2.0);
 }

@@ -82,7 +82,7 @@ class CholeskyEngine : public SolverEngine {
   // The symbolic factorization (given, see adopt, or the engine's own) and the factor's values in its
   // supernodal blocks.
   std::unique_ptr<AnalysisState> analysis_ = std::make_unique<AnalysisState>();
-  std::vector<double> values_;
+  linalg::FactorValues<double> values_;
   const linalg::SymbolicFactor& symbolic_factor() const { return analysis_->symbolic; }
   Supernodes supernodes() const { return Supernodes(analysis_->symbolic, values_.data()); }
   Factorization factorization_;

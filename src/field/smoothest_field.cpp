@@ -192,7 +192,7 @@ SmoothestSystem assemble_smoothest_system(const Topology& t, const Geometry& g, 
 // Curvature alignment (docs/auto.md): the field x found so far is replaced, on each component with curvature,
 // by the solution of (A − t·λ̂ M) u = M q + b_D toward the guidance q; with t ≠ 0 the factor L is refactored.
 void align_to_guidance(const Topology& t, const Geometry& g, const Weights& k, const AutoOptions& o, const std::vector<Complex>& guidance,
-                       SmoothestSystem& S, const linalg::SymbolicFactor& L, std::vector<Complex>& Lx,
+                       SmoothestSystem& S, const linalg::SymbolicFactor& L, linalg::FactorValues<Complex>& Lx,
                        const linalg::Substitution<Complex>& substitution, std::vector<double>& x) {
   const int N = o.N, n = S.size(), components = static_cast<int>(t.components.size());
   // Per component: the Rayleigh quotient λ̂ of the field found so far (the smoothest field's eigenvalue, or the
@@ -256,7 +256,7 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   ordering_used = analysis.ordering;
   // The numeric factor by trivcon's own supernodal code (src/linalg/supernodal.h, the same that factors the
   // trivial-connection system), on both cores: cholmod_factorize visits the supernodes one after another.
-  std::vector<Complex> Lx;  // the factor's values
+  linalg::FactorValues<Complex> Lx;  // the factor's values
   if (const int minor = linalg::factorize_complex(L, Lx, S.outer, S.inner, S.values); minor < n)
     throw Error("automatic singularities: the smoothest-field matrix is not positive definite (column " + std::to_string(minor) +
                 " of " + std::to_string(n) + "): a non-finite or degenerate weight");

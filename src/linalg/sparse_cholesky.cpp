@@ -12,7 +12,7 @@ namespace trivcon::linalg {
 
 struct SparseCholesky::State {
   SymbolicFactor symbolic;
-  std::vector<double> x;               // the factor's values
+  FactorValues<double> x;              // the factor's values
   std::vector<int> outer, inner;       // the upper triangle's pattern, compressed columns
   std::vector<double> values;
   std::unique_ptr<Substitution<double>> substitution;

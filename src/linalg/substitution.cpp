@@ -10,7 +10,7 @@
 namespace trivcon::linalg {
 
 template <class T>
-Substitution<T>::Substitution(const SymbolicFactor& L, const std::vector<T>& values) : S_(L, nullptr), values_(&values) {
+Substitution<T>::Substitution(const SymbolicFactor& L, const FactorValues<T>& values) : S_(L, nullptr), values_(&values) {
   if (values.size() != L.xsize || static_cast<int>(L.perm.size()) != L.n)
     throw Error("internal: the parallel substitution needs a numeric supernodal LL' factor of the right type");
   n_ = L.n;

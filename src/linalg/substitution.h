@@ -40,7 +40,7 @@ template <class T>
 class Substitution {
  public:
   // `values`: the factor's entries (L.xsize), as factorize / factorize_complex fill them; read at each solve.
-  Substitution(const SymbolicFactor& L, const std::vector<T>& values);
+  Substitution(const SymbolicFactor& L, const FactorValues<T>& values);
 #ifdef TRIVCON_WITH_SUITESPARSE
   explicit Substitution(const cholmod_factor& L);
 #endif
@@ -64,7 +64,7 @@ class Substitution {
 #ifdef TRIVCON_WITH_SUITESPARSE
   const cholmod_factor* cholmod_ = nullptr;   // CHOLMOD's factor, whose x may be reallocated by a refactorization
 #endif
-  const std::vector<T>* values_ = nullptr;    // the values of trivcon's own factor
+  const FactorValues<T>* values_ = nullptr;    // the values of trivcon's own factor
   int n_ = 0;
   std::vector<int> perm_;                     // factor position k holds matrix row perm_[k]
   std::vector<int> top_;                      // supernodes above the split, increasing

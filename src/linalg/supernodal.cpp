@@ -436,12 +436,12 @@ int factorize_as(cholmod_factor& L, const std::vector<int>& outer, const std::ve
 #endif
 
 template <class T>
-int factorize_own(const SymbolicFactor& L, std::vector<T>& x, const std::vector<int>& outer, const std::vector<int>& inner,
+int factorize_own(const SymbolicFactor& L, FactorValues<T>& x, const std::vector<int>& outer, const std::vector<int>& inner,
                   const T* values) {
   if (static_cast<int>(L.super.size()) != L.nsuper + 1 || L.pi.size() != L.super.size() || L.px.size() != L.super.size() ||
       static_cast<int>(L.perm.size()) != L.n)
     throw Error("internal: the numeric factorization was given an incomplete symbolic factor");
-  x.assign(L.xsize, T(0));
+  x.resize(L.xsize);  // not zeroed: Numeric::compute writes each supernode's block whole
   return factor_values<T>(Supernodes(L, reinterpret_cast<const double*>(x.data())), L.perm.data(), L.n, x.data(), outer, inner, values);
 }
 
@@ -459,12 +459,12 @@ int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const st
 }
 #endif
 
-int factorize(const SymbolicFactor& L, std::vector<double>& x, const std::vector<int>& outer, const std::vector<int>& inner,
+int factorize(const SymbolicFactor& L, FactorValues<double>& x, const std::vector<int>& outer, const std::vector<int>& inner,
               const std::vector<double>& values) {
   return factorize_own<double>(L, x, outer, inner, values.data());
 }
 
-int factorize_complex(const SymbolicFactor& L, std::vector<Complex>& x, const std::vector<int>& outer, const std::vector<int>& inner,
+int factorize_complex(const SymbolicFactor& L, FactorValues<Complex>& x, const std::vector<int>& outer, const std::vector<int>& inner,
                       const std::vector<double>& values) {
   return factorize_own<Complex>(L, x, outer, inner, reinterpret_cast<const Complex*>(values.data()));
 }

@@ -18,6 +18,9 @@
 
 #include <array>
 #include <complex>
+#include <memory>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "linalg/symbolic.h"
@@ -38,6 +41,28 @@ struct TreeSplit {
   std::vector<std::vector<int>> part;
 };
 TreeSplit split_tree(const std::vector<int>& parent, const std::vector<double>& work, double min_split, int parts = 2, bool deepen = false);
+
+// The values of a factor of trivcon's own (below): a std::vector whose new entries are left unwritten.
+// The numeric factorization writes every entry, supernode by supernode on the thread that computes it; a
+// plain std::vector would first zero them all on one thread, which on a large mesh costs more than the
+// factorization's own first touch of that memory (the kernel's page clearing, then, spread over the threads).
+template <class T>
+struct UninitializedAllocator : std::allocator<T> {
+  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+  template <class U>
+  struct rebind {
+    using other = UninitializedAllocator<U>;
+  };
+  UninitializedAllocator() = default;
+  template <class U>
+  UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    if constexpr (sizeof...(Args) > 0) ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+template <class T>
+using FactorValues = std::vector<T, UninitializedAllocator<T>>;
 
 // A supernodal factor, read in place (CHOLMOD's, or one of src/linalg/symbolic.h, whose arrays mean the same):
 // supernode s holds the columns first(s) … first(s) + cols(s) − 1; its rows (its own columns first, then rows
@@ -90,9 +115,9 @@ int factorize_complex(cholmod_factor& L, const std::vector<int>& outer, const st
 // The same two into a factor of trivcon's own symbolic analysis (src/linalg/symbolic.h, permutation L.perm):
 // `x` becomes its values, L.xsize entries. Returns n on success, or the first factor column found not
 // positive definite.
-int factorize(const SymbolicFactor& L, std::vector<double>& x, const std::vector<int>& outer, const std::vector<int>& inner,
+int factorize(const SymbolicFactor& L, FactorValues<double>& x, const std::vector<int>& outer, const std::vector<int>& inner,
               const std::vector<double>& values);
-int factorize_complex(const SymbolicFactor& L, std::vector<std::complex<double>>& x, const std::vector<int>& outer,
+int factorize_complex(const SymbolicFactor& L, FactorValues<std::complex<double>>& x, const std::vector<int>& outer,
                       const std::vector<int>& inner, const std::vector<double>& values);
 
 }  // namespace trivcon::linalg
