@@ -59,11 +59,12 @@ void run_param(const ParamCommand& o) {
                             (q.unaligned_edges ? ", " + std::to_string(q.unaligned_edges) + " edges the field crosses obliquely left free" : "")
                       : std::string())
               << ")\n"
-              << "flipped faces " << q.flipped_faces << ", degenerate " << q.degenerate_faces << " (" << q.stiffening_rounds
-              << " stiffening rounds); distortion mean " << fmt(q.mean_distortion) << ", max " << fmt(q.max_distortion) << "\n"
+              << "flipped faces " << q.flipped_faces << ", degenerate " << q.degenerate_faces << " (" << q.untangled_faces
+              << " untangled, " << q.stiffening_rounds << " stiffening rounds); distortion mean " << fmt(q.mean_distortion) << ", max " << fmt(q.max_distortion) << "\n"
               << "time: read " << fmt(read_seconds) << " s, field " << fmt(out.design.solve_seconds + out.design.field_seconds) << " s, map "
-              << fmt(q.seconds_cut + q.seconds_setup + q.seconds_rounding + q.seconds_stiffening + q.seconds_check) << " s (cut "
-              << fmt(q.seconds_cut) << ", setup " << fmt(q.seconds_setup) << ", rounding " << fmt(q.seconds_rounding) << ", stiffening "
+              << fmt(q.seconds_cut + q.seconds_setup + q.seconds_rounding + q.seconds_untangling + q.seconds_stiffening + q.seconds_check)
+              << " s (cut " << fmt(q.seconds_cut) << ", setup " << fmt(q.seconds_setup) << ", rounding " << fmt(q.seconds_rounding)
+              << ", untangling " << fmt(q.seconds_untangling) << ", stiffening "
               << fmt(q.seconds_stiffening) << ", check " << fmt(q.seconds_check) << ")\n";
   if (const std::string w = param_warning(param); !w.empty()) std::cerr << "trivcon: warning: " << w << "\n";
   if (!q.seamless) exit_code = kVerificationFailed;

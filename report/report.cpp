@@ -122,6 +122,8 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"folds_rounded", q.folds_rounded},
           {"cones_moved", q.cones_moved},
           {"integers_moved", q.integers_moved},
+          {"untangled_faces", q.untangled_faces},
+          {"untangling_regions", q.untangling_regions},
           {"flipped_faces", q.flipped_faces},
           {"degenerate_faces", q.degenerate_faces},
           {"first_flipped", q.first_flipped},
@@ -137,7 +139,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"target_squares", q.target_squares},
           {"non_unimodular", q.non_unimodular},
           {"seconds", {{"cut", q.seconds_cut}, {"setup", q.seconds_setup}, {"rounding", q.seconds_rounding},
-                       {"stiffening", q.seconds_stiffening}, {"check", q.seconds_check}}}};
+                       {"untangling", q.seconds_untangling}, {"stiffening", q.seconds_stiffening}, {"check", q.seconds_check}}}};
 }
 
 nlohmann::ordered_json quad_report(const QuadMesh& quads) {

@@ -513,7 +513,7 @@ TEST(Quad, LargeMeshIsFast) {
   std::printf(
       "large torus: %d faces, %d quads, extract %.3f s, check %.3f s, map %.2f s\n", static_cast<int>(m.F.rows()),
       static_cast<int>(r.quads.Q.rows()), r.quads.quality.seconds_extract, r.quads.quality.seconds_check,
-      r.param.quality.seconds_cut + r.param.quality.seconds_setup + r.param.quality.seconds_rounding + r.param.quality.seconds_stiffening);
+      r.param.quality.seconds_cut + r.param.quality.seconds_setup + r.param.quality.seconds_rounding + r.param.quality.seconds_untangling + r.param.quality.seconds_stiffening);
 }
 
 }  // namespace

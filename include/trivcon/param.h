@@ -37,7 +37,7 @@ struct ParamOptions {
   std::vector<int> aligned_edges;
   // Greedy rounding: each round fixes the integers nearest to whole numbers, this fraction of those left (at
   // least one), then re-solves.
-  double rounding_fraction = 0.3;
+  double rounding_fraction = 0.5;
   int max_stiffening_rounds = 20;  // re-solves with the flipped faces stiffened (MIQ's §5), integers kept
 };
 
@@ -51,6 +51,8 @@ struct ParamQuality {
   int folds_rounded = 0;      // folded faces right after the rounding (before stiffening again)
   int cones_moved = 0;        // singularities moved to a neighbouring integer point against a fold or a shared point
   int integers_moved = 0;     // other integers (iso-lines, translations) moved by ±1 against a fold
+  int untangled_faces = 0;    // folded or degenerate faces opened by the local untangling (docs/param.md)
+  int untangling_regions = 0; // regions untangled (each kept only when the map had fewer folds after it)
   int flipped_faces = 0;      // faces whose (u, v) triangle is inverted
   int degenerate_faces = 0;   // faces whose (u, v) triangle has (nearly) zero area
   std::vector<int> first_flipped;  // up to 10 ids of flipped or degenerate faces
@@ -64,7 +66,7 @@ struct ParamQuality {
   double unit_squares = 0;             // total (u, v) area
   double target_squares = 0;           // mesh area / edge_length²
   int non_unimodular = 0;              // integer relations the elimination could not keep whole (0 expected)
-  double seconds_cut = 0, seconds_setup = 0, seconds_rounding = 0, seconds_stiffening = 0, seconds_check = 0;
+  double seconds_cut = 0, seconds_setup = 0, seconds_rounding = 0, seconds_stiffening = 0, seconds_untangling = 0, seconds_check = 0;
   // True when the map is seamless (transitions whole to 1e-6), every cone on an integer point, every aligned edge
   // on an iso-line: what the linear constraints promise. Folds (and a cone angle off by whole turns, which a
   // fold around the cone makes) are counted above.

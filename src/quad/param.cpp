@@ -20,6 +20,7 @@
 
 #include "linalg/sparse_cholesky.h"
 #include "linalg/timing.h"
+#include "quad/untangle.h"
 #include "trivcon/cancel.h"
 #include "trivcon/error.h"
 #include "trivcon/matching.h"
@@ -620,9 +621,217 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   }
   q.folds_rounded = count_folds();
   q.seconds_rounding = linalg::seconds_since(t2);
+
+  // --- Stiffening, then untangling: the folds left opened locally, every integer held (src/quad/untangle.h) ---
+  // Stiffening (global re-solves) first, because it would undo local work. Then around each folded or
+  // degenerate face, the real unknowns of the wedges within `rings` rings become the variables of the barrier
+  // energy of Garanzha et al. 2021, the rest of the map held; its energy covers every face those unknowns
+  // move, so that no new fold appears. Kept only when the map is better after it (Badness); the region grows
+  // when a fold is left; singularities whose rings cannot open are moved to a neighbouring integer point.
   const auto t3 = linalg::Clock::now();
+  std::vector<char> is_integer(nY, 0);
+  for (int j : integer_free) is_integer[j] = 1;
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> P_rows = P;
+  std::vector<int> wedge_corner_start(W + 1, 0), wedge_corners(3 * nF);
+  for (int c = 0; c < 3 * nF; ++c) ++wedge_corner_start[wedge[c] + 1];
+  for (int w = 0; w < W; ++w) wedge_corner_start[w + 1] += wedge_corner_start[w];
+  {
+    std::vector<int> next(wedge_corner_start.begin(), wedge_corner_start.end() - 1);
+    for (int c = 0; c < 3 * nF; ++c) wedge_corners[next[wedge[c]]++] = c;
+  }
+  // Folded faces plus singularities whose (u, v) corner angles do not sum to 2π(1 − k): an unfolded ring can
+  // still wind around its singularity once too often, which would give the quad mesh a vertex of another valence.
+  auto cone_winds_wrong = [&](int i) {
+    const int v = out.cones[i];
+    double angle = 0;
+    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
+      const int f = t.vertex_faces[j], k = corner_of(t, f, v);
+      const Eigen::Vector2d p = out.uv.row(3 * f + k).transpose();
+      const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
+      angle += std::atan2(a.x() * c.y() - a.y() * c.x(), a.dot(c));
+    }
+    return std::abs(angle - 2 * kPi * (1 - out.cone_index[i] / 4.0)) > 1e-6;
+  };
+  // The folds, and which singularities wind wrong.
+  struct Badness {
+    int folds = 0, cones = 0;
+    std::vector<char> wrong;
+    int total() const { return folds + cones; }
+    // Better: fewer problems in all, and no singularity winding wrong that did not before.
+    bool better_than(const Badness& before) const {
+      for (size_t i = 0; i < wrong.size(); ++i)
+        if (wrong[i] && !before.wrong[i]) return false;
+      return total() < before.total();
+    }
+  };
+  auto badness = [&]() {
+    Badness b;
+    b.folds = count_folds();
+    b.wrong.resize(nCone);
+    for (int i = 0; i < nCone; ++i) b.cones += (b.wrong[i] = cone_winds_wrong(i));
+    return b;
+  };
+  // Untangles the region within `rings` rings of the vertices `seeds`; kept when the whole map has fewer folds
+  // after it (returns true), else undone.
+  auto untangle_around = [&](const std::vector<int>& seeds, int rings) {
+    const Badness before = badness();
+    std::vector<int> depth(nV, -1), frontier;
+    for (int v : seeds)
+      if (depth[v] < 0) depth[v] = 0, frontier.push_back(v);
+    for (int r = 0; r < rings; ++r) {
+      std::vector<int> next;
+      for (int v : frontier)
+        for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
+          for (int k = 0; k < 3; ++k)
+            if (const int u = t.F(t.vertex_faces[j], k); depth[u] < 0) depth[u] = r + 1, next.push_back(u);
+      frontier = std::move(next);
+    }
+    // The region's real free unknowns are the variables; the faces they move carry the energy.
+    std::vector<int> variable(nY, -1), variables;
+    for (int c = 0; c < 3 * nF; ++c) {
+      if (depth[t.F(c / 3, c % 3)] < 0) continue;
+      for (int r = 0; r < 2; ++r)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * wedge[c] + r); it; ++it) {
+          const int j = static_cast<int>(it.col());
+          if (!is_integer[j] && variable[j] < 0) variable[j] = static_cast<int>(variables.size()), variables.push_back(j);
+        }
+    }
+    if (variables.empty()) return false;
+    std::vector<char> moved(nF, 0);
+    std::vector<int> faces;
+    for (int j : variables)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(P, j); it; ++it) {
+        const int w = static_cast<int>(it.row()) / 2;
+        if (w >= W) continue;
+        for (int k = wedge_corner_start[w]; k < wedge_corner_start[w + 1]; ++k)
+          if (const int f = wedge_corners[k] / 3; !moved[f]) moved[f] = 1, faces.push_back(f);
+      }
+    quad::UntangleProblem problem;
+    problem.num_variables = static_cast<int>(variables.size());
+    for (int f : faces) {
+      const Eigen::Vector2d X(std::cos(theta[f]), std::sin(theta[f])), Y(-X.y(), X.x());
+      std::array<Eigen::Vector2d, 3> gradient;
+      std::array<std::array<quad::AffineForm, 2>, 3> corner;
+      for (int i = 0; i < 3; ++i) {
+        gradient[i] = Eigen::Vector2d(grad[f][i].dot(X), grad[f][i].dot(Y)) / s;  // relative to the ideal s·(X Y)ᵀ
+        for (int r = 0; r < 2; ++r)
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * wedge[3 * f + i] + r); it; ++it) {
+            const int j = static_cast<int>(it.col());
+            if (variable[j] >= 0) corner[i][r].terms.emplace_back(variable[j], it.value());
+            else corner[i][r].constant += it.value() * y[j];
+          }
+      }
+      problem.area.push_back(face_area[f]);
+      problem.gradient.push_back(gradient);
+      problem.corner.push_back(std::move(corner));
+    }
+    Eigen::VectorXd z(problem.num_variables);
+    for (size_t k = 0; k < variables.size(); ++k) z[static_cast<int>(k)] = y[variables[k]];
+    const Eigen::VectorXd y0 = y;
+    quad::untangle(problem, z);
+    for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z[static_cast<int>(k)];
+    corner_uv();
+    if (badness().better_than(before)) {
+      ++q.untangling_regions;
+      return true;
+    }
+    y = y0;
+    corner_uv();
+    return false;
+  };
+  // Each folded face in turn (the first still folded), in regions of 2, 4 and 8 rings; then, where a fold is
+  // left beside a singularity whose integer point is free, that point moved to each of its 8 neighbours (the
+  // solution is affine in it: two solves), the region around it untangled, the first that leaves fewer folds kept.
+  std::vector<int> cone_of(nV, -1);
+  for (int k = 0; k < nCone; ++k) cone_of[out.cones[k]] = k;
+  // Each folded face in turn (the first still folded), in regions of 2, 4 and 8 rings.
+  auto untangle_faces = [&]() {
+    std::vector<char> given_up(nF, 0);
+    for (int f = 0; f < nF; ++f) {
+      if (given_up[f] || !folded(f)) continue;
+      check_cancelled();
+      for (int rings : {2, 4, 8})
+        if (untangle_around({t.F(f, 0), t.F(f, 1), t.F(f, 2)}, rings) && !folded(f)) break;
+      if (folded(f)) given_up[f] = 1;
+      f = -1;  // the regions overlap: look again from the first face
+    }
+  };
+  // Where a fold is left within 2 rings of a singularity whose integer point is free, that point is moved to
+  // its neighbours (the solution is affine in it: two solves), the `candidates` that leave the fewest folds
+  // before untangling first, the region around it untangled; the first that leaves fewer folds is kept.
+  auto move_cones = [&](size_t candidates) {
+    std::vector<char> cone_tried(nCone, 0);
+    std::vector<int> trouble;  // folded faces, and a face of each singularity whose ring winds wrong
+    for (int f = 0; f < nF; ++f)
+      if (folded(f)) trouble.push_back(f);
+    for (int i = 0; i < nCone; ++i)
+      if (cone_winds_wrong(i)) trouble.push_back(t.vertex_faces[t.vertex_face_offsets[out.cones[i]]]);
+    for (int f : trouble) {
+      std::vector<int> near, ring{t.F(f, 0), t.F(f, 1), t.F(f, 2)};
+      for (int step = 0; step < 2; ++step) {
+        std::vector<int> next;
+        for (int v : ring)
+          for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
+            for (int k = 0; k < 3; ++k) next.push_back(t.F(t.vertex_faces[j], k));
+        std::sort(next.begin(), next.end());
+        next.erase(std::unique(next.begin(), next.end()), next.end());
+        ring = std::move(next);
+      }
+      for (int v : ring)
+        if (const int c = cone_of[v]; c >= 0 && !cone_tried[c]) near.push_back(c);
+      for (int c : near) {
+        if (cone_tried[c] || elim.eliminated(cone0 + 2 * c) || elim.eliminated(cone0 + 2 * c + 1)) continue;
+        cone_tried[c] = 1;
+        check_cancelled();
+        const int ju = free_index[cone0 + 2 * c], jv = free_index[cone0 + 2 * c + 1];
+        const Eigen::VectorXd y0 = y, gu = response(ju), gv = response(jv);
+        const Badness before = badness();
+        std::vector<std::tuple<int, double, int, int>> order;
+        for (int dx = -1; dx <= 1; ++dx)
+          for (int dy = -1; dy <= 1; ++dy) {
+            if (dx == 0 && dy == 0) continue;
+            y = y0 + dx * gu + dy * gv;
+            corner_uv();
+            order.emplace_back(count_folds(), energy(y), dx, dy);
+          }
+        std::sort(order.begin(), order.end());
+        bool kept = false;
+        for (size_t k = 0; k < std::min(candidates, order.size()) && !kept; ++k) {
+          const auto [folds, e, dx, dy] = order[k];
+          y = y0 + dx * gu + dy * gv;
+          corner_uv();
+          untangle_around({out.cones[c]}, 4);
+          if (badness().better_than(before)) {
+            value[ju] += dx, value[jv] += dy;
+            ++q.cones_moved;
+            kept = true;
+          }
+        }
+        if (!kept) {
+          y = y0;
+          corner_uv();
+        }
+      }
+    }
+  };
+  auto untangle_all = [&]() {
+    for (size_t candidates : {3, 8}) {
+      untangle_faces();
+      if (badness().total() == 0) return;
+      move_cones(candidates);
+    }
+    untangle_faces();
+  };
+  auto untangle_folds = [&]() {
+    const int folds_before = count_folds();
+    untangle_all();
+    q.untangled_faces += folds_before - count_folds();
+  };
   stiffen(options.max_stiffening_rounds);
   q.seconds_stiffening = linalg::seconds_since(t3);
+  const auto t5 = linalg::Clock::now();
+  untangle_folds();
+  q.seconds_untangling = linalg::seconds_since(t5);
 
   // --- What the map promises, checked on the result --------------------------------------------------------
   const auto t4 = linalg::Clock::now();

@@ -1,0 +1,167 @@
+// The local untangling of a map (src/quad/untangle.h).
+#include "quad/untangle.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include "trivcon/cancel.h"
+
+namespace trivcon::quad {
+
+namespace {
+
+double chi(double D, double eps) { return 0.5 * (D + std::sqrt(eps * eps + D * D)); }
+double chi_derivative(double D, double eps) { return 0.5 * (1 + D / std::sqrt(eps * eps + D * D)); }
+
+class Energy {
+ public:
+  Energy(const UntangleProblem& p, double lambda) : p_(p), lambda_(lambda) {}
+
+  // The relative Jacobian of face f at z.
+  Eigen::Matrix2d jacobian(int f, const Eigen::VectorXd& z) const {
+    Eigen::Matrix2d J = Eigen::Matrix2d::Zero();
+    for (int i = 0; i < 3; ++i)
+      for (int r = 0; r < 2; ++r) J.row(r) += value(p_.corner[f][i][r], z) * p_.gradient[f][i].transpose();
+    return J;
+  }
+
+  double min_determinant(const Eigen::VectorXd& z) const {
+    double m = std::numeric_limits<double>::infinity();
+    for (size_t f = 0; f < p_.area.size(); ++f) m = std::min(m, jacobian(static_cast<int>(f), z).determinant());
+    return m;
+  }
+
+  // The energy at z with regularisation eps; its gradient into `grad` when given.
+  double operator()(const Eigen::VectorXd& z, double eps, Eigen::VectorXd* grad) const {
+    if (grad) grad->setZero(z.size());
+    double total = 0;
+    for (size_t f = 0; f < p_.area.size(); ++f) {
+      const Eigen::Matrix2d J = jacobian(static_cast<int>(f), z);
+      const double D = J.determinant(), T = J.squaredNorm(), c = chi(D, eps), a = p_.area[f];
+      total += a * ((1 - lambda_) * T + lambda_ * (D * D + 1)) / c;
+      if (!grad) continue;
+      const double dc = chi_derivative(D, eps);
+      Eigen::Matrix2d cofactor;
+      cofactor << J(1, 1), -J(1, 0), -J(0, 1), J(0, 0);
+      const Eigen::Matrix2d G = a * ((1 - lambda_) * (2 * J / c - T * dc / (c * c) * cofactor) +
+                                     lambda_ * (2 * D / c - (D * D + 1) * dc / (c * c)) * cofactor);
+      for (int i = 0; i < 3; ++i)
+        for (int r = 0; r < 2; ++r) {
+          const double d = G.row(r).dot(p_.gradient[f][i]);
+          for (const auto& [j, coefficient] : p_.corner[f][i][r].terms) (*grad)[j] += coefficient * d;
+        }
+    }
+    return total;
+  }
+
+ private:
+  static double value(const AffineForm& a, const Eigen::VectorXd& z) {
+    double v = a.constant;
+    for (const auto& [j, coefficient] : a.terms) v += coefficient * z[j];
+    return v;
+  }
+  const UntangleProblem& p_;
+  double lambda_;
+};
+
+// L-BFGS (Nocedal & Wright, Algorithm 7.4, memory 8) with a backtracking Armijo line search, from z, for at
+// most `iterations` steps or until the gradient or the decrease is negligible. Returns the steps taken.
+int minimise(const Energy& energy, double eps, Eigen::VectorXd& z, int iterations) {
+  const int memory = 8;
+  std::deque<Eigen::VectorXd> S, Y;
+  std::deque<double> rho;
+  Eigen::VectorXd g(z.size()), g_new(z.size());
+  double E = energy(z, eps, &g);
+  const double g0 = g.norm();
+  int it = 0;
+  for (; it < iterations; ++it) {
+    if (!(g.norm() > 1e-10 * std::max(1.0, g0))) break;
+    Eigen::VectorXd d = -g;
+    std::vector<double> alpha(S.size());
+    for (int k = static_cast<int>(S.size()) - 1; k >= 0; --k) {
+      alpha[k] = rho[k] * S[k].dot(d);
+      d -= alpha[k] * Y[k];
+    }
+    if (!S.empty()) d *= S.back().dot(Y.back()) / Y.back().squaredNorm();
+    for (size_t k = 0; k < S.size(); ++k) d += S[k] * (alpha[k] - rho[k] * Y[k].dot(d));
+    double slope = g.dot(d);
+    if (!(slope < 0)) {  // not a descent direction (curvature pairs gone stale): restart from the gradient
+      S.clear(), Y.clear(), rho.clear();
+      d = -g;
+      slope = -g.squaredNorm();
+    }
+    double step = 1, E_new = 0;
+    Eigen::VectorXd z_new;
+    bool accepted = false;
+    for (int tries = 0; tries < 40; ++tries, step *= 0.5) {
+      z_new = z + step * d;
+      E_new = energy(z_new, eps, nullptr);
+      if (std::isfinite(E_new) && E_new <= E + 1e-4 * step * slope) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    energy(z_new, eps, &g_new);
+    const Eigen::VectorXd s = z_new - z, y = g_new - g;
+    const double sy = s.dot(y);
+    if (sy > 1e-12 * s.norm() * y.norm()) {
+      S.push_back(s), Y.push_back(y), rho.push_back(1 / sy);
+      if (static_cast<int>(S.size()) > memory) S.pop_front(), Y.pop_front(), rho.pop_front();
+    }
+    const double decrease = E - E_new;
+    z = z_new, g = g_new, E = E_new;
+    if (decrease < 1e-9 * std::abs(E)) break;
+  }
+  return it;
+}
+
+}  // namespace
+
+UntangleResult untangle(const UntangleProblem& problem, Eigen::VectorXd& z, double min_determinant, double lambda, int max_outer,
+                        int max_inner) {
+  UntangleResult result;
+  const Energy energy(problem, lambda);
+  double D = energy.min_determinant(z);
+  result.min_determinant = D;
+  if (problem.area.empty() || z.size() == 0) {
+    result.unfolded = D > min_determinant;
+    return result;
+  }
+  // ε's rule (Garanzha et al. 2021, §3): after each minimisation with ε, σ = max(1 − E_new/E_old, 1/10) and
+  // μ = (1 − σ) χ(D_min, ε); ε becomes 2√(μ(μ − D_min)) while D_min < μ (smaller as the worst face opens).
+  double eps = D > 0 ? 1e-3 : std::max(1e-3, 2 * std::abs(D));
+  double E_old = energy(z, eps, nullptr);
+  // Stuck: the worst face no better than 4 rounds before while still folded (the held unknowns admit no
+  // unfolded map here: e.g. two singularities on one integer point).
+  std::vector<double> worst;
+  int unfolded_rounds = 0;
+  for (int outer = 0; outer < max_outer; ++outer) {
+    check_cancelled();
+    ++result.outer_iterations;
+    result.inner_iterations += minimise(energy, eps, z, max_inner);
+    const double E_new = energy(z, eps, nullptr);
+    D = energy.min_determinant(z);
+    result.min_determinant = D;
+    // Unfolded: a few more rounds for the shape while they still lower the energy markedly.
+    const bool decreasing = E_old - E_new > 1e-3 * std::abs(E_new);
+    if (D > min_determinant && (!decreasing || ++unfolded_rounds > 3)) break;
+    worst.push_back(D);
+    if (D <= min_determinant && worst.size() > 4) {
+      const double then = worst[worst.size() - 5];
+      if (D <= then + std::max(1e-3 * std::abs(then), 1e-4)) break;
+    }
+    const double sigma = std::max(1 - E_new / E_old, 0.1);
+    const double mu = (1 - sigma) * chi(D, eps);
+    eps = D < mu ? std::max(2 * std::sqrt(mu * (mu - D)), 1e-12) : 1e-8;
+    E_old = energy(z, eps, nullptr);
+  }
+  result.unfolded = result.min_determinant > min_determinant;
+  return result;
+}
+
+}  // namespace trivcon::quad
