@@ -1,8 +1,15 @@
+# SPDX-License-Identifier: MIT
 """Builds the trivcon Python package: CMake compiles the extension trivcon._core (python/src/module.cpp)
 against the repository's static library (CMakeLists.txt with -DTRIVCON_PYTHON=ON); setuptools packages it
 with python/trivcon/. Metadata is in pyproject.toml. Install, offline on Debian 12 (README, "Python"):
 
     /usr/bin/python3 -m venv --system-site-packages venv && venv/bin/pip install --no-build-isolation .
+
+A wheel (python/tests/test_wheel.py builds, installs and uses one; CHANGELOG.md, "Packages"):
+
+    /usr/bin/python3 -m pip wheel . --no-build-isolation --no-deps -w dist
+
+The version is CMakeLists.txt's project() version (version() below), the one source of every version.
 
 Environment:
   TRIVCON_CMAKE_BUILD_DIR  the CMake build folder (default: build/python in the checkout, kept between
@@ -29,7 +36,10 @@ ROOT = os.path.dirname(os.path.abspath(__file__))
 
 def version():
     with open(os.path.join(ROOT, "CMakeLists.txt")) as f:
-        return re.search(r"project\(trivcon VERSION ([0-9.]+)", f.read()).group(1)
+        match = re.search(r"project\(trivcon VERSION ([0-9]+\.[0-9]+\.[0-9]+)", f.read())
+    if not match:
+        sys.exit("setup.py: CMakeLists.txt has no 'project(trivcon VERSION MAJOR.MINOR.PATCH' line to take the version from")
+    return match.group(1)
 
 
 class CMakeBuild(build_ext):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The items of `solve --sing-batch`: many singularity sets solved with one factorization.
 #pragma once
 #include <string>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon check MESH FIELD [options]: the indices of a per-face field, compared with a prescription.
 #include <iostream>
 #include <nlohmann/json.hpp>

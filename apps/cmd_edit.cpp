@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon edit MESH [options]: the interactive editor — a local web server (server/) on one FieldDesigner,
 // serving the page of web/ (embedded in the program) until SIGINT or SIGTERM.
 #include <signal.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon info MESH [--json] [--cycles]
 #include <iostream>
 

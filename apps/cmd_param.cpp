@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon param MESH [field options] (--target-faces K | --edge-length H) -o P.obj: the seamless integer-grid map
 // of the field (trivcon/param.h), written as the input mesh with one texture coordinate per corner.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon quad MESH [field options] (--target-faces K | --edge-length H) -o Q.obj: the quad mesh of the field's
 // seamless integer-grid map (trivcon/quad.h), its irregular vertices exactly the field's singularities.
 #include <cmath>

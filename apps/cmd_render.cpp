@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon render MESH (--field F | --uv P.obj) -o picture.png [options]: a picture of a field and/or of a map's
 // checkerboard (trivcon/render.h).
 #include <iostream>

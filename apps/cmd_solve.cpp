@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon solve MESH [options]: the smoothest field with exactly the prescribed singularities.
 #include <algorithm>
 #include <iomanip>

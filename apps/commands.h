@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The subcommands of the `trivcon` program. Each registers itself on the CLI11 app; its callback
 // throws trivcon::Error for bad input (main prints it and exits with status 1) or returns an exit code
 // through `exit_code`.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "feature_options.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The options that choose feature (sharp) edges (--align-features DEG, --features FILE), shared by `solve`
 // and `render` (trivcon/features.h).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "field_options.h"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The options that state a field request (trivcon/request.h), shared by `solve` and `param`: the
 // prescription, fixed directions, boundary and feature alignment, automatic placement, roots, the solver's
 // options and splitting of large turns. What the request means is the library's; here only the parsing.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "map_command.h"
 
 #include "outputs.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What `param` and `quad` share: the mesh, the field request and the scale of the map, parsed once, and the run
 // from the file to the seamless integer-grid map (trivcon/param.h) of a verified field.
 #pragma once

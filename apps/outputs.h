@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The files `solve` writes after a design. They appear together or not at all: each is written
 // (atomically) beside its final path under a temporary name, and all are renamed into place once every
 // one was written.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "prescription_options.h"
 
 #include "trivcon/constraints.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The options that describe a prescription (-N, -s, --sing, --generator, --boundary), shared by `solve`, `edit`
 // and `check`.
 #pragma once

@@ -1,8 +1,11 @@
+// SPDX-License-Identifier: MIT
 // trivcon: command-line front end. Subcommands live in apps/cmd_*.cpp; all the work is in the library.
 #include <chrono>
 #include <cstdio>
 #include <exception>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <utility>
 
 #include "commands.h"
@@ -51,6 +54,24 @@ void add_mesh_options(CLI::App* cmd, MeshOptions& options) {
 MatrixX3d rows_on_mesh(const LoadedMesh& m, const MatrixX3d& input_rows) {
   return m.repair ? rows_on_repaired(*m.repair, input_rows) : input_rows;
 }
+// The end of `trivcon --help`: the exit statuses (ExitStatus in commands.h), laid out as CLI11 lays out options
+// (descriptions from column 30), so that scripts/cli_help.py reads them into the man page's EXIT STATUS.
+std::string exit_status_help() {
+  const std::pair<int, const char*> statuses[] = {
+      {kSuccess, "Success (also --help and --version)"},
+      {kBadInput, "Bad input (the message on stderr names the problem and where: file and line, vertex, edge or face), "
+                  "a file that cannot be read or written, or out of memory"},
+      {kUsageError, "Usage error: an unknown subcommand or option, a bad or missing value, a missing or extra argument"},
+      {kVerificationFailed, "solve, param, quad: the result failed verification (the message says which check missed "
+                            "and by how much; the outputs are still written)"},
+      {kIndicesDiffer, "check: the field's indices differ from the prescription"},
+      {kInternalError, "Internal error (a bug: the message starts with 'trivcon: internal error:')"},
+  };
+  std::ostringstream out;
+  out << "Exit status:\n";
+  for (const auto& [code, text] : statuses) out << "  " << std::left << std::setw(28) << code << text << "\n";
+  return out.str();
+}
 }  // namespace trivcon::cli
 
 int main(int argc, char** argv) {
@@ -67,6 +88,7 @@ int main(int argc, char** argv) {
 #ifdef TRIVCON_EDITOR
   trivcon::cli::register_edit(app);
 #endif
+  app.footer(trivcon::cli::exit_status_help());  // after the subcommands, which would otherwise inherit it
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // bench_trivcon: how long reading, preparing and editing take, per mesh, and the peak memory.
 //
 //   bench_trivcon [--quick] [--cache DIR] [--dragon PATH] [--json FILE] [--meshes a,b,...]

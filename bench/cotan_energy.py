@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """The energy Σ x_e² / w_e of a connection in the mesh's own clamped cotangent weights
 w_e = ½ (max(cot α, 0) + max(cot β, 0)), computed here from the positions (independently of trivcon's
 geometry), for comparing fields solved with other weights (BENCHMARKS.md "Weights that spread turning").

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The editor's latency in a real browser: `trivcon edit` on each mesh, its page in headless Chromium
 // (puppeteer-core, WebGL through SwiftShader: a CPU rasterizer, so "drawing" here is not a GPU's time).
 //

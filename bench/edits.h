@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // bench/edits.h: the benchmark's edits — a new set of singularities at random vertices each time.
 //
 // An edit moves every singularity to other random interior vertices. Per connected component:

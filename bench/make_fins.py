@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # A flat grid of m x m squares with a fin on every interior edge: about 3m^2 edges with three faces, for
 # timing repair (BENCHMARKS.md "Repair"). Usage: python3 bench/make_fins.py 183 fins.obj
 import sys

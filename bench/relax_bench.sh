@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Relaxation against a plain solve (issue 33's benchmark rows in BENCHMARKS.md, "Relaxation"): 20 singularities at
 # random vertices (14 of +1/4, 6 of -1/4: the sum 2 of a sphere; fixed seeds) on a scan of about 100k faces
 # (armadillo, from ../shared) and on its midpoint subdivision (4x the faces); `solve -s S --relax` and `solve -s S`

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The weight-policy study of BENCHMARKS.md "Weights that spread turning": for each mesh, the singularities
 # of `--auto` and 94 random vertices (±1/4 balanced to the mesh's χ; a mesh with boundary or unused
 # vertices usually gets no random set: the solve refuses it, and the line says FAILED), solved (N = 4)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Finds AMD and CAMD (BSD-3; the orders of src/linalg/symbolic.h, which call them directly) and, as the
 # components CHOLMOD and SPQR, CHOLMOD and SuiteSparseQR (GPL; only a build with TRIVCON_WITH_SUITESPARSE asks
 # for them), as packaged by Debian 12 (libsuitesparse-dev 5.12), which ships headers in /usr/include/suitesparse

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """A complete trivcon session in Python: read a mesh, solve a cross field, edit the singularities and
 re-solve, check the result, write the field in the CLI's formats, and render pictures.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_batch.cpp: the JSON-lines file of `solve --sing-batch` (apps/batch.h read_batch_lines), each
 // item's prescription then checked against the fixed mesh as `solve` does.
 #include <set>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_fixed.cpp: a fixed-direction file (--fix FILE: "FACE x y z" or "FACE angle=A" lines) against the
 // fixed mesh (trivcon/constraints.h read_fixed_directions), then the conflicts `solve` reports for it.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_gltf.cpp: the glTF reader (trivcon/io.h read_gltf), .gltf JSON and .glb, on any bytes.
 #include "fuzz_target.h"
 

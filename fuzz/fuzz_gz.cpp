@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_gz.cpp: a gzipped mesh (read_mesh on "mesh.obj.gz" and the like): the bytes are gunzipped as
 // read_file_bytes does (src/io/gzip.h), then what comes out is read as OBJ, OFF and PLY in turn.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_obj.cpp: the OBJ reader (trivcon/io.h read_obj) on any bytes.
 #include "fuzz_target.h"
 

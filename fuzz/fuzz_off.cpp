@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_off.cpp: the OFF reader (trivcon/io.h read_off) on any bytes.
 #include "fuzz_target.h"
 

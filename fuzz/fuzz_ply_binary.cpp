@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_ply_binary.cpp: the PLY reader (trivcon/io.h read_ply) on any bytes, from binary PLY seeds of
 // both byte orders, every scalar type, extra properties and lists (fuzz_ply_ascii.cpp: ASCII seeds).
 #include "fuzz_target.h"

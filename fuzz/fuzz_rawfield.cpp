@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_rawfield.cpp: a field file (.rawfield) against the fixed mesh, then what `check` does with it: the
 // field's angles and its indices (trivcon/field_io.h read_field, trivcon/field.h).
 #include "io/readers.h"

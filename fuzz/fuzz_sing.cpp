@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_sing.cpp: a plain singularity file (-s FILE: "VERTEX INDEX" lines), read with N = 4 and checked
 // against the fixed mesh as `solve` does (trivcon/indices.h read_singularities, validate_prescription).
 #include "io/readers.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_sings.cpp: a singularity file in Directional's format (-s FILE.sings: "N count", then "vertex n"
 // lines), read with N = 4 and checked against the fixed mesh as `solve` does.
 #include "io/readers.h"

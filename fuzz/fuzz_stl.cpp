@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_stl.cpp: the STL reader (trivcon/io.h read_stl), ASCII and binary, on any bytes.
 #include "fuzz_target.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/fuzz_target.h: what the fuzz targets (fuzz/fuzz_*.cpp, one per reader a user can reach) share.
 //
 // Each target is written once, as

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fuzz/support.cpp: the shared parts of the fuzz targets; see fuzz/fuzz_target.h.
 #include <cmath>
 #include <cstdio>

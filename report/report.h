@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The JSON report of one `solve` design (--report; documented in README.md).
 #pragma once
 #include <nlohmann/json.hpp>

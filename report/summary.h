@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // JSON descriptions shared by `info` and the `solve` report (documented in README.md, "trivcon info --json"),
 // and the clock of the report's timings.
 #pragma once

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Builds trivcon (Release) with its benchmark and runs it: prints the machine and markdown tables
 # (per mesh: reading, topology, geometry, cycles, set-up, edits, peak memory; ours against the
 # paper-literal QR solver; growth exponents; the targets). See BENCHMARKS.md.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Configures and builds trivcon (Release) into build/ (or $BUILD_DIR), after installing dependencies, the
 # editor's too (scripts/deps.sh --web: `trivcon edit` and its page are part of the program; -DTRIVCON_EDITOR=OFF
 # builds without them).

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Builds everything, then computes a cross field (N = 4) on the bundled mesh data/cube_sphere.obj with
 # the eight +1/4 singularities of a cube (data/cube_sphere.sing), writes the field files, a report and a
 # picture (field.png) to demo-output/, and prints the summary. Then the same from Python: the module installed

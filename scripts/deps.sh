@@ -1,5 +1,8 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages trivcon builds and tests with (as root; uses sudo otherwise).
+# SPDX-License-Identifier: MIT
+# Installs the Debian 12 packages trivcon builds and tests with (as root; uses sudo otherwise). The base set
+# includes python3 (the build generates the man page and bash completion with scripts/cli_help.py), dpkg-dev
+# (dpkg-shlibdeps: `cpack -G DEB` computes the package's Depends) and groff-base (the man page's test).
 # Shared by scripts/demo.sh, scripts/test.sh and scripts/bench.sh.
 #   scripts/deps.sh            the C++ build (library, program, tests, benchmark)
 #   scripts/deps.sh --fuzz     also clang's libFuzzer and sanitizer runtimes (scripts/fuzz.sh)
@@ -10,7 +13,8 @@
 #                              puppeteer-core, at the versions of web/package-lock.json) when web/node_modules is not current
 set -euo pipefail
 packages=(build-essential cmake pkg-config zlib1g-dev libeigen3-dev libsuitesparse-dev libopenblas-dev libmetis-dev
-          libcli11-dev nlohmann-json3-dev libtinygltf-dev libgtest-dev libgmock-dev libbenchmark-dev libstb-dev)
+          libcli11-dev nlohmann-json3-dev libtinygltf-dev libgtest-dev libgmock-dev libbenchmark-dev libstb-dev
+          python3 dpkg-dev groff-base)
 web=0
 for extra in "$@"; do
   case "$extra" in

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Fuzzes every reader a user can reach (fuzz/fuzz_*.cpp) with libFuzzer under ASan + UBSan, each for
 # SECONDS seconds, starting from its seed corpus fuzz/corpus/<target>/, and writes a report.
 #   scripts/fuzz.sh 1800                  every target, 30 minutes each

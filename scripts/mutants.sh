@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Mutation testing: a measure of the test suite's power (not part of CI; slow: every mutant rebuilds).
 #
 #   bash scripts/mutants.sh                 # every mutant of scripts/mutants.txt

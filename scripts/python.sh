@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Installs the Python module the README's way into a virtual environment, build/venv (or $VENV), made from
 # Debian's /usr/bin/python3 with --system-site-packages (numpy, pybind11, pytest and Dask from Debian), after
 # installing those packages. Works offline: pip builds with --no-build-isolation.

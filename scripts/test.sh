@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Builds everything and runs all tests: the C++ suite (GoogleTest through CTest), then the Python module,
 # installed the README's way into build/venv, and its pytest suite (scripts/python.sh --test), then the editor's
 # browser tests (scripts/web.sh --test: `trivcon edit` driven in headless Chromium). Tests on the real

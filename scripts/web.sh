@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The editor's page (web/): its dependencies, and its browser tests against the program.
 #   scripts/web.sh --test     web/tests/run.mjs: `trivcon edit` ($BUILD_DIR/trivcon, default build/) on the bundled
 #                             cube sphere, driven in headless Chromium (puppeteer-core); run by scripts/test.sh

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "editor_server.h"
 
 #include <arpa/inet.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // server/editor_server.h: the HTTP server of `trivcon edit` — the page and a JSON API over one FieldDesigner.
 //
 // No numerics here: requests are turned into the library's prescriptions (through the same parsers as

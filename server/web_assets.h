@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The page's files, embedded into the program at build time (web/embed.mjs writes the table from
 // web/index.html and the esbuild bundle of web/src/).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The tests' own reading of a per-face field (test_matching, test_split_large_turns): indices from world
 // directions and dihedral rotations alone, with the principal matching or a given one; and the coarse
 // icosphere whose connection turns by more than π/N across edges.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Shared helpers for the test programs.
 #pragma once
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Automatic singularities (trivcon/auto.h): the smoothest field's singularities, cancellation, and the
 // exact solve with them.
 #include <algorithm>

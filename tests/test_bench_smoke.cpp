@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The benchmark's edit generator (bench/edits.h) produces valid, changing prescriptions that the solver
 // realises. No timing is measured or asserted here.
 #include <gtest/gtest.h>

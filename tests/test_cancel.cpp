@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Cooperative cancellation (trivcon/cancel.h): a set flag stops a set-up, a factorization, the automatic
 // placement and the refinement with trivcon::Cancelled; without a scope nothing is polled; a designer whose
 // factorization was cancelled factors again on its next design.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The Cholesky route's two numeric factorizations (SolverOptions::factorization): trivcon's own on
 // several threads (src/linalg/supernodal.h) and CHOLMOD's cholmod_factorize give the same connection,
 // the same chosen indices and the same energy, on every kind of system (vertex rows only, with cycle

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of the `trivcon` program (apps/): run as a separate process through run_cli(), on meshes
 // generated here and written with trivcon::write_obj / write_ply, and on the shared real meshes.
 // Expected values come from the library (build_topology, compute_geometry, run in this process), from
@@ -12,6 +13,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -82,7 +84,22 @@ Mesh with_extra_vertices(const Mesh& m, int extra) {
 TEST(Cli, Version) {
   const CommandResult r = run_cli("--version");
   EXPECT_EQ(r.status, 0);
-  EXPECT_EQ(r.out, "trivcon 0.1.0\n");
+  // Semantic versioning, MAJOR.MINOR.PATCH: the one version of CMakeLists.txt's project() (CHANGELOG.md).
+  EXPECT_EQ(r.out, std::string("trivcon ") + TRIVCON_VERSION + "\n");
+  EXPECT_TRUE(std::regex_match(r.out, std::regex("trivcon [0-9]+\\.[0-9]+\\.[0-9]+\n"))) << r.out;
+}
+
+// The help ends with the exit statuses, one line each, as the man page's EXIT STATUS shows them.
+TEST(Cli, HelpListsTheExitStatuses) {
+  const CommandResult r = run_cli("--help");
+  EXPECT_EQ(r.status, 0);
+  const std::string heading = "\nExit status:\n";
+  const size_t at = r.out.find(heading);
+  ASSERT_NE(at, std::string::npos) << r.out;
+  std::istringstream lines(r.out.substr(at + heading.size()));
+  std::vector<int> codes;
+  for (std::string line; std::getline(lines, line) && line.rfind("  ", 0) == 0;) codes.push_back(std::stoi(line));
+  EXPECT_EQ(codes, (std::vector<int>{0, 1, 2, 3, 4, 70}));
 }
 
 TEST(Cli, HelpListsTheSubcommands) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `trivcon solve --auto`, `--auto-cancel`, `--sing-out` and `--sing-from-field`, run as a separate process.
 #include <cmath>
 #include <fstream>

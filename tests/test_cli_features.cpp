@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `trivcon solve --align-features / --features / --sharp-out / --field-out *.rosy`, `check` on a .rosy and
 // `render --align-features`, run as a separate process.
 #include <Eigen/Geometry>

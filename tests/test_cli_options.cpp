@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Every documented option of `trivcon solve` and `trivcon check` end to end, through the real program
 // (run_cli), on meshes generated here: the batch mode and its output names, boundary alignment, fixed
 // directions from files, pictures, unit weights, the QR route, prescribed generator and loop indices, the

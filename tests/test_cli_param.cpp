@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `trivcon param`, run as a separate process: the OBJ it writes (the input's vertices and faces, one vt per
 // corner) read back independently, the report, the usage errors.
 #include <cmath>

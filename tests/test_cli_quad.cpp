@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `trivcon quad`, run as a separate process: the quad mesh file read back and checked on its own (only quads,
 // each edge in at most two, χ, boundary loops, valences at the written singularities), the report, --uv-out,
 // --sing-out, PLY output, usage errors.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `trivcon solve --relax` (and `param --relax`), run as a separate process: singularities moved downhill in
 // the field's energy (trivcon/relax.h), reported, written by --sing-out, pins held, usage errors.
 #include <nlohmann/json.hpp>

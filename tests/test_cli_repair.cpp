@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Meshes as users have them, through the program: repaired by default (trivcon/repair.h), every output indexed
 // by the input file, --mesh-out the repaired mesh; --no-repair refuses them with the topology's messages.
 #include <cmath>

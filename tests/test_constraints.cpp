@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Fixed directions (paper Section 2.8) and boundary alignment: exact at the fixed faces, still exactly the
 // prescribed singularities, optimal, and as fast to edit as without constraints.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of trivcon/curvature.h: the per-face curvature tensors behind --align curvature.
 #include "trivcon/curvature.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of trivcon/cycles.h: the generators are 2g closed, non-contractible and independent dual cycles
 // per component, the loop cycles go once around their boundary loop, and the holonomies add up.
 #include "trivcon/cycles.h"

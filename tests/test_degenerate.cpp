@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Degenerate triangles (slivers, needles, zero-area faces, coincident vertices): the default solve stays
 // exact, and the field on a mesh that is a clean mesh with edges split at or next to an endpoint (same
 // surface, more triangles) agrees with the clean mesh's field with the same singularities (paper Fig. 21).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Sharp feature edges (trivcon/features.h): detection, the fixed faces that make a field follow them (with
 // --auto's placement and with singularities given by hand), conflicts at corners, and the .sharp / .rosy
 // files QuadWild reads.

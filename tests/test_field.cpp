@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of trivcon/field.h: propagation reproduces the connection it is given, the indices read off a
 // field (solved or made by hand) are the expected ones and do not see the N-fold symmetry, and the
 // conversions between angles and world directions.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of trivcon/field_io.h: every field format reads back to the field written, the connection file
 // holds the library's x, the lines file draws the field, and the readers name the file and line of each
 // problem.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Independent checks of the formulation (README "Conventions", "Weights and energy"): every expected value
 // here is computed in the test from the vertex positions alone, by hand or with the few lines of geometry
 // below (cotangents, corner angles, polar angles in the plane), never with the library's weight, angle,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Replays the fuzz targets (fuzz/fuzz_*.cpp, compiled into this program without libFuzzer; see
 // fuzz/fuzz_target.h) on their seed corpus (fuzz/corpus/<target>/) and on every input a fuzzer found a
 // crash, hang or leak with (tests/fuzz_regressions/<target>/, kept after the reader was fixed): each input

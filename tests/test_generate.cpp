@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of trivcon/generate.h. Every property is recomputed here from V and F alone (no use of
 // topology.h), so a bug shared by the generators and the library's connectivity code cannot hide.
 #include "trivcon/generate.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of src/connection/generator_rounding.h: Babai's nearest-plane rounding, which chooses the free
 // whole numbers of a solve (generator and loop indices, fixed-face path turns). nearest_lattice_point, which
 // adds single steps on top of it, is tested through the solver (test_solver.cpp, test_formulation.cpp).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of trivcon/geometry.h: the documented conventions (frames, half-edge angles, ρ, cotan weights),
 // Gauss–Bonnet, degenerate faces, and wrap_angle. Expected values are recomputed from the positions.
 #include "trivcon/geometry.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The glTF reader (trivcon/io.h read_gltf, by extension in read_mesh): a .gltf with an embedded buffer and the
 // same as .glb, node transforms applied, every triangle primitive its own block of vertices, strips and fans;
 // errors name the file and the primitive.

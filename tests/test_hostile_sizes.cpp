@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Hostile sizes: headers and list counts that claim more than the file can hold (10^12 vertices, a face
 // of 2^31 corners, ...). Each must give a trivcon::Error that names the claim and what the file has, with
 // bounded memory: every read here runs in a child process (fork) whose address space may grow by at most

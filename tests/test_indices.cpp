@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of trivcon/indices.h: parsing indices, specs and singularity files (plain and Directional's
 // .sings), formatting, and validating a prescription against a mesh, with the exact messages.
 #include "trivcon/indices.h"

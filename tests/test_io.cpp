@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // tests/test_io.cpp: the mesh readers and writers of trivcon/io.h.
 //
 // Small hand-written files cover every accepted variant of OBJ, OFF and PLY (ASCII and binary of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Matchings (trivcon/matching.h, --matching-out, check --matching): an independent principal matching, read
 // from the field's world directions alone, sees other singularities where the connection turns by π/N or
 // more; with the matching trivcon exports, an independent index computation finds exactly the prescription.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The fill-reducing orders of src/linalg/ordering.h (internal): the coordinate dissection against AMD and
 // against the fill it must avoid, through CHOLMOD's own symbolic analysis.
 #include <cholmod.h>

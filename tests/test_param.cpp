@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/param.h: the integer-grid map on generated meshes with known answers. Every test checks what the
 // map promises from the (u, v) alone (transitions, cones, iso-lines, flips), not the solver's own report only.
 #include <gtest/gtest.h>

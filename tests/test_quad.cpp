@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/quad.h: quad meshes extracted from integer-grid maps of generated meshes with known answers. Every test
 // checks the quads from (V, Q) alone with the small counts below (edges, orientation, χ, boundary loops, valences,
 // distance to the input), not the extraction's own report only.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Singularity relaxation (trivcon/relax.h): singularities spread apart on a sphere and reach a cube's
 // corners; the energy only decreases and the result verifies; pins hold; the duals give the exact first-order
 // change of every candidate and the estimate its second order; opposite indices cancel when that helps.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of trivcon/render.h and trivcon/streamlines.h, and of `trivcon render`, on generated meshes with
 // fields designed by trivcon::FieldDesigner. Geometric checks (points on faces, tangency, adjacency) are
 // recomputed here from V and F.

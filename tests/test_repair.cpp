@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/repair.h: duplicates dropped, non-manifold edges cut, fans split; the result is a manifold mesh the
 // topology accepts, with maps back to the input's faces and vertices.
 #include <gtest/gtest.h>

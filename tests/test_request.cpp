@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/request.h: one request, the same meaning in every front end (the CLI, the editor and Python are
 // tested against it through their own files; here the layer itself).
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of the editor's server (server/editor_server.h): every endpoint, its answers checked for what
 // they mean (unit tangent directions, the prescription honoured, the CLI's error texts), and the refusals
 // (token, origin, content type, Host, body size, malformed requests), against a server started in-process

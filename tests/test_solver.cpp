@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The trivial-connection solve: exact constraints, no spurious singularities, optimality, agreement of
 // the Cholesky and QR routes, invariance under renumbering, and the defects of other implementations
 // listed in ../shared/notes/peers.md.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Refinement where the connection turns by π/N or more (trivcon/split_large_turns.h, --split-large-turns): the
 // split keeps ids, surface and orientation; afterwards any matching, even one computed from the directions
 // alone, reads exactly the prescription; fixed directions carry over; the library function's rounds.

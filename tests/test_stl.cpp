@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The STL reader (trivcon/io.h read_stl, by extension in read_mesh): ASCII and binary, corners welded by exact
 // position into vertices numbered in order of first appearance; the errors name the file and the triangle.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The numeric supernodal factorization (src/linalg/supernodal.h, internal) against CHOLMOD's own, on the same
 // symbolic factorization; the split of the elimination tree it and the backward substitution use; and the
 // parallel substitution (src/linalg/substitution.h) against CHOLMOD's solve.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon's own symbolic analysis (src/linalg/symbolic.h, internal) against a brute-force symbolic Cholesky
 // factorization and against CHOLMOD's (cholmod_analyze_p with the same order), its AMD and CAMD orders against
 // CHOLMOD's, and the numeric factorization of src/linalg/supernodal.h on its structure. The comparisons with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Tests of trivcon/topology.h (build_topology, check_finite); the geometry on top of it is in
 // test_geometry.cpp. Expected values come from the generators' documented formulas, from brute-force
 // recomputation on F alone (test::expect_consistent), and, for the real meshes, from the table in

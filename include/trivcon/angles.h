@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/angles.h: the three ways trivcon brings an angle (radians) into a range, each written once.
 //   wrap_angle(a)      into (−π, π]            a rotation (transport ρ_e, a connection's turn, a jump)
 //   wrap_two_pi(a)     into [0, 2π)            a field's stored angle (trivcon/field.h)

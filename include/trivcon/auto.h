@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/auto.h: singularities found automatically, from the globally smoothest N-direction field
 // (Knöppel, Crane, Pinkall & Schröder 2013, face-based). The method, its weights, the eigen-solve and the
 // reasons for each choice: docs/auto.md.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/blas.h: which BLAS kernels the factorization runs on, and how many threads each BLAS call uses.
 //
 // The supernodal factorization (src/linalg/supernodal.h) spends most of its time in BLAS (dgemm, dsyrk, dtrsm). Debian 12's

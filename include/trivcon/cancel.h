@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/cancel.h: stopping a long call from another thread (a front end's Ctrl-C).
 //
 // A front end that runs a long call (a FieldDesigner's set-up and factorization, automatic singularities,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/common.h: the types and constants every part of the library shares.
 //
 // - Meshes are libigl-style plain arrays: V is n×3 double (one row per vertex), F is m×3 int (one row

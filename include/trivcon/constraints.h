@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/constraints.h: fixed directions at faces (paper Section 2.8) and boundary alignment.
 //
 // A fixed face f holds a direction γ_f (an angle in f's frame, trivcon/geometry.h); the field must equal

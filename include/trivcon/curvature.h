@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/curvature.h: principal curvature directions per face, as guidance for fields (trivcon/auto.h).
 //
 // Conventions

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/cycles.h: the dual cycles whose holonomy a trivial connection must control (paper 2.1, 2.6).
 //
 // A dual cycle is a closed walk over faces, stored as signed interior edges: sign +1 where the walk

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/design.h: the whole pipeline on plain (V, F) — validate, prepare once, then design fields.
 //
 //   trivcon::FieldDesigner designer(V, F);          // topology, geometry, cycles (factorization on first use)

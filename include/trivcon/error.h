@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/error.h: the one exception type the library throws.
 //
 // Every error a user can cause (bad file, bad mesh, bad singularity, infeasible constraints) is

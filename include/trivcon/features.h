@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/features.h: sharp feature edges, and the fixed directions that make a field follow them.
 //
 // Conventions

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/field.h: direction fields from a connection (paper Section 2.7), and the indices of any field.
 //
 // A field stores one angle per face, in the face's frame (trivcon/geometry.h): the first of its N

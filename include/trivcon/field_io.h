@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/field_io.h: the files `trivcon solve` writes, and the readers that take them back.
 //
 // Formats (all ids 0-based and the input file's own; faces in file order after fan triangulation):

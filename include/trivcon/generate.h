@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/generate.h: meshes built in code, for tests that must run anywhere and for benchmarks.
 //
 // Every generator returns a consistently oriented manifold triangle mesh (outward normals for

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/geometry.h: the intrinsic and extrinsic geometry the trivial-connection solver needs.
 //
 // Conventions (all angles in radians)

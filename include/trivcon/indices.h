@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/indices.h: what the user prescribes — singular vertices, and the turning of the field around
 // generators and boundary loops — and how it is read and checked.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/io.h: reading and writing triangle meshes (OBJ, OFF, PLY, and the same gzipped).
 //
 // Conventions

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/matching.h: how the N directions of neighbouring faces are paired, which a per-face field
 // does not store, and what a tool that computes its own pairing will read from our field.
 //

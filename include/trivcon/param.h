@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/param.h: a seamless integer-grid parametrization from a cross field (N = 4) and its trivial
 // connection (Kälberer, Nieser & Polthier 2007; Bommes, Zimmer & Kobbelt 2009), the map a quad mesh is
 // extracted from (trivcon/quad.h). The mathematics and its choices: docs/param.md.

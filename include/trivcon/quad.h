@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/quad.h: the quad mesh of a seamless integer-grid map (trivcon/param.h): the integer points of the map
 // are its vertices, the integer iso-lines between them its edges (in the manner of QEx: Ebke, Bommes, Campen &
 // Kobbelt 2013). The steps and what happens on folded maps: docs/quad.md.

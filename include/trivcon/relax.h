@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/relax.h: singularity relaxation — moving the prescribed singularities, one edge at a time,
 // to where the field is smoother (lower Connection::energy), keeping their indices.
 //

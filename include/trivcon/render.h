@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/render.h: pictures of a field on its surface, rendered in software to a PNG (no display, no GPU).
 //
 // Typical use, after a design (this is all `trivcon solve --png` needs):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/repair.h: a mesh as users have it made manifold, with maps back to the input.
 //
 // What repair_mesh does, in this order:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/request.h: one field request, as every front end states it (the CLI's options, the editor's JSON,
 // Python's keywords), turned into a design. The front ends parse and print; what a request means is here.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/solver.h: the trivial connection closest to Levi-Civita (paper Sections 2.3–2.6, 3).
 // How it is solved and why (the two routes, ordering, edits, refinement, fixed-face paths, free indices):
 // docs/solver.md.

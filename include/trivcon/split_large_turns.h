@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/split_large_turns.h: refining a mesh where the connection turns by π/N or more, so that every consumer's
 // own matching reads exactly the prescribed singularities (solve --split-large-turns).
 //

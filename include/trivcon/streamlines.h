@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/streamlines.h: integral curves of a per-face direction field (the paper's Figure 16 "ribbons"),
 // and deterministic, evenly spread sample points on a surface.
 //

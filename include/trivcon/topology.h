@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/topology.h: connectivity, validation and topological invariants of a triangle mesh.
 //
 // Conventions

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/tuned_process.h: what a program's process must be started with to run trivcon at full speed.
 //
 // Three settings are read only when a process starts, so a program cannot change them once it runs:

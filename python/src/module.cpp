@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon._core: the pybind11 extension behind the `trivcon` Python package (python/trivcon/).
 //
 // This file holds no numerics: every function converts arrays, calls the library (trivcon/*.h) and converts

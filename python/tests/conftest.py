@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Shared fixtures: meshes built in code, the CLI binary, the shared real meshes (skipped when absent)."""
 
 import os

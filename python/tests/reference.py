@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """An independent reference for the tests: the paper's quantities recomputed in numpy from (V, F) alone.
 
 Nothing here calls trivcon: frames, corner angles, angle defects, edges with their faces, the Levi-Civita

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Arrays in, arrays out: singularities as index arrays, all N directions per face, read-only arrays, and the
 same short message for every too-large index."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """The Dask batch (python -m trivcon.batch) on a local cluster of two worker processes."""
 
 import json

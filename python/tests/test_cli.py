@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """The module agrees with the `trivcon` program (build/trivcon, or $TRIVCON_CLI) on the same input."""
 
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Docstrings everywhere, help(trivcon) reads well, and the examples/ script runs."""
 
 import inspect

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Wrong shapes, dtypes and indices raise the documented errors; library errors carry the CLI's message."""
 
 import math

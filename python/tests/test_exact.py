@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Result.field_exact: whether the per-face field, read on its own, shows exactly the prescription.
 
 `verified` is about the connection (its holonomy, the field's transport by it); a field sampled once per face

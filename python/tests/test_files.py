@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Files: meshes, fields, singularities and pictures, in the CLI's formats, with the file's own ids."""
 
 import gzip

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Long calls release the GIL: another Python thread runs while they work.
 
 No clocks: the switch interval is made huge, so that a thread holding the GIL is never made to hand it over;

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Ctrl-C: a long call raises KeyboardInterrupt within a fraction of a second of SIGINT, the abandoned work
 stops, and the module (and the designer) stay usable.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Result.parametrize: the seamless integer-grid map from Python, checked from the (u, v) alone, and against the
 `trivcon param` program."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """FieldDesigner, Result and AutoResult pickle: through pickle, a multiprocessing worker and a Dask worker they
 come back giving the same values (a Result is not solved again; a designer is prepared again and factors on
 its first solve)."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Result.quad and Parametrization.quads: the quad mesh from Python, checked from (V, Q) alone and against
 `trivcon quad`."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """FieldDesigner.relax and solve(relax=True): singularities moved downhill in the field's energy, from Python,
 checked against real solves and against `trivcon solve --relax`."""
 

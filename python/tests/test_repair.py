@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Meshes as users have them: FieldDesigner repairs what is not manifold (repair=True, the default), says so, and
 writes the input's faces and vertices, as the CLI does; repair=False refuses with the topology's message."""
 import pickle

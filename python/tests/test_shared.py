@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Real meshes from ../shared/data/meshes (skipped with a message when the folder is absent)."""
 
 import os

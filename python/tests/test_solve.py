@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Solves judged by the independent reference (reference.py): holonomy, transport, indices read back."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """threads=: per designer (OpenMP's count on the thread that runs each call, OpenBLAS single-threaded while a
 one-thread call runs), the module's default (set_threads, TRIVCON_THREADS), and the same fields whatever
 the count. _core.probe_threads(k) reports what a call with k threads sees from inside."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Type information: __all__ is the public namespace, and the .pyi stubs with py.typed are installed beside
 the module and describe it (every public name, method and property, with the module's parameters)."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """trivcon: direction fields on triangle meshes with exactly the singularities you ask for.
 
 Vector fields (N = 1), line fields (N = 2), cross fields (N = 4), any N: the trivial connection closest

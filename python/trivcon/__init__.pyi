@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Type stubs of the trivcon package (python/trivcon/__init__.py; see its docstrings for what each does).
 # Installed beside the module with py.typed (PEP 561). python/tests/test_types.py checks that every public
 # name and every parameter here matches the module.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 """Solve many meshes on a Dask cluster: python3 -m trivcon.batch MESH... --out DIR.
 
     python3 -m trivcon.batch meshes/*.obj --out results -N 4                  # automatic singularities

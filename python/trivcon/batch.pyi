@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Type stubs of trivcon.batch (python/trivcon/batch.py; see its docstrings).
 from typing import Any, Dict, List, Optional, Sequence, TextIO, Tuple
 

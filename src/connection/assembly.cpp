@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The constraint system as matrices (src/connection/assembly.h).
 #include "connection/assembly.h"
 

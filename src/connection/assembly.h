@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/connection/assembly.h (internal): the constraint system of the trivial connection as matrices
 // (trivcon/solver.h states the system and its signs; docs/solver.md which rows it has and why).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The Cholesky route of ConnectionSolver (src/connection/cholesky_engine.h).
 #include "connection/cholesky_engine.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/connection/cholesky_engine.h (internal): the default route of ConnectionSolver (trivcon/solver.h).
 //
 // One supernodal Cholesky factorization R Rᵀ = Π M Πᵀ of the whole normal matrix

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Choosing free indices by lattice rounding (src/connection/generator_rounding.h).
 #include "connection/generator_rounding.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/connection/generator_rounding.h (internal): choosing the free whole numbers of a solve (generator and loop
 // indices, fixed-face path turns) so that the field is smoothest.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/indices.h: the checks of a prescription against a mesh (the text of indices is read in
 // src/io/singularity_files.cpp).
 #include "trivcon/indices.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The QR route of ConnectionSolver (src/connection/qr_engine.h).
 #include "connection/qr_engine.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/connection/qr_engine.h (internal): the paper-literal route of ConnectionSolver (SolverKind::QR): the
 // minimum-norm solution of the full weighted constraint system by SuiteSparseQR, from one QR
 // factorization of (A W^½)ᵀ reused for every right-hand side (x = W^½ Q R⁻ᵀ Eᵀ b, as SPQR's min2norm).

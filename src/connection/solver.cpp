@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The trivial connection closest to Levi-Civita (trivcon/solver.h): the constraint rows, the weights and
 // their regularization, the right-hand sides of a prescription, the choice of free indices, and the
 // result. The factorizations are src/connection/cholesky_engine.h and qr_engine.h, the matrices

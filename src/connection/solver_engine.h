@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/connection/solver_engine.h (internal): what ConnectionSolver asks of a factorization of its constraint
 // system (trivcon/solver.h): the Cholesky route (cholesky_engine.h) or the QR route (qr_engine.h).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Verification of a connection against every holonomy constraint (trivcon/solver.h verify_connection).
 #include <algorithm>
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "trivcon/features.h"
 
 #include <Eigen/Geometry>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Matchings of a per-face field across edges (trivcon/matching.h).
 #include "trivcon/matching.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Singularity relaxation (trivcon/relax.h): candidates ranked by the vertex duals, verified by real solves.
 #include "trivcon/relax.h"
 

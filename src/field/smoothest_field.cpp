@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Automatic singularities from the globally smoothest field (trivcon/auto.h).
 #include "trivcon/auto.h"
 #include "trivcon/cancel.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "trivcon/split_large_turns.h"
 
 #include <numeric>

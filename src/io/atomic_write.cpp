@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/atomic_write.cpp: write_file_atomically (trivcon/io.h), through which all of trivcon's outputs are
 // written: a fresh temporary file beside the target, renamed into place once it is complete.
 #include "trivcon/io.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/features.h: the text of feature edges: 'i j' files (--features) and QuadWild's .sharp.
 #include <algorithm>
 #include <sstream>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "trivcon/field_io.h"
 
 #include <Eigen/Geometry>

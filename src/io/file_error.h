@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/file_error.h (internal): the errors of the mesh file readers, which name the file and,
 // in text formats, the 1-based line ("mesh.obj:12: ..."); binary offsets go into the message.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/constraints.h: the text of fixed directions: --fix specs and files of 'FACE x y z' / 'FACE angle=A'.
 #include <cmath>
 #include <limits>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/gzip.cpp: gzip decompression with zlib; see src/io/gzip.h.
 #include "io/gzip.h"
 

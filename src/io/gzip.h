@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/gzip.h (internal): decompressing a whole gzip file in memory, for the mesh readers.
 #pragma once
 #include <string>

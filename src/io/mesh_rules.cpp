@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/mesh_rules.cpp: the checks and messages the mesh readers and writers share; see src/io/mesh_rules.h.
 #include "io/mesh_rules.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/mesh_rules.h (internal): what every mesh reader checks (counts, finite coordinates, index
 // ranges, polygons) with the messages it gives, and how it collects the faces. The writers check the
 // same (src/io/write_mesh.cpp), so that everything they write reads back identically.

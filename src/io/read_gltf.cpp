@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/read_gltf.cpp: glTF 2.0 (.gltf with embedded or external buffers, .glb) through tinygltf (MIT, Debian's
 // libtinygltf-dev; its JSON is nlohmann's). Images are never decoded. Every triangle primitive (mode 4, and
 // strips and fans, turned into triangles) of the meshes of the default scene's nodes (scene 0 without a

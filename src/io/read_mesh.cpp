@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/read_mesh.cpp: reading a mesh file by its extension (trivcon/io.h): the whole file into memory,
 // gunzipped when it ends in .gz, then the reader of its format (src/io/read_obj.cpp, read_off.cpp, read_ply.cpp, read_stl.cpp, read_gltf.cpp).
 #include "trivcon/io.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/read_obj.cpp: the Wavefront OBJ reader of trivcon/io.h (v and f lines; everything else is skipped).
 // Why hand-written, and the scanner it shares with the other text readers: src/io/text_scanner.h.
 #include "trivcon/io.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/read_off.cpp: the Geomview OFF reader of trivcon/io.h (ASCII [ST][C][N]OFF, 3-D).
 // Why hand-written, and the scanner it shares with the other text readers: src/io/text_scanner.h.
 #include "trivcon/io.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/read_ply.cpp: the PLY reader of trivcon/io.h (ascii, binary_little_endian, binary_big_endian): the
 // header's types, elements and properties, and one body loop over both encodings (PlyAsciiSource,
 // PlyBinarySource). Why hand-written, and the scanner the header and ASCII data are read with:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/read_stl.cpp: the STL reader of trivcon/io.h, ASCII and binary. STL stores every triangle with its own
 // three corners; they are welded into vertices by exact position (the same three doubles), numbered in the order
 // of first appearance, so that a mesh that was one surface before it was written as STL is one again. A

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/readers.h (internal): the readers of singularity, fixed-direction and field files on a file's
 // bytes in memory. The public functions (trivcon/indices.h read_singularities, trivcon/constraints.h
 // read_fixed_directions, trivcon/field_io.h read_field) read the whole file with read_file_bytes (gunzipped

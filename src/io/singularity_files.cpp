@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/indices.h: the text of indices: "p/q" specs, singularity files (ours and Directional's .sings).
 #include "trivcon/indices.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal: the lines of a small text file (field, matching, feature-edge files), for readers that go line by
 // line and name "path:line" in their errors.
 #pragma once

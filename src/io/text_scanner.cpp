@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/text_scanner.cpp: quoting and number parsing for the text mesh readers; see src/io/text_scanner.h.
 #include "io/text_scanner.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/text_scanner.h (internal): what the text mesh readers (OBJ, OFF, ASCII PLY) share: the
 // line and token scanner, number parsing, and quoting tokens for messages. The PLY header is text too.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/io.h: the (u, v) per corner of an OBJ with texture coordinates (what `param -o` writes, or any OBJ
 // whose faces are the mesh's triangles with 'v/vt' corners).
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/io/write_mesh.cpp: the mesh writers of trivcon/io.h, OBJ (text, 17 significant digits) and binary
 // little-endian PLY (doubles). They refuse what the readers would reject (src/io/mesh_rules.h), so that
 // everything written reads back identically, and write through write_file_atomically.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "trivcon/blas.h"
 
 #include <dlfcn.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Cooperative cancellation of long calls (trivcon/cancel.h).
 #include "trivcon/cancel.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The CHOLMOD adaptor (src/linalg/cholmod.h): workspaces and views. Compiled only with TRIVCON_WITH_SUITESPARSE.
 #include "linalg/cholmod.h"
 

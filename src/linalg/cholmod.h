@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/linalg/cholmod.h (internal): the one adaptor between trivcon and CHOLMOD / SuiteSparseQR, in a build with
 // TRIVCON_WITH_SUITESPARSE only (CHOLMOD's Debian build contains GPL modules, SuiteSparseQR is GPL: the default
 // build links neither; docs/solver.md).

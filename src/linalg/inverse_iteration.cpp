@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "linalg/inverse_iteration.h"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/linalg/inverse_iteration.h (internal): the smallest eigenvector of A x = λ M x (A Hermitian positive
 // definite, factored; M diagonal, non-negative) by inverse power iteration, for several independent groups of
 // unknowns at once (a mesh's components: A has no entries between groups), with an affine term d (Dirichlet

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The check of the numeric libraries (src/linalg/numeric_libraries.h), beside src/linalg/blas.cpp.
 #include "linalg/numeric_libraries.h"
 

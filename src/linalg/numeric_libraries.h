@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/linalg/numeric_libraries.h (internal): the run-time check of the numeric libraries.
 //
 // The hand-written numeric factorization and substitutions (src/linalg/supernodal.h, src/linalg/substitution.h)

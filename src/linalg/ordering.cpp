@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "linalg/ordering.h"
 
 #include <algorithm>

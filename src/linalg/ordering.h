@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal: fill-reducing orders and their elimination trees.
 // - The pattern and elimination tree of the normal matrix's vertex block, to postorder a fill-reducing order
 //   (see vertex_order in src/connection/cholesky_engine.cpp).

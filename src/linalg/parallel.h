@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/linalg/parallel.h (internal): when the library's loops and passes run on several threads.
 //
 // Thread counts come from OpenMP's setting (OMP_NUM_THREADS, omp_set_num_threads; by default the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/linalg/sparse_cholesky.h (internal): a sparse symmetric positive definite solve, A x = b, for the
 // layers that need one without the trivial-connection solver's structure (the integer-grid map of
 // src/quad/). The order (AMD, through libamd), the symbolic analysis, the numeric factorization and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal: solves with a numeric supernodal Cholesky factor (L Lᴴ x = b) on several threads.
 //
 // Why not cholmod_solve: CHOLMOD 3 (Debian 12) visits the supernodes one after another, on one core, with a

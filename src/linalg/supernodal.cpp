@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "linalg/supernodal.h"
 
 #include <omp.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal: the numeric supernodal Cholesky factorization behind ConnectionSolver, on several threads.
 //
 // trivcon's own symbolic analysis (src/linalg/symbolic.h, docs/solver.md) gives the supernodal structure; this

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal: the symbolic analysis of a sparse Cholesky factorization, and the minimum degree orders it is given.
 //
 // Given the pattern of a symmetric matrix A and a fill-reducing order, symbolic_analysis() computes the

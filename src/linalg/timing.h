@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/linalg/timing.h (internal): wall-clock seconds for the per-stage timings the library reports.
 #pragma once
 #include <chrono>

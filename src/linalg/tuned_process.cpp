@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "trivcon/tuned_process.h"
 
 #include <unistd.h>

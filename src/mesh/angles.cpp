@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/angles.h: bringing angles into range.
 #include "trivcon/angles.h"
 

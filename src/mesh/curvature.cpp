@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Principal curvature directions per face (trivcon/curvature.h).
 #include "trivcon/curvature.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // generate.cpp: meshes built in code (see trivcon/generate.h).
 //
 // All generators write into a MeshBuilder; grids of quads go through add_quad_grid so that the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/repair.h: duplicates dropped, non-manifold edges cut into sheets, fans split into vertices.
 #include "trivcon/repair.h"
 

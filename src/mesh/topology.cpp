@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Connectivity and validation in (near) linear time: half-edges are bucketed by their smaller vertex
 // (counting sort), so matching the two sides of an edge costs O(degree) per vertex. Above 50k faces the
 // independent passes (non-manifold vertices and orientation; the vertex-face and vertex-edge lists) run

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The quad mesh of an integer-grid map (trivcon/quad.h; the steps and the folds: docs/quad.md).
 //
 // Stages: exact charts (the map's (u, v) as whole multiples of 2⁻²⁰, one value per vertex carried around its fan

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The integer-grid map (trivcon/param.h; the mathematics: docs/param.md).
 //
 // Stages: the cut and the combing (which of the four directions is u in each face), the corners grouped

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What a quad mesh promises, measured on (V, Q) against the input surface and the map's cones (trivcon/quad.h,
 // check_quads), and the one-sentence warning.
 #include <Eigen/Geometry>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // trivcon/request.h: a field request turned into a design, once for every front end.
 #include "trivcon/request.h"
 

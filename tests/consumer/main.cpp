@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A user's program on the installed library's public API (trivcon/design.h on plain (V, F) arrays):
 // a cross field on a cube-like sphere with +1/4 at the eight cube corners (its only vertices of valence
 // 3), then an edit that moves two of them. Exits 0 only if both solves are exact and the indices read back

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Run by CTest (InstallConsumer.FindPackage): installs BUILD_DIR into WORK_DIR/prefix, then builds the
 # consumer project in SOURCE_DIR with only CMAKE_PREFIX_PATH set, and runs it (it exits 0 when its two
 # solves are exact). Any failing step fails the test with that step's output.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The server's API (README.md, "Editor"): every call sends the token as the X-Trivcon-Token header.
 
 // The token comes in the page's address (?token=…, as `trivcon edit` prints it). It is kept in this tab's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The field drawn as short crosses on the surface: for even N, N/2 lines through a point; for odd N, N rays
 // out of it. The vertex shader turns each face's first direction about its normal into the others, so a new
 // field costs one copy of the drawn glyphs' directions and their upload.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Index texts and the Gauss–Bonnet readout, as trivcon/indices.h defines them: an index is n/N, written
 // as a reduced fraction ("1/4", "-1/2") or an integer; on every component the vertex indices plus the
 // boundary-loop indices sum to χ (a component with a loop left free balances through it).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The page of `trivcon edit`: the mesh, the field drawn on it, and the edits that re-solve it through the
 // server (src/api.js). All numerics are the server's; this file keeps the session (singularities, fixed
 // directions, cycle indices), its history, and draws.

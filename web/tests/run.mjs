@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Browser tests of `trivcon edit`: the real program serving the real page, driven in headless Chromium
 // (puppeteer-core, Debian's /usr/bin/chromium, WebGL through SwiftShader: see ../../../shared/notes/browser.md).
 //   node web/tests/run.mjs [--trivcon PATH] [--mesh PATH --sing PATH]
