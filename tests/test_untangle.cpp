@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // src/quad/untangle.h: the local untangling opens folded maps with the held unknowns held, and leaves an
 // unfolded map unfolded; checked on the determinants computed here from the corners, not on its own report.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The local untangling of a map (src/quad/untangle.h).
 #include "quad/untangle.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Internal: removes the folds a map keeps, locally, with the map's exact relations held (used by
 // src/quad/param.cpp after the rounding; the mathematics: docs/param.md, "Untangling").
 //
