@@ -1,4 +1,4 @@
-// The JSON report of one `solve` design (--report; documented in README.md).
+// The JSON report of one `solve` design (--report; documented in docs/reference/report.md).
 #pragma once
 #include <nlohmann/json.hpp>
 #include <string>

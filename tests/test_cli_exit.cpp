@@ -1,4 +1,4 @@
-// The exit statuses of the `trivcon` program, end to end (README.md, "Exit status"): 0 success (also
+// The exit statuses of the `trivcon` program, end to end (docs/reference/exit-codes.md): 0 success (also
 // --help and --version), 1 bad input, 2 usage error (whatever CLI11's own code for it), 3 `solve`
 // verification failed, 4 `check` found indices that differ from the prescription. Meshes are generated
 // here and written with trivcon::write_obj.
