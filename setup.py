@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Builds the trivcon Python package: CMake compiles the extension trivcon._core (python/src/module.cpp)
 against the repository's static library (CMakeLists.txt with -DTRIVCON_PYTHON=ON); setuptools packages it
-with python/trivcon/. Metadata is in pyproject.toml. Install, offline on Debian 12 (README, "Python"):
+with python/trivcon/. Metadata is in pyproject.toml. Install, offline on Debian 12 (docs/tutorials/python.md):
 
     /usr/bin/python3 -m venv --system-site-packages venv && venv/bin/pip install --no-build-isolation .
 

@@ -16,7 +16,7 @@ void register_info(CLI::App& app) {
   static bool json = false, with_cycles = false;
   static MeshOptions mesh_options;
   cmd->add_option("mesh", path, "Mesh file: .obj .off .ply .stl .gltf .glb, optionally .gz")->required();
-  cmd->add_flag("--json", json, "Print JSON (format documented in README.md)");
+  cmd->add_flag("--json", json, "Print JSON (format documented in docs/reference/report.md)");
   cmd->add_flag("--cycles", with_cycles, "Also list the generators and boundary loops whose index solve can set");
   add_mesh_options(cmd, mesh_options);
   cmd->callback([&] {

@@ -12,7 +12,7 @@
 
 namespace trivcon::cli {
 
-// The program's exit statuses (README.md, "Exit status").
+// The program's exit statuses (docs/reference/exit-codes.md).
 enum ExitStatus : int {
   kSuccess = 0,
   kBadInput = 1,            // a trivcon::Error: bad input, a file that cannot be read or written; out of memory

@@ -6,7 +6,7 @@ geometry), for comparing fields solved with other weights (BENCHMARKS.md "Weight
     /usr/bin/python3 bench/cotan_energy.py MESH CONNECTION        (CONNECTION: solve --connection-out)
 
 Prints the energy over the edges of positive weight and how many edges of weight 0 carry a turn.
-Reads the mesh with the trivcon module (PYTHONPATH as README "Python").
+Reads the mesh with the trivcon module (installed as docs/tutorials/python.md says).
 """
 import sys
 

@@ -6,7 +6,7 @@ re-solve, check the result, write the field in the CLI's formats, and render pic
     python3 examples/cross_field.py mesh.obj --out DIR     # your mesh, singularities found automatically
     python3 examples/cross_field.py mesh.obj -s mesh.sing  # your mesh and singularities
 
-Install the module first (README, "Python"): pip install --no-build-isolation . in a venv.
+Install the module first (docs/tutorials/python.md): pip install --no-build-isolation . in a venv.
 """
 
 import argparse

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The JSON report of one `solve` design (--report; documented in README.md).
+// The JSON report of one `solve` design (--report; documented in docs/reference/report.md).
 #pragma once
 #include <nlohmann/json.hpp>
 #include <string>

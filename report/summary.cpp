@@ -35,7 +35,7 @@ nlohmann::ordered_json mesh_summary(const std::string& path, const MeshData& mes
   j["degenerate_faces"] = g.degenerate_faces;
   j["reoriented_faces"] = t.flipped_faces.size();
   j["negative_cotan_edges"] = g.negative_cotan_edges;
-  // The weight policy (README "Weight policy", trivcon/geometry.h): what it touched on this mesh.
+  // The weight policy (docs/explanation/weights.md, trivcon/geometry.h): what it touched on this mesh.
   j["mollified_faces"] = g.mollified_faces;
   j["mollify_epsilon"] = g.mollify_epsilon;
   j["clamped_cotangents"] = g.clamped_cotangents;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// JSON descriptions shared by `info` and the `solve` report (documented in README.md, "trivcon info --json"),
+// JSON descriptions shared by `info` and the `solve` report (documented in docs/reference/report.md, "info --json"),
 // and the clock of the report's timings.
 #pragma once
 #include <chrono>

@@ -189,7 +189,7 @@ def write_man(info, path):
             out += [".TP", f".B {roff(code)}", roff(desc)]
     if top["footer"]:
         out += [".SH NOTES", roff(top["footer"])]
-    out += [".SH SEE ALSO", "The README.md of trivcon's source (file formats, conventions, the library and the Python module)."]
+    out += [".SH SEE ALSO", "The documentation site (scripts/docs.sh builds it into build/docs from docs/ in trivcon's source): tutorials, file formats, conventions, the C++ library and the Python module."]
     write(path, "\n".join(out) + "\n")
 
 

@@ -11,6 +11,7 @@
 #   scripts/deps.sh --web      also the editor's (`trivcon edit`): cpp-httplib, Chromium for the browser tests, node and
 #                              npm (Debian's, unless a node is already installed), then `npm ci` in web/ (three, esbuild,
 #                              puppeteer-core, at the versions of web/package-lock.json) when web/node_modules is not current
+#   scripts/deps.sh --docs     also the documentation site's (scripts/docs.sh): Sphinx, furo, breathe, doxygen, myst-parser
 set -euo pipefail
 packages=(build-essential cmake pkg-config zlib1g-dev libeigen3-dev libsuitesparse-dev libopenblas-dev libmetis-dev
           libcli11-dev nlohmann-json3-dev libtinygltf-dev libgtest-dev libgmock-dev libbenchmark-dev libstb-dev
@@ -21,10 +22,11 @@ for extra in "$@"; do
     --python) packages+=(python3 python3-dev python3-venv python3-pip python3-setuptools python3-wheel python3-numpy pybind11-dev
                          python3-pybind11 python3-pytest python3-distributed) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev libomp-14-dev) ;;  # libFuzzer, its sanitizer runtimes, OpenMP for clang
+    --docs) packages+=(python3-sphinx furo python3-breathe doxygen python3-myst-parser) ;;
     --web) web=1
            packages+=(libcpp-httplib-dev chromium)
            command -v npm >/dev/null 2>&1 || packages+=(nodejs npm) ;;
-    *) echo "deps.sh: unknown option $extra (known: --python, --fuzz, --web)" >&2; exit 2 ;;
+    *) echo "deps.sh: unknown option $extra (known: --python, --fuzz, --web, --docs)" >&2; exit 2 ;;
   esac
 done
 missing=()

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Installs the Python module the README's way into a virtual environment, build/venv (or $VENV), made from
+# Installs the Python module the Python tutorial's way (docs/tutorials/python.md) into a virtual environment, build/venv (or $VENV), made from
 # Debian's /usr/bin/python3 with --system-site-packages (numpy, pybind11, pytest and Dask from Debian), after
 # installing those packages. Works offline: pip builds with --no-build-isolation.
 #   scripts/python.sh          install (a C++ build folder $BUILD_DIR, default build, is reused when it exists:
@@ -14,7 +14,7 @@ BUILD_DIR=${BUILD_DIR:-build}
 VENV=${VENV:-$BUILD_DIR/venv}
 start=$(date +%s)
 [ -x "$VENV/bin/python" ] || /usr/bin/python3 -m venv --system-site-packages "$VENV"
-# The README's install command; TRIVCON_CMAKE_BUILD_DIR lets setup.py reuse the C++ build folder.
+# The tutorial's install command; TRIVCON_CMAKE_BUILD_DIR lets setup.py reuse the C++ build folder.
 if [ -f "$BUILD_DIR/CMakeCache.txt" ]; then export TRIVCON_CMAKE_BUILD_DIR=$BUILD_DIR; fi
 "$VENV/bin/pip" install --no-build-isolation --no-cache-dir --quiet .
 installed=$(date +%s)

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Builds everything and runs all tests: the C++ suite (GoogleTest through CTest), then the Python module,
-# installed the README's way into build/venv, and its pytest suite (scripts/python.sh --test), then the editor's
-# browser tests (scripts/web.sh --test: `trivcon edit` driven in headless Chromium). Tests on the real
+# installed the Python tutorial's way (docs/tutorials/python.md) into build/venv, and its pytest suite
+# (scripts/python.sh --test), then the editor's browser tests (scripts/web.sh --test: `trivcon edit` driven in headless Chromium), then builds the documentation
+# site with warnings as errors (scripts/docs.sh; its examples run in the pytest suite). Tests on the real
 # meshes in ../shared/data/meshes run when that folder exists and are skipped with a message otherwise.
 #   scripts/test.sh             Release build in build/, all tests
 #   scripts/test.sh --sanitize  the C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer, in build-asan/
@@ -27,4 +28,9 @@ if [ "$BUILD_DIR" = build ]; then
   bash scripts/web.sh --test
 else
   echo "== web: the browser tests run without --sanitize only"
+fi
+if [ "$BUILD_DIR" = build ]; then
+  bash scripts/docs.sh
+else
+  echo "== docs: the documentation site is built without --sanitize only"
 fi

@@ -951,7 +951,7 @@ struct EditorServer::Impl {
     }
     static const std::vector<std::string> posts = {"/api/solve", "/api/auto", "/api/relax", "/api/quad", "/api/export", "/api/streamlines"};
     if (std::find(posts.begin(), posts.end(), req.path) == posts.end())
-      return refuse(res, 404, "no such endpoint (see README.md, Editor)", has_body);
+      return refuse(res, 404, "no such endpoint (see docs/reference/editor-api.md)", has_body);
     // A form of any web page can POST text/plain, form data or multipart without asking; only a script of the
     // editor's own origin can send application/json.
     if (!is_json_type(req.get_header_value("Content-Type")))
@@ -1098,7 +1098,7 @@ struct EditorServer::Impl {
       else if (c && c->in_headers() && c->timed_out())
         set_error(res, 408, "the request's headers did not arrive in time (" + number_text(options.header_seconds) + " s)");
       else if (res.status == 404)
-        set_error(res, 404, "no such endpoint (see README.md, Editor)");
+        set_error(res, 404, "no such endpoint (see docs/reference/editor-api.md)");
       else if (res.status == 413)
         set_error(res, 413, too_large_message());
       else

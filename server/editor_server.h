@@ -3,9 +3,9 @@
 //
 // No numerics here: requests are turned into the library's prescriptions (through the same parsers as
 // the command line, so that a mistake gets the CLI's message), designed by FieldDesigner, and described
-// by solve_report (report/report.h). The endpoints are documented in README.md ("Editor").
+// by solve_report (report/report.h). The endpoints are documented in docs/reference/editor-api.md.
 //
-// Safety (README.md, "Editor"): it listens on the host it is given (the CLI's default is 127.0.0.1);
+// Safety (docs/reference/editor-api.md): it listens on the host it is given (the CLI's default is 127.0.0.1);
 // every API call needs the per-run token in a header (X-Trivcon-Token, or Authorization: token T; never a
 // cookie, which every other port of the same host would be sent too); an API call from another origin
 // (Origin or Referer not the served one) or a POST that is not application/json is refused (a page on

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The exit statuses of the `trivcon` program, end to end (README.md, "Exit status"): 0 success (also
+// The exit statuses of the `trivcon` program, end to end (docs/reference/exit-codes.md): 0 success (also
 // --help and --version), 1 bad input, 2 usage error (whatever CLI11's own code for it), 3 `solve`
 // verification failed, 4 `check` found indices that differ from the prescription. Meshes are generated
 // here and written with trivcon::write_obj.
@@ -58,7 +58,7 @@ TEST(CliExit, HelpAndVersionExitZero) {
   }
   const CommandResult r = run_cli("--version");
   EXPECT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(r.out, std::string("trivcon ") + TRIVCON_VERSION + "\n");
+  EXPECT_EQ(r.out, "trivcon 0.1.0\n");
 }
 
 // ----------------------------------------------------------------------------------------------

@@ -41,7 +41,7 @@ void expect_along_cube_edges(const Mesh& m, const MatrixX3d& d, const std::vecto
   }
 }
 
-// The solve of the README's pipeline on the flat-faced cube: --auto puts +1/4 at the 8 corners, the .rosy
+// The solve of the QuadWild pipeline (docs/howto/other-tools.md) on the flat-faced cube: --auto puts +1/4 at the 8 corners, the .rosy
 // has every face beside a cube edge along it (modulo π/2), the .sharp lists both sides of the 12 · n edges.
 TEST(CliFeatures, CubePipelineForQuadWild) {
   const int n = 6;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Independent checks of the formulation (README "Conventions", "Weights and energy"): every expected value
+// Independent checks of the formulation (docs/explanation/conventions.md, docs/explanation/weights.md): every expected value
 // here is computed in the test from the vertex positions alone, by hand or with the few lines of geometry
 // below (cotangents, corner angles, polar angles in the plane), never with the library's weight, angle,
 // frame or index functions. The library is only asked for its results (weights, x, energy, the field).
@@ -59,7 +59,7 @@ double cot_from_sides(double a, double b, double c) {
   return cosine / std::sqrt(std::max(0.0, 1 - cosine * cosine));
 }
 
-// The mollification's ε for a mesh of one component (README "Weight policy", Sharp & Crane 2020 Sec. 4.5): δ = 1e-5 × the mean edge
+// The mollification's ε for a mesh of one component (docs/explanation/weights.md, Sharp & Crane 2020 Sec. 4.5): δ = 1e-5 × the mean edge
 // length; ε = the largest δ − (l_i + l_j − l_k) over faces and sides, or 0.
 double mollify_epsilon(const MatrixX3d& V, const MatrixX3i& F) {
   std::map<Edge, double> length;
@@ -77,7 +77,7 @@ double mollify_epsilon(const MatrixX3d& V, const MatrixX3i& F) {
   return epsilon;
 }
 
-// README: w_e = ½ (max(cot α, 0) + max(cot β, 0)) over the angles opposite interior edge e, of the
+// docs/explanation/weights.md: w_e = ½ (max(cot α, 0) + max(cot β, 0)) over the angles opposite interior edge e, of the
 // mollified intrinsic triangles when ε > 0 (every length + ε), of the faces as given otherwise; boundary
 // edges have weight 0.
 std::map<Edge, EdgeData> independent_weights(const MatrixX3d& V, const MatrixX3i& F) {
@@ -381,7 +381,7 @@ TEST(Formulation, EnergyIsTheWeightedNormWithIndependentWeights) {
 TEST(Formulation, EnergyOnSpotWithIndependentWeights) {
   TRIVCON_REQUIRE_SHARED();
   const MeshData spot = read_mesh(test::shared_mesh("spot.obj"));
-  IndexPrescription p;  // README: +1 at the snout and a vortex on the flank
+  IndexPrescription p;  // docs/getting-started.md's picture: +1 at the snout and a vortex on the flank
   p.vertex[1453] = 1;
   p.vertex[849] = 1;
   expect_energy_matches(spot, p, "spot.obj");
@@ -431,7 +431,7 @@ Eigen::Vector3d rotate(const Eigen::Vector3d& d, const Eigen::Vector3d& axis, do
   return Eigen::AngleAxisd(angle, axis.normalized()) * d;
 }
 
-// The README's frame of face f: x along corner 0 → corner 1, normal (p1 − p0) × (p2 − p0).
+// The frame of face f (docs/explanation/conventions.md): x along corner 0 → corner 1, normal (p1 − p0) × (p2 − p0).
 Eigen::Vector3d frame_x(const Mesh& m, int f) { return (pos(m.V, m.F(f, 1)) - pos(m.V, m.F(f, 0))).normalized(); }
 Eigen::Vector3d normal(const Mesh& m, int f) {
   const Eigen::Vector3d p0 = pos(m.V, m.F(f, 0));
@@ -514,7 +514,7 @@ TEST(Formulation, FlatJitteredGridFieldIsParallel) {
 // outside the circle, so its counter-clockwise cycle runs counter-clockwise about the centre; around a vertex
 // of the outer circle they lie inside, so it runs clockwise. Hence index = (K_ℓ ± W) / 2π with W the winding
 // of the field along the band of faces at the loop, walked counter-clockwise about the centre, + for the
-// inner loop and − for the outer. A constant field (W = 0) gives +1 outer, −1 inner (README). A field
+// inner loop and − for the outer. A constant field (W = 0) gives +1 outer, −1 inner (docs/explanation/conventions.md). A field
 // tangent to both circles winds once (W = 2π on both): inner −1 + 1 = 0, outer +1 − 1 = 0.
 
 struct AnnulusLoop {
@@ -627,7 +627,7 @@ TEST(Formulation, AnnulusAlignedCrossFieldLoopIndices) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The holonomy constraint at every interior vertex, with the README's sign: Σ_{edges (u,v)} s·x = K_v − 2π k_v,
+// The holonomy constraint at every interior vertex, with the sign of docs/explanation/conventions.md: Σ_{edges (u,v)} s·x = K_v − 2π k_v,
 // s = +1 when v is the edge's larger id. K_v and the interior vertices are the test's own.
 
 void expect_vertex_holonomy(const Mesh& m, const IndexPrescription& p, const std::string& what, SolverKind solver = SolverKind::Cholesky) {

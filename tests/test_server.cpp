@@ -377,7 +377,7 @@ TEST_F(Server, MalformedRequestsGet400AndTheServerKeepsServing) {
   EXPECT_EQ(res->status, 200);
   EXPECT_EQ(error_of(r().post("/api/solve?format=xml", json::object())), "unknown format 'xml' (known: json, binary, oct16)");
   EXPECT_EQ(r().client->Get("/api/nothing")->status, 404);
-  EXPECT_EQ(error_of(r().client->Get("/api/nothing")), "no such endpoint (see README.md, Editor)");
+  EXPECT_EQ(error_of(r().client->Get("/api/nothing")), "no such endpoint (see docs/reference/editor-api.md)");
 }
 
 // The glyph order: every face once, first times ascending, and format=oct16&order=area sends the

@@ -3,7 +3,7 @@
 
 Nothing here calls trivcon: frames, corner angles, angle defects, edges with their faces, the Levi-Civita
 rotation rho, the holonomy of a connection around every vertex, the transport of a field across every edge,
-and the indices of a per-face field are computed from the positions and the conventions of the README.
+and the indices of a per-face field are computed from the positions and the conventions of docs/explanation/conventions.md.
 """
 
 import math
@@ -80,7 +80,7 @@ class Mesh:
         return self.angle_in(np.arange(self.F.shape[0]), np.asarray(directions, dtype=float))
 
     def vertex_holonomy_residual(self, edges, x, singularities):
-        """max over interior vertices of |sum_e s x_e - (K_v - 2 pi k_v)| (README, "Connection")."""
+        """max over interior vertices of |sum_e s x_e - (K_v - 2 pi k_v)| (docs/explanation/conventions.md, "Connection")."""
         edges = np.asarray(edges)
         index = {tuple(e): k for k, e in enumerate(edges)}
         assert len(index) == len(self.interior_edges)

@@ -57,14 +57,15 @@ def test_example_script(tmp_path):
     assert trivcon.field_indices(V, F, directions, N=N) == trivcon.read_singularities(os.path.join(REPO, "data", "cube_sphere.sing"), N=4)
 
 
-def test_readme_example_runs(tmp_path, monkeypatch):
-    """The README's complete example, as printed (run in a scratch folder, data/ from the checkout)."""
-    text = open(os.path.join(REPO, "README.md")).read()
-    section = text[text.index("## Python"):]
+def test_python_tutorial_example_runs(tmp_path, monkeypatch):
+    """The Python tutorial's complete example (docs/tutorials/python.md), as printed (run in a scratch folder, data/
+    from the checkout); test_site_examples runs it too, this checks the files it writes."""
+    text = open(os.path.join(REPO, "docs", "tutorials", "python.md")).read()
+    section = text[text.index("## A complete example"):]
     code = section[section.index("```python\n") + len("```python\n"):]
     code = code[:code.index("```")]
     os.symlink(os.path.join(REPO, "data"), tmp_path / "data")
     monkeypatch.chdir(tmp_path)
-    exec(compile(code, "README.md", "exec"), {})
+    exec(compile(code, "docs/tutorials/python.md", "exec"), {})
     for name in ("field.txt", "connection.txt", "field.rawfield", "field.png", "lines.png"):
         assert (tmp_path / name).stat().st_size > 0

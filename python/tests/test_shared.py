@@ -47,5 +47,5 @@ def test_errors_on_real_meshes(shared_meshes, cli):
 def test_spot_agrees_with_the_program(shared_meshes, cli, tmp_path):
     path = os.path.join(shared_meshes, "spot.obj")
     d = trivcon.FieldDesigner(*trivcon.read_mesh(path))
-    r = d.solve(N=1, singularities={1453: 1, 849: 1})  # the README's picture
+    r = d.solve(N=1, singularities={1453: 1, 849: 1})  # the picture in docs/getting-started.md
     agree(cli, tmp_path, path, 1, ["--sing", "1453:1", "--sing", "849:1"], r)

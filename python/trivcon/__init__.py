@@ -16,7 +16,7 @@ same C++ library as the `trivcon` command line. Plain numpy arrays in, plain arr
     trivcon.write_field("f.rawfield", V, F, r.directions, N=4)
     image = trivcon.render(V, F, r.directions, N=4, size=(800, 600))   # (600, 800, 3) uint8
 
-Conventions (the CLI's, see the README):
+Conventions (the CLI's, see docs/explanation/conventions.md):
 - Ids are the file's own, 0-based; nothing is renumbered. Polygons are fan-triangulated in order.
 - Indices are exact multiples of 1/N. They are given as int, float (a multiple of 1/N),
   fractions.Fraction or "p/q" strings, and returned as fractions.Fraction; or as arrays: a tuple
@@ -627,7 +627,7 @@ class FieldDesigner(_Cached):
     factorization: "own" (trivcon's, on several threads) or "cholmod" ("qr" and "cholmod" only when
     trivcon.with_suitesparse). weight_floor: with cotan
     weights, every interior edge gets at least this fraction of the median weight (0 to 1; default 0,
-    none): fewer large turns on meshes with many obtuse angles, at some cost in smoothness (README
+    none): fewer large turns on meshes with many obtuse angles, at some cost in smoothness (docs/explanation/weights.md,
     "Weights and energy"). threads: how many threads its calls use (None: trivcon.set_threads's default;
     see set_threads for what is per call and what is per process); also the attribute `threads`.
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The server's API (README.md, "Editor"): every call sends the token as the X-Trivcon-Token header.
+// The server's API (docs/reference/editor-api.md): every call sends the token as the X-Trivcon-Token header.
 
 // The token comes in the page's address (?token=…, as `trivcon edit` prints it). It is kept in this tab's
 // sessionStorage (per origin, so no other port of this host sees it, unlike a cookie) and removed from the
