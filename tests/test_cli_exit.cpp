@@ -58,7 +58,7 @@ TEST(CliExit, HelpAndVersionExitZero) {
   }
   const CommandResult r = run_cli("--version");
   EXPECT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(r.out, "trivcon 0.1.0\n");
+  EXPECT_EQ(r.out, std::string("trivcon ") + TRIVCON_VERSION + "\n");
 }
 
 // ----------------------------------------------------------------------------------------------
