@@ -130,6 +130,42 @@ TEST(CliQuad, HoledPlateEndsOnItsBoundaryLoops) {
   EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
 }
 
+// A scan whose map folded around clustered singularities before the untangling (armadillo, --auto, 10,000
+// quads): closed, manifold, χ 2, and every irregular vertex within 3 quad edges of a written singularity of the
+// matching index (valence 4 − 4k), from the files alone.
+TEST(CliQuad, ArmadilloIsClosedWithItsIrregularVerticesAtTheSingularities) {
+  TRIVCON_REQUIRE_SHARED();
+  const std::string out = temp_file("q.obj"), sing = temp_file("q.sing"), report = temp_file("r.json");
+  const auto r = run_cli("quad " + test::shared_mesh("armadillo.obj") + " --auto --target-faces 10000 -o " + out + " --sing-out " + sing +
+                         " --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const QuadFile q = read_quads(out);
+  const Census c = census(q);
+  EXPECT_EQ(c.euler, 2);
+  EXPECT_EQ(c.boundary_edges, 0);
+  EXPECT_EQ(c.over_shared_edges, 0);
+  const MeshData input = read_mesh(test::shared_mesh("armadillo.obj"));
+  std::map<int, int> index;  // singular vertex -> index in quarters
+  for (const auto& [v, text] : test::read_singularity_texts(sing)) {
+    const size_t slash = text.find('/');  // "p/q" (reduced: 1/2 is two quarters) or a whole number
+    const int p = std::stoi(text.substr(0, slash)), den = slash == std::string::npos ? 1 : std::stoi(text.substr(slash + 1));
+    ASSERT_EQ(4 % den, 0) << text;
+    index[v] = p * (4 / den);
+  }
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  const double h = j["param"]["edge_length"].get<double>();
+  int irregular = 0;
+  for (auto [v, n] : c.interior_valence) {
+    if (n == 4) continue;
+    ++irregular;
+    bool near = false;
+    for (auto [s, k] : index)
+      if (4 - k == n && (q.V.row(v) - input.V.row(s)).norm() <= 3 * h) near = true;
+    EXPECT_TRUE(near) << "quad vertex " << v << " of valence " << n << " has no singularity of index " << (4 - n) << "/4 within 3 quad edges";
+  }
+  EXPECT_EQ(irregular, static_cast<int>(index.size()));
+}
+
 TEST(CliQuad, UsageErrors) {
   const std::string mesh = mesh_file(make_icosphere(2), "sphere.obj"), out = temp_file("q.obj");
   EXPECT_EQ(run_cli("quad " + mesh + " --auto -o " + out).status, 2);                         // no scale

@@ -642,6 +642,23 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   }
   // Folded faces plus singularities whose (u, v) corner angles do not sum to 2π(1 − k): an unfolded ring can
   // still wind around its singularity once too often, which would give the quad mesh a vertex of another valence.
+  // Per interior vertex: whether its (u, v) corner angles fail to sum to 2π(1 − k) (k its index, 0 off the
+  // singularities). An unfolded ring can still wind around its vertex once too often or too few times, which
+  // would give the quad mesh a vertex of another valence (or one more irregular vertex).
+  std::vector<double> expected_angle(nV, 2 * kPi);
+  for (int i = 0; i < nCone; ++i) expected_angle[out.cones[i]] = 2 * kPi * (1 - out.cone_index[i] / 4.0);
+  auto winding_errors = [&]() {
+    std::vector<double> angle(nV, 0.0);
+    for (int f = 0; f < nF; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d p = out.uv.row(3 * f + k).transpose();
+        const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
+        angle[t.F(f, k)] += std::atan2(a.x() * c.y() - a.y() * c.x(), a.dot(c));
+      }
+    std::vector<char> wrong(nV, 0);
+    for (int v = 0; v < nV; ++v) wrong[v] = t.is_interior_vertex(v) && std::abs(angle[v] - expected_angle[v]) > 1e-6;
+    return wrong;
+  };
   auto cone_winds_wrong = [&](int i) {
     const int v = out.cones[i];
     double angle = 0;
@@ -651,14 +668,14 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
       const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
       angle += std::atan2(a.x() * c.y() - a.y() * c.x(), a.dot(c));
     }
-    return std::abs(angle - 2 * kPi * (1 - out.cone_index[i] / 4.0)) > 1e-6;
+    return std::abs(angle - expected_angle[v]) > 1e-6;
   };
-  // The folds, and which singularities wind wrong.
+  // The folds, and which interior vertices wind wrong.
   struct Badness {
-    int folds = 0, cones = 0;
+    int folds = 0, windings = 0;
     std::vector<char> wrong;
-    int total() const { return folds + cones; }
-    // Better: fewer problems in all, and no singularity winding wrong that did not before.
+    int total() const { return folds + windings; }
+    // Better: fewer problems in all, and no vertex winding wrong that did not before.
     bool better_than(const Badness& before) const {
       for (size_t i = 0; i < wrong.size(); ++i)
         if (wrong[i] && !before.wrong[i]) return false;
@@ -668,8 +685,8 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   auto badness = [&]() {
     Badness b;
     b.folds = count_folds();
-    b.wrong.resize(nCone);
-    for (int i = 0; i < nCone; ++i) b.cones += (b.wrong[i] = cone_winds_wrong(i));
+    b.wrong = winding_errors();
+    for (char w : b.wrong) b.windings += w;
     return b;
   };
   // Untangles the region within `rings` rings of the vertices `seeds`; kept when the whole map has fewer folds
@@ -781,7 +798,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
       for (int v : ring)
         if (const int c = cone_of[v]; c >= 0 && !cone_tried[c]) near.push_back(c);
       for (int c : near) {
-        if (cone_tried[c] || elim.eliminated(cone0 + 2 * c) || elim.eliminated(cone0 + 2 * c + 1)) continue;
+        if (cone_tried[c] || elim.eliminated(cone0 + 2 * c) || elim.eliminated(cone0 + 2 * c + 1)) continue;  // its point is not free
         cone_tried[c] = 1;
         check_cancelled();
         const int ju = free_index[cone0 + 2 * c], jv = free_index[cone0 + 2 * c + 1];
