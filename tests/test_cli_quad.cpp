@@ -7,6 +7,7 @@
 #include <set>
 
 #include "support.h"
+#include "trivcon/generate.h"
 #include "trivcon/io.h"
 
 namespace trivcon {
@@ -164,6 +165,28 @@ TEST(CliQuad, ArmadilloIsClosedWithItsIrregularVerticesAtTheSingularities) {
     EXPECT_TRUE(near) << "quad vertex " << v << " of valence " << n << " has no singularity of index " << (4 - n) << "/4 within 3 quad edges";
   }
   EXPECT_EQ(irregular, static_cast<int>(index.size()));
+}
+
+// A round disk with its boundary aligned: the smoothest field puts one +1 at the centre, which no quad vertex
+// can carry (valence 4 − 4); --auto for a map splits it into four +1/4 a unit around it, and the map's scale
+// is corrected so that the quads meet the target although the layout shrinks the interior.
+TEST(CliQuad, RoundDiskSplitsItsCentreIntoFourCorners) {
+  const Mesh m = make_disk(20, 64);
+  const std::string mesh = mesh_file(m, "disk.obj"), out = temp_file("q.obj"), sing = temp_file("q.sing");
+  const auto r = run_cli("quad " + mesh + " --auto --align-boundary --target-faces 1000 -o " + out + " --sing-out " + sing);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::map<int, std::string> written = test::read_singularity_texts(sing);
+  ASSERT_EQ(written.size(), 4u);
+  for (const auto& [v, text] : written) EXPECT_EQ(text, "1/4") << v;
+  const QuadFile q = read_quads(out);
+  const Census c = census(q);
+  EXPECT_EQ(c.euler, 1);
+  EXPECT_EQ(c.over_shared_edges, 0);
+  int valence3 = 0, other = 0;
+  for (auto [v, n] : c.interior_valence) n == 3 ? ++valence3 : n != 4 ? ++other : 0;
+  EXPECT_EQ(valence3, 4);
+  EXPECT_EQ(other, 0);
+  EXPECT_NEAR(static_cast<double>(q.quads.size()), 1000.0, 300.0);
 }
 
 TEST(CliQuad, UsageErrors) {

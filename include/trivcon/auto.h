@@ -45,6 +45,13 @@ struct AutoOptions {
   int iterations = 8;            // inverse-power iterations, ≥ 1
   double cancel_distance = 0;    // cancel ± pairs at most this far apart; 0: none
   bool cancel_absolute = false;  // cancel_distance in mesh units instead of mean edge lengths
+  // Split (after cancellation): singularities of one sign closer than split_distance (mesh units, along edges)
+  // whose summed |n| exceeds split_above (0: never) are gathered, and each such |n| > split_above becomes |n|
+  // singularities of ±1 on interior vertices about split_distance from it, far from each other. `trivcon param`
+  // and `quad` with --auto use split_above = N − 1 = 3 and one quad edge: a quad vertex has valence 4 − n, none
+  // for n ≥ 4.
+  int split_above = 0;
+  double split_distance = 0;
   std::map<int, double> fixed;   // face → angle in its frame (radians), held as Dirichlet values
   bool align_curvature = false;  // follow the principal curvature directions (see above); N even
   double curvature_t = 0;        // its strength t < 1: 0 as geometry-central, → 1 smoother, < 0 closer to the curvature
@@ -62,6 +69,7 @@ struct AutoResult {
                                            // an interior neighbour (boundary_turns_moved_inside, trivcon/constraints.h)
   std::map<int, int> vertex;               // after that and cancellation: the singularities to prescribe
   std::vector<std::pair<int, int>> pairs;  // cancelled pairs (vertex of index +n, vertex of −n), in order
+  int split = 0;                           // singularities split into ±1 ones (split_above)
   double energy = 0;                       // E(u) / ‖u‖²_M over the whole mesh (the Rayleigh quotient without fixed faces)
   int vanishing_faces = 0;                 // faces where |u_f| vanished (see above)
   std::string ordering;                    // the smoothest field's factor order: "AMD" or "coordinate dissection"

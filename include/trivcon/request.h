@@ -115,8 +115,10 @@ ParamOptions request_param_options(const FieldDesigner& designer, const FieldReq
 // placement a ± pair closer than that cannot sit on two integer points without folding the map, so the map's
 // front ends cancel pairs within it unless the request says otherwise (cancel_for_map).
 double map_unit(const FieldDesigner& designer, double edge_length, double target_faces);
-// Sets request.auto_options to cancel pairs within one unit of the map (absolute), when auto_place and no cancel
-// distance was given.
+// With auto_place: sets request.auto_options to cancel pairs within one unit of the map (absolute) when no cancel
+// distance was given, and to split every singularity of |index| ≥ 1 into ones of ±1/4 about one unit around it
+// (AutoOptions::split_above = 3) when no split was asked for: a quad vertex has valence 4 − 4k, so k ≥ 1
+// cannot be made (the smoothest field of a round disk with its boundary aligned puts +1 at the centre).
 void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double edge_length, double target_faces);
 
 }  // namespace trivcon

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <exception>
 #include <limits>
 #include <memory>
@@ -361,6 +362,117 @@ std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& 
   return left;
 }
 
+namespace {
+
+// The split of AutoOptions::split_above: each singularity of |n| > limit becomes |n| of sign(n) · 1 on interior
+// vertices about `distance` from it along edges (Dijkstra: those first reached at or past it), chosen far from each other (farthest-point order,
+// in space, from the one nearest to `distance`); where too few such vertices exist, it stays as it is.
+std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, const std::map<int, int>& given, int limit,
+                                       double distance, int& split) {
+  std::map<int, int> out;
+  std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int>;
+  // First, singularities of one sign closer than `distance` (along edges) are gathered into one of their summed
+  // index at the member nearest to their centroid: two +1/4 on neighbouring vertices cannot sit on two integer
+  // points of a map one unit apart, but their sum split below can.
+  std::map<int, int> vertex;
+  {
+    std::map<int, int> parent;
+    for (auto [v, n] : given) parent[v] = v;
+    std::function<int(int)> root = [&](int v) { return parent[v] == v ? v : parent[v] = root(parent[v]); };
+    for (auto [source, n] : given) {
+      std::vector<int> touched{source};
+      std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+      dist[source] = 0, queue.emplace(0.0, source);
+      while (!queue.empty()) {
+        auto [d, v] = queue.top();
+        queue.pop();
+        if (d > dist[v]) continue;
+        if (auto it = given.find(v); v != source && it != given.end() && (it->second > 0) == (n > 0)) parent[root(v)] = root(source);
+        for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
+          const int e = t.vertex_edges[q];
+          const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+          const double dw = d + edge_length(V, t, e);
+          if (dw < distance && dw < dist[w]) {
+            if (std::isinf(dist[w])) touched.push_back(w);
+            dist[w] = dw, queue.emplace(dw, w);
+          }
+        }
+      }
+      for (int v : touched) dist[v] = std::numeric_limits<double>::infinity();
+    }
+    std::map<int, std::vector<int>> members;
+    for (auto [v, n] : given) members[root(v)].push_back(v);
+    for (const auto& [r, list] : members) {
+      Eigen::RowVector3d centroid = Eigen::RowVector3d::Zero();
+      int total = 0;
+      for (int v : list) centroid += V.row(v), total += given.at(v);
+      centroid /= static_cast<double>(list.size());
+      if (std::abs(total) <= limit) {  // nothing to split: the members stay where they are
+        for (int v : list) vertex[v] += given.at(v);
+        continue;
+      }
+      int centre = list[0];
+      for (int v : list)
+        if ((V.row(v) - centroid).norm() < (V.row(centre) - centroid).norm()) centre = v;
+      vertex[centre] += total;
+    }
+  }
+  for (auto [source, n] : vertex) {
+    if (std::abs(n) <= limit) {
+      out[source] += n;
+      continue;
+    }
+    std::vector<int> touched{source}, ring;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+    dist[source] = 0, queue.emplace(0.0, source);
+    while (!queue.empty()) {
+      auto [d, v] = queue.top();
+      queue.pop();
+      if (d > dist[v]) continue;
+      if (d >= distance) {
+        if (t.is_interior_vertex(v) && !given.count(v)) ring.push_back(v);  // the first vertices at or past `distance`
+        continue;  // the ring: no further
+      }
+      for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
+        const int e = t.vertex_edges[q];
+        const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+        const double dw = d + edge_length(V, t, e);
+        if (dw < dist[w]) {
+          if (std::isinf(dist[w])) touched.push_back(w);
+          dist[w] = dw, queue.emplace(dw, w);
+        }
+      }
+    }
+    const int count = std::abs(n);
+    std::vector<int> chosen;
+    if (static_cast<int>(ring.size()) >= count) {
+      std::sort(ring.begin(), ring.end(), [&](int a, int b) { return dist[a] != dist[b] ? dist[a] < dist[b] : a < b; });
+      chosen.push_back(ring[0]);
+      std::vector<double> nearest(ring.size(), std::numeric_limits<double>::infinity());
+      while (static_cast<int>(chosen.size()) < count) {
+        size_t best = 0;
+        for (size_t i = 0; i < ring.size(); ++i) {
+          nearest[i] = std::min(nearest[i], (V.row(ring[i]) - V.row(chosen.back())).norm());
+          if (nearest[i] > nearest[best]) best = i;
+        }
+        chosen.push_back(ring[best]);
+      }
+    }
+    for (int v : touched) dist[v] = std::numeric_limits<double>::infinity();
+    if (chosen.empty()) {
+      out[source] += n;
+      continue;
+    }
+    ++split;
+    for (int v : chosen) out[v] += n > 0 ? 1 : -1;
+  }
+  for (auto it = out.begin(); it != out.end();) it = it->second == 0 ? out.erase(it) : std::next(it);
+  return out;
+}
+
+}  // namespace
+
 std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex) {
   // Clusters of vertices joined by zero-length edges (union-find with path halving).
   std::vector<int> parent(t.num_vertices);
@@ -464,6 +576,11 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
     throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
   const double distance = o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
   r.vertex = cancel_singularity_pairs(V, t, merged, distance, &r.pairs);
+  if (o.split_above > 0) {
+    if (!(o.split_distance > 0) || !std::isfinite(o.split_distance))
+      throw Error("automatic singularities: invalid split distance " + std::to_string(o.split_distance) + " (need a finite number > 0)");
+    r.vertex = split_singularities(V, t, r.vertex, o.split_above, o.split_distance, r.split);
+  }
   r.seconds.cancel = seconds_since(t0);
   return r;
 }

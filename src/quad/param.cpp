@@ -201,7 +201,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   }
   if (!(out.edge_length > 0) || !std::isfinite(out.edge_length))
     throw Error("param: the mesh has no area to parametrize");
-  const double s = 1.0 / out.edge_length;
+  double s = 1.0 / out.edge_length;  // (u, v) units per mesh unit; with a target face count, rescaled below
   ParamQuality& q = out.quality;
   q.faces = nF;
   q.target_squares = area * s * s;
@@ -515,6 +515,25 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   y = solve_fixed();
   corner_uv();
   ++q.rounding_rounds;
+  // With a target face count: the field's map does not keep area (around singularities, along an aligned
+  // boundary that curves), so its (u, v) area can miss the target by a third. The real-valued map is linear in
+  // the scale (nothing is fixed yet), so when it misses by more than 10 % it is rescaled exactly to cover
+  // area / edge_length² unit squares, and the edge length reported is the one used.
+  if (!(options.edge_length > 0) && q.target_squares > 0) {
+    double covered = 0;
+    for (int f = 0; f < nF; ++f) covered += uv_area(f);
+    if (covered > 0 && std::isfinite(covered)) {
+      const double ratio = std::sqrt(q.target_squares / covered);
+      if (std::abs(ratio * ratio - 1) > 0.1) {  // more than 10 % off in area (within that, the map is kept as it is)
+        s *= ratio;
+        out.edge_length /= ratio;
+        Eigen::SparseMatrix<double> K2;
+        assemble(K2, b);  // the same matrix, the right-hand side of the new scale
+        y *= ratio;
+        corner_uv();
+      }
+    }
+  }
   q.folds_real_valued = count_folds();
   stiffen(options.max_stiffening_rounds);
   // --- Greedy rounding: the integers nearest to whole numbers first, a fraction of those left per solve --------
@@ -559,10 +578,14 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     return solver->solve(r);
   };
   std::vector<char> tried(nCone, 0);
-  for (int k = 0; k < nCone; ++k) {
+  // At most this many singularities tried (two solves each): on a map folded at large (far more singularities
+  // than the target's squares can separate) the search would otherwise cost a solve pair per singularity.
+  int searches_left = 64 + nV / 500;
+  for (int k = 0; k < nCone && searches_left > 0; ++k) {
     const int v = out.cones[k];
     if (tried[k] || !ring_is_bad(v) || elim.eliminated(cone0 + 2 * k) || elim.eliminated(cone0 + 2 * k + 1)) continue;
     tried[k] = 1;
+    --searches_left;
     const int ju = free_index[cone0 + 2 * k], jv = free_index[cone0 + 2 * k + 1];
     const double u0 = value[ju], v0 = value[jv];
     // The solution is affine in the two values: y + dx·g_u + dy·g_v, with g_j the response to a unit change of
@@ -591,7 +614,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     for (int k = 0; k < nCone; ++k)
       for (int c = 0; c < 2; ++c)
         if (!elim.eliminated(cone0 + 2 * k + c)) is_cone_value[free_index[cone0 + 2 * k + c]] = 1;
-    int budget = 400;  // candidate integers tried in all
+    int budget = std::min(400, 64 + nV / 500);  // candidate integers tried in all (a solve each)
     for (int f = 0; f < nF && budget > 0; ++f) {
       if (!folded(f)) continue;
       std::vector<int> candidates;
@@ -691,7 +714,15 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   };
   // Untangles the region within `rings` rings of the vertices `seeds`; kept when the whole map has fewer folds
   // after it (returns true), else undone.
+  // Bounds on the untangling's work, so that a map that cannot be untangled (a singularity of index ≥ 1 folds by
+  // necessity) costs little: at most this many regions and this much work in all, and none when the folds are
+  // more than a small share of the faces (the map is then wrong at large, not locally).
+  int regions_left = 64 + nF / 256;
+  double work_left = 2000.0 * nF + 2e7;  // faces × L-BFGS steps, over all regions
+  const int too_many_folds = std::max(100, nF / 200);
   auto untangle_around = [&](const std::vector<int>& seeds, int rings) {
+    if (regions_left <= 0 || work_left <= 0) return false;
+    --regions_left;
     const Badness before = badness();
     std::vector<int> depth(nV, -1), frontier;
     for (int v : seeds)
@@ -746,7 +777,8 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     Eigen::VectorXd z(problem.num_variables);
     for (size_t k = 0; k < variables.size(); ++k) z[static_cast<int>(k)] = y[variables[k]];
     const Eigen::VectorXd y0 = y;
-    quad::untangle(problem, z);
+    const quad::UntangleResult result = quad::untangle(problem, z);
+    work_left -= static_cast<double>(faces.size()) * (result.inner_iterations + result.outer_iterations);
     for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z[static_cast<int>(k)];
     corner_uv();
     if (badness().better_than(before)) {
@@ -763,9 +795,20 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   std::vector<int> cone_of(nV, -1);
   for (int k = 0; k < nCone; ++k) cone_of[out.cones[k]] = k;
   // Each folded face in turn (the first still folded), in regions of 2, 4 and 8 rings.
+  // Faces within 2 rings of a singularity of index ≥ 1 are left: its (u, v) angle 2π(1 − k) ≤ 0 needs folds.
+  std::vector<char> hopeless(nF, 0);
+  for (int i = 0; i < nCone; ++i) {
+    if (out.cone_index[i] < 4) continue;
+    const int v = out.cones[i];
+    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
+      for (int k = 0; k < 3; ++k) {
+        const int u = t.F(t.vertex_faces[j], k);
+        for (int l = t.vertex_face_offsets[u]; l < t.vertex_face_offsets[u + 1]; ++l) hopeless[t.vertex_faces[l]] = 1;
+      }
+  }
   auto untangle_faces = [&]() {
-    std::vector<char> given_up(nF, 0);
-    for (int f = 0; f < nF; ++f) {
+    std::vector<char> given_up(hopeless);
+    for (int f = 0; f < nF && regions_left > 0 && work_left > 0; ++f) {
       if (given_up[f] || !folded(f)) continue;
       check_cancelled();
       for (int rings : {2, 4, 8})
@@ -785,6 +828,8 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     for (int i = 0; i < nCone; ++i)
       if (cone_winds_wrong(i)) trouble.push_back(t.vertex_faces[t.vertex_face_offsets[out.cones[i]]]);
     for (int f : trouble) {
+      if (regions_left <= 0 || work_left <= 0) return;
+      if (hopeless[f]) continue;
       std::vector<int> near, ring{t.F(f, 0), t.F(f, 1), t.F(f, 2)};
       for (int step = 0; step < 2; ++step) {
         std::vector<int> next;
@@ -842,6 +887,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   };
   auto untangle_folds = [&]() {
     const int folds_before = count_folds();
+    if (folds_before > too_many_folds) return;
     untangle_all();
     q.untangled_faces += folds_before - count_folds();
   };

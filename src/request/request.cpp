@@ -211,8 +211,11 @@ double map_unit(const FieldDesigner& designer, double edge_length, double target
 }
 
 void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double edge_length, double target_faces) {
-  if (!request.auto_place || request.auto_options.cancel_distance != 0) return;
-  request.auto_options.cancel_distance = map_unit(designer, edge_length, target_faces);
+  if (!request.auto_place) return;
+  const double unit = map_unit(designer, edge_length, target_faces);
+  if (request.auto_options.split_above == 0) request.auto_options.split_above = 3, request.auto_options.split_distance = unit;
+  if (request.auto_options.cancel_distance != 0) return;
+  request.auto_options.cancel_distance = unit;
   request.auto_options.cancel_absolute = true;
 }
 
