@@ -464,6 +464,17 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     return signed_area(out.uv.row(3 * f).transpose(), out.uv.row(3 * f + 1).transpose(), out.uv.row(3 * f + 2).transpose());
   };
   auto folded = [&](int f) { return !(uv_area(f) > 1e-12 * face_area[f] * s * s); };
+  // Σ of the signed (u, v) corner angles at vertex v.
+  auto uv_angle_sum = [&](int v) {
+    double angle = 0;
+    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
+      const int f = t.vertex_faces[j], k = corner_of(t, f, v);
+      const Eigen::Vector2d p = out.uv.row(3 * f + k).transpose();
+      const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
+      angle += std::atan2(a.x() * c.y() - a.y() * c.x(), a.dot(c));
+    }
+    return angle;
+  };
   // σ_max / σ_min of the map's Jacobian on face f (rows ∇u, ∇v in the face's frame); infinite when σ_min = 0.
   auto distortion = [&](int f) {
     Eigen::Matrix2d J = Eigen::Matrix2d::Zero();
@@ -682,17 +693,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     for (int v = 0; v < nV; ++v) wrong[v] = t.is_interior_vertex(v) && std::abs(angle[v] - expected_angle[v]) > 1e-6;
     return wrong;
   };
-  auto cone_winds_wrong = [&](int i) {
-    const int v = out.cones[i];
-    double angle = 0;
-    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
-      const int f = t.vertex_faces[j], k = corner_of(t, f, v);
-      const Eigen::Vector2d p = out.uv.row(3 * f + k).transpose();
-      const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
-      angle += std::atan2(a.x() * c.y() - a.y() * c.x(), a.dot(c));
-    }
-    return std::abs(angle - expected_angle[v]) > 1e-6;
-  };
+  auto cone_winds_wrong = [&](int i) { return std::abs(uv_angle_sum(out.cones[i]) - expected_angle[out.cones[i]]) > 1e-6; };
   // The folds, and which interior vertices wind wrong.
   struct Badness {
     int folds = 0, windings = 0;
@@ -929,15 +930,11 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   }
   for (int i = 0; i < nCone; ++i) {
     const int v = out.cones[i];
-    double angle = 0;
     for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
       const int f = t.vertex_faces[j], k = corner_of(t, f, v);
-      const Eigen::Vector2d p = out.uv.row(3 * f + k).transpose();
-      const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
-      angle += std::atan2(a.x() * c.y() - a.y() * c.x(), a.dot(c));
-      q.max_cone_offset = std::max({q.max_cone_offset, whole_offset(p.x()), whole_offset(p.y())});
+      q.max_cone_offset = std::max({q.max_cone_offset, whole_offset(out.uv(3 * f + k, 0)), whole_offset(out.uv(3 * f + k, 1))});
     }
-    q.max_cone_angle_error = std::max(q.max_cone_angle_error, std::abs(angle - 2 * kPi * (1 - out.cone_index[i] / 4.0)));
+    q.max_cone_angle_error = std::max(q.max_cone_angle_error, std::abs(uv_angle_sum(v) - 2 * kPi * (1 - out.cone_index[i] / 4.0)));
   }
   for (int i = 0; i < nAligned; ++i) {
     const auto [e, f] = aligned[i];
