@@ -308,6 +308,32 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   return S.u;
 }
 
+// Dijkstra along edges from `source`: visit(v, d) for each vertex reached, nearest first; a vertex is expanded
+// when visit returns true, and a neighbour reached only while its distance is below `radius` (at most, when
+// `inclusive`). `dist` is a work vector of infinities, left so.
+template <class Visit>
+void edge_dijkstra(const MatrixX3d& V, const Topology& t, int source, double radius, bool inclusive, std::vector<double>& dist, Visit visit) {
+  using Item = std::pair<double, int>;
+  std::vector<int> touched{source};
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  dist[source] = 0, queue.emplace(0.0, source);
+  while (!queue.empty()) {
+    auto [d, v] = queue.top();
+    queue.pop();
+    if (d > dist[v] || !visit(v, d)) continue;
+    for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
+      const int e = t.vertex_edges[q];
+      const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+      const double dw = d + edge_length(V, t, e);
+      if ((inclusive ? dw <= radius : dw < radius) && dw < dist[w]) {
+        if (std::isinf(dist[w])) touched.push_back(w);
+        dist[w] = dw, queue.emplace(dw, w);
+      }
+    }
+  }
+  for (int v : touched) dist[v] = std::numeric_limits<double>::infinity();
+}
+
 }  // namespace
 
 std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
@@ -323,33 +349,14 @@ std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& 
   };
   std::vector<Candidate> candidates;
   std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
-  std::vector<int> touched;
-  using Item = std::pair<double, int>;
   for (auto [source, n] : vertex) {
     if (n <= 0) continue;
     if (source < 0 || source >= t.num_vertices) throw Error("singularity cancellation: vertex " + std::to_string(source) + " out of range");
-    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-    dist[source] = 0, touched.push_back(source), queue.emplace(0.0, source);
-    while (!queue.empty()) {
-      auto [d, v] = queue.top();
-      queue.pop();
-      if (d > dist[v]) continue;
-      if (v != source) {
-        auto it = vertex.find(v);
-        if (it != vertex.end() && it->second == -n) candidates.push_back({d, source, v});
-      }
-      for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
-        const int e = t.vertex_edges[q];
-        const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
-        const double dw = d + edge_length(V, t, e);
-        if (dw <= distance && dw < dist[w]) {
-          if (std::isinf(dist[w])) touched.push_back(w);
-          dist[w] = dw, queue.emplace(dw, w);
-        }
-      }
-    }
-    for (int v : touched) dist[v] = std::numeric_limits<double>::infinity();
-    touched.clear();
+    edge_dijkstra(V, t, source, distance, true, dist, [&, source = source, n = n](int v, double d) {
+      if (v != source)
+        if (auto it = vertex.find(v); it != vertex.end() && it->second == -n) candidates.push_back({d, source, v});
+      return true;
+    });
   }
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
     return a.d != b.d ? a.d < b.d : a.plus != b.plus ? a.plus < b.plus : a.minus < b.minus;
@@ -371,7 +378,6 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
                                        double distance, int& split) {
   std::map<int, int> out;
   std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
-  using Item = std::pair<double, int>;
   // First, singularities of one sign closer than `distance` (along edges) are gathered into one of their summed
   // index at the member nearest to their centroid: two +1/4 on neighbouring vertices cannot sit on two integer
   // points of a map one unit apart, but their sum split below can.
@@ -380,27 +386,11 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
     std::map<int, int> parent;
     for (auto [v, n] : given) parent[v] = v;
     std::function<int(int)> root = [&](int v) { return parent[v] == v ? v : parent[v] = root(parent[v]); };
-    for (auto [source, n] : given) {
-      std::vector<int> touched{source};
-      std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-      dist[source] = 0, queue.emplace(0.0, source);
-      while (!queue.empty()) {
-        auto [d, v] = queue.top();
-        queue.pop();
-        if (d > dist[v]) continue;
+    for (auto [source, n] : given)
+      edge_dijkstra(V, t, source, distance, false, dist, [&, source = source, n = n](int v, double) {
         if (auto it = given.find(v); v != source && it != given.end() && (it->second > 0) == (n > 0)) parent[root(v)] = root(source);
-        for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
-          const int e = t.vertex_edges[q];
-          const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
-          const double dw = d + edge_length(V, t, e);
-          if (dw < distance && dw < dist[w]) {
-            if (std::isinf(dist[w])) touched.push_back(w);
-            dist[w] = dw, queue.emplace(dw, w);
-          }
-        }
-      }
-      for (int v : touched) dist[v] = std::numeric_limits<double>::infinity();
-    }
+        return true;
+      });
     std::map<int, std::vector<int>> members;
     for (auto [v, n] : given) members[root(v)].push_back(v);
     for (const auto& [r, list] : members) {
@@ -423,31 +413,18 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
       out[source] += n;
       continue;
     }
-    std::vector<int> touched{source}, ring;
-    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-    dist[source] = 0, queue.emplace(0.0, source);
-    while (!queue.empty()) {
-      auto [d, v] = queue.top();
-      queue.pop();
-      if (d > dist[v]) continue;
-      if (d >= distance) {
-        if (t.is_interior_vertex(v) && !given.count(v)) ring.push_back(v);  // the first vertices at or past `distance`
-        continue;  // the ring: no further
-      }
-      for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
-        const int e = t.vertex_edges[q];
-        const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
-        const double dw = d + edge_length(V, t, e);
-        if (dw < dist[w]) {
-          if (std::isinf(dist[w])) touched.push_back(w);
-          dist[w] = dw, queue.emplace(dw, w);
-        }
-      }
-    }
+    std::vector<std::pair<double, int>> reached;  // the first interior vertices at or past `distance`
+    edge_dijkstra(V, t, source, std::numeric_limits<double>::infinity(), true, dist, [&](int v, double d) {
+      if (d < distance) return true;
+      if (t.is_interior_vertex(v) && !given.count(v)) reached.emplace_back(d, v);
+      return false;  // the ring: no further
+    });
+    std::sort(reached.begin(), reached.end());  // nearest first, then by id
+    std::vector<int> ring;
+    for (auto [d, v] : reached) ring.push_back(v);
     const int count = std::abs(n);
     std::vector<int> chosen;
     if (static_cast<int>(ring.size()) >= count) {
-      std::sort(ring.begin(), ring.end(), [&](int a, int b) { return dist[a] != dist[b] ? dist[a] < dist[b] : a < b; });
       chosen.push_back(ring[0]);
       std::vector<double> nearest(ring.size(), std::numeric_limits<double>::infinity());
       while (static_cast<int>(chosen.size()) < count) {
@@ -459,7 +436,6 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
         chosen.push_back(ring[best]);
       }
     }
-    for (int v : touched) dist[v] = std::numeric_limits<double>::infinity();
     if (chosen.empty()) {
       out[source] += n;
       continue;
