@@ -682,15 +682,8 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   std::vector<double> expected_angle(nV, 2 * kPi);
   for (int i = 0; i < nCone; ++i) expected_angle[out.cones[i]] = 2 * kPi * (1 - out.cone_index[i] / 4.0);
   auto winding_errors = [&]() {
-    std::vector<double> angle(nV, 0.0);
-    for (int f = 0; f < nF; ++f)
-      for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector2d p = out.uv.row(3 * f + k).transpose();
-        const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
-        angle[t.F(f, k)] += std::atan2(a.x() * c.y() - a.y() * c.x(), a.dot(c));
-      }
     std::vector<char> wrong(nV, 0);
-    for (int v = 0; v < nV; ++v) wrong[v] = t.is_interior_vertex(v) && std::abs(angle[v] - expected_angle[v]) > 1e-6;
+    for (int v = 0; v < nV; ++v) wrong[v] = t.is_interior_vertex(v) && std::abs(uv_angle_sum(v) - expected_angle[v]) > 1e-6;
     return wrong;
   };
   auto cone_winds_wrong = [&](int i) { return std::abs(uv_angle_sum(out.cones[i]) - expected_angle[out.cones[i]]) > 1e-6; };
@@ -725,21 +718,27 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     if (regions_left <= 0 || work_left <= 0) return false;
     --regions_left;
     const Badness before = badness();
-    std::vector<int> depth(nV, -1), frontier;
+    std::vector<char> inside(nV, 0);
+    std::vector<int> frontier, region;
     for (int v : seeds)
-      if (depth[v] < 0) depth[v] = 0, frontier.push_back(v);
+      if (!inside[v]) inside[v] = 1, frontier.push_back(v), region.push_back(v);
     for (int r = 0; r < rings; ++r) {
       std::vector<int> next;
       for (int v : frontier)
         for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
           for (int k = 0; k < 3; ++k)
-            if (const int u = t.F(t.vertex_faces[j], k); depth[u] < 0) depth[u] = r + 1, next.push_back(u);
+            if (const int u = t.F(t.vertex_faces[j], k); !inside[u]) inside[u] = 1, next.push_back(u), region.push_back(u);
       frontier = std::move(next);
     }
-    // The region's real free unknowns are the variables; the faces they move carry the energy.
+    // The corners at the region's vertices, in order; their real free unknowns are the variables, and the faces
+    // those move carry the energy.
+    std::vector<int> corners;
+    for (int v : region)
+      for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
+        corners.push_back(3 * t.vertex_faces[j] + corner_of(t, t.vertex_faces[j], v));
+    std::sort(corners.begin(), corners.end());
     std::vector<int> variable(nY, -1), variables;
-    for (int c = 0; c < 3 * nF; ++c) {
-      if (depth[t.F(c / 3, c % 3)] < 0) continue;
+    for (int c : corners) {
       for (int r = 0; r < 2; ++r)
         for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * wedge[c] + r); it; ++it) {
           const int j = static_cast<int>(it.col());
