@@ -16,6 +16,7 @@
 #include <memory>
 #include <cmath>
 #include <numeric>
+#include <map>
 #include <sstream>
 #include <unordered_map>
 
@@ -32,6 +33,18 @@ namespace {
 
 
 using Terms = std::vector<std::pair<int, double>>;
+
+// atan2(y, x) to within 1e-5 rad (a polynomial for atan on [0, 1]; the zeros as std::atan2): about a fifth of
+// its cost, for tests that only tell apart angle sums differing by whole turns.
+double rough_atan2(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  if (ax == 0 && ay == 0) return std::atan2(y, x);
+  const double a = std::min(ax, ay) / std::max(ax, ay), s = a * a;
+  double r = a * (0.99997726 + s * (-0.33262347 + s * (0.19354346 + s * (-0.11643287 + s * (0.05265332 + s * -0.01172120)))));
+  if (ay > ax) r = kPi / 2 - r;
+  if (std::signbit(x)) r = kPi - r;
+  return std::signbit(y) ? -r : r;
+}
 
 // Unknowns: 2 per wedge (u then v), then the integers (cone positions, iso-line values, translations).
 // Linear relations Σ c x = 0 are eliminated one at a time: a relation is rewritten in the unknowns still free,
@@ -385,42 +398,62 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     const double eps = g.component_epsilon.empty() ? 0.0 : g.component_epsilon[t.face_component[f]];
     hat_gradients(layout(V, t, f, eps), grad[f], face_area[f]);
   }
+  // The least squares' matrix H over the wedges' (u, v) and its right-hand side r are linear in the faces'
+  // weights (the stiffening changes only those): made once as Hw (H's stored entries × faces) and rw (wedge
+  // unknowns × faces), then H's values = Hw · weight and r = s · rw · weight, and K = Pᵀ H P, b = Pᵀ r.
   std::vector<double> weight(nF, 1.0);
-  Eigen::VectorXd rhs_full(nX);
-  auto assemble = [&](Eigen::SparseMatrix<double>& K, Eigen::VectorXd& b) {
-    std::vector<Eigen::Triplet<double>> ht;
+  Eigen::SparseMatrix<double> H, Hw, rw, K;
+  Eigen::VectorXd b;
+  {
+    std::vector<Eigen::Triplet<double>> ht, hwt, rt;
     ht.reserve(18 * static_cast<size_t>(nF));
-    rhs_full.setZero();
+    for (int f = 0; f < nF; ++f)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          for (int c = 0; c < 2; ++c) ht.emplace_back(2 * wedge[3 * f + i] + c, 2 * wedge[3 * f + j] + c, 1.0);
+    H.resize(nX, nX);
+    H.setFromTriplets(ht.begin(), ht.end());  // the pattern, rows ascending in each column
+    auto entry = [&](int row, int col) {  // H(row, col)'s place among H's stored values
+      const int* first = H.innerIndexPtr() + H.outerIndexPtr()[col];
+      const int* last = H.innerIndexPtr() + H.outerIndexPtr()[col + 1];
+      return static_cast<int>(std::lower_bound(first, last, row) - H.innerIndexPtr());
+    };
+    hwt.reserve(18 * static_cast<size_t>(nF));
+    rt.reserve(6 * static_cast<size_t>(nF));
     for (int f = 0; f < nF; ++f) {
-      const double A = face_area[f] * weight[f];
+      const double A = face_area[f];
       const Eigen::Vector2d X(std::cos(theta[f]), std::sin(theta[f])), Y(-X.y(), X.x());
       for (int i = 0; i < 3; ++i) {
         const int wi = wedge[3 * f + i];
-        rhs_full[2 * wi] += A * s * grad[f][i].dot(X);
-        rhs_full[2 * wi + 1] += A * s * grad[f][i].dot(Y);
+        rt.emplace_back(2 * wi, f, A * grad[f][i].dot(X));
+        rt.emplace_back(2 * wi + 1, f, A * grad[f][i].dot(Y));
         for (int j = 0; j < 3; ++j) {
-          const double h = A * grad[f][i].dot(grad[f][j]);
           const int wj = wedge[3 * f + j];
-          ht.emplace_back(2 * wi, 2 * wj, h);
-          ht.emplace_back(2 * wi + 1, 2 * wj + 1, h);
+          const double h = A * grad[f][i].dot(grad[f][j]);
+          for (int c = 0; c < 2; ++c) hwt.emplace_back(entry(2 * wi + c, 2 * wj + c), f, h);
         }
       }
     }
-    Eigen::SparseMatrix<double> H(nX, nX);
-    H.setFromTriplets(ht.begin(), ht.end());
-    K = Eigen::SparseMatrix<double>(P.transpose() * H * P);
+    Hw.resize(H.nonZeros(), nF);
+    Hw.setFromTriplets(hwt.begin(), hwt.end());
+    rw.resize(nX, nF);
+    rw.setFromTriplets(rt.begin(), rt.end());
+  }
+  const Eigen::SparseMatrix<double> Pt = P.transpose();
+  auto assemble = [&]() {
+    const Eigen::Map<const Eigen::VectorXd> w(weight.data(), nF);
+    Eigen::Map<Eigen::VectorXd>(H.valuePtr(), H.nonZeros()) = Hw * w;
+    K = Pt * (H * P);
     // The map is defined up to a translation per component: a tiny pull of every unknown toward 0 makes the
     // system definite without moving anything else measurably (the right-hand side is orthogonal to translations).
     double diagonal = 0;
     for (int j = 0; j < nY; ++j) diagonal += K.coeff(j, j);
     const double epsilon = 1e-11 * (nY > 0 ? diagonal / nY : 1.0);
     for (int j = 0; j < nY; ++j) K.coeffRef(j, j) += epsilon;
-    b = P.transpose() * rhs_full;
+    K.makeCompressed();
+    b = s * (Pt * (rw * w));
   };
-  Eigen::SparseMatrix<double> K;
-  Eigen::VectorXd b;
-  assemble(K, b);
-  K.makeCompressed();
+  assemble();
   auto solver = std::make_unique<linalg::SparseCholesky>(K, "param");
   std::vector<char> fixed(nY, 0);
   Eigen::VectorXd value = Eigen::VectorXd::Zero(nY);  // the fixed integers' values
@@ -465,13 +498,14 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   };
   auto folded = [&](int f) { return !(uv_area(f) > 1e-12 * face_area[f] * s * s); };
   // Σ of the signed (u, v) corner angles at vertex v.
-  auto uv_angle_sum = [&](int v) {
+  auto uv_angle_sum = [&](int v, bool rough = false) {
     double angle = 0;
     for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
       const int f = t.vertex_faces[j], k = corner_of(t, f, v);
       const Eigen::Vector2d p = out.uv.row(3 * f + k).transpose();
       const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
-      angle += std::atan2(a.x() * c.y() - a.y() * c.x(), a.dot(c));
+      const double sine = a.x() * c.y() - a.y() * c.x(), cosine = a.dot(c);
+      angle += rough ? rough_atan2(sine, cosine) : std::atan2(sine, cosine);
     }
     return angle;
   };
@@ -506,10 +540,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
         const double ratio = folded(f) ? 20.0 : distortion(f);
         if (ratio > 2) weight[f] += std::min(ratio - 1, 20.0);
       }
-      Eigen::SparseMatrix<double> K2;
-      assemble(K2, b);
-      K2.makeCompressed();
-      K = std::move(K2);
+      assemble();
       refactor = true;
       y = solve_fixed();
       corner_uv();
@@ -538,8 +569,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
       if (std::abs(ratio * ratio - 1) > 0.1) {  // more than 10 % off in area (within that, the map is kept as it is)
         s *= ratio;
         out.edge_length /= ratio;
-        Eigen::SparseMatrix<double> K2;
-        assemble(K2, b);  // the same matrix, the right-hand side of the new scale
+        assemble();  // the same matrix, the right-hand side of the new scale
         y *= ratio;
         corner_uv();
       }
@@ -568,7 +598,25 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   // its faces (they were closer than a unit), or whose ring folds (the ring winds around it once too few or too
   // many times), tries the 8 integer points around its own; the one with the fewest folded faces, then the least
   // energy, is kept (staying is a candidate unless it coincides). Each singularity is tried once.
-  auto energy = [&](const Eigen::VectorXd& yy) { return 0.5 * yy.dot(K * yy) - b.dot(yy); };
+  // The energy ½ yᵀK y − bᵀy along y0 + dx·gu + dy·gv, a quadratic in (dx, dy): three products with K instead
+  // of one per candidate.
+  struct EnergyAlong {
+    double e0;
+    Eigen::Vector2d linear;
+    Eigen::Matrix2d quadratic;
+    double operator()(double dx, double dy) const {
+      const Eigen::Vector2d d(dx, dy);
+      return e0 + linear.dot(d) + 0.5 * d.dot(quadratic * d);
+    }
+  };
+  auto energy_along = [&](const Eigen::VectorXd& y0, const Eigen::VectorXd& gu, const Eigen::VectorXd& gv) {
+    const Eigen::VectorXd Ky0 = K * y0, Kgu = K * gu, Kgv = K * gv;
+    EnergyAlong e;
+    e.e0 = 0.5 * y0.dot(Ky0) - b.dot(y0);
+    e.linear = Eigen::Vector2d(gu.dot(Ky0) - b.dot(gu), gv.dot(Ky0) - b.dot(gv));
+    e.quadratic << gu.dot(Kgu), gu.dot(Kgv), gv.dot(Kgu), gv.dot(Kgv);
+    return e;
+  };
   auto ring_is_bad = [&](int v) {
     for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
       const int f = t.vertex_faces[j];
@@ -602,13 +650,14 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     // The solution is affine in the two values: y + dx·g_u + dy·g_v, with g_j the response to a unit change of
     // fixed value j (two solves with the current factorization, instead of one per candidate).
     const Eigen::VectorXd y0 = y, gu = response(ju), gv = response(jv);
+    const EnergyAlong energy = energy_along(y0, gu, gv);
     std::pair<int, double> best{std::numeric_limits<int>::max(), std::numeric_limits<double>::infinity()};
     Eigen::Vector2d step(0, 0);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy) {
         y = y0 + dx * gu + dy * gv;
         corner_uv();
-        const std::pair<int, double> score{count_folds() + (ring_is_bad(v) ? 1 : 0), energy(y)};
+        const std::pair<int, double> score{count_folds() + (ring_is_bad(v) ? 1 : 0), energy(dx, dy)};
         if (score < best) best = score, step = Eigen::Vector2d(dx, dy);
       }
     y = y0 + step.x() * gu + step.y() * gv;
@@ -638,14 +687,11 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
       for (int j : candidates) {
         if (budget-- <= 0 || !folded(f)) break;
         const Eigen::VectorXd y0 = y, gj = response(j);
-        const std::pair<int, double> here{count_folds(), energy(y0)};
-        std::pair<int, double> best = here;
-        int step = 0;
+        int fewest = count_folds(), step = 0;
         for (int d : {-1, 1}) {
           y = y0 + d * gj;
           corner_uv();
-          const std::pair<int, double> score{count_folds(), energy(y)};
-          if (score.first < best.first) best = score, step = d;
+          if (const int folds = count_folds(); folds < fewest) fewest = folds, step = d;
         }
         y = y0 + step * gj;
         value[j] += step;
@@ -674,37 +720,50 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     std::vector<int> next(wedge_corner_start.begin(), wedge_corner_start.end() - 1);
     for (int c = 0; c < 3 * nF; ++c) wedge_corners[next[wedge[c]]++] = c;
   }
-  // Folded faces plus singularities whose (u, v) corner angles do not sum to 2π(1 − k): an unfolded ring can
-  // still wind around its singularity once too often, which would give the quad mesh a vertex of another valence.
   // Per interior vertex: whether its (u, v) corner angles fail to sum to 2π(1 − k) (k its index, 0 off the
   // singularities). An unfolded ring can still wind around its vertex once too often or too few times, which
   // would give the quad mesh a vertex of another valence (or one more irregular vertex).
   std::vector<double> expected_angle(nV, 2 * kPi);
   for (int i = 0; i < nCone; ++i) expected_angle[out.cones[i]] = 2 * kPi * (1 - out.cone_index[i] / 4.0);
-  auto winding_errors = [&]() {
-    std::vector<char> wrong(nV, 0);
-    for (int v = 0; v < nV; ++v) wrong[v] = t.is_interior_vertex(v) && std::abs(uv_angle_sum(v) - expected_angle[v]) > 1e-6;
-    return wrong;
-  };
-  auto cone_winds_wrong = [&](int i) { return std::abs(uv_angle_sum(out.cones[i]) - expected_angle[out.cones[i]]) > 1e-6; };
-  // The folds, and which interior vertices wind wrong.
+  // With every integer whole, a ring's angles sum to 2π(1 − k) up to whole turns (the transitions rotate by
+  // quarter turns that add up to the index): the test tells whole turns apart, the rough atan2 is enough.
+  auto winds_wrong = [&](int v) { return t.is_interior_vertex(v) && std::abs(uv_angle_sum(v, true) - expected_angle[v]) > 1; };
+  auto cone_winds_wrong = [&](int i) { return winds_wrong(out.cones[i]); };
+  // The folded faces and the interior vertices winding wrong, over the whole map or over a part of it (faces and
+  // vertices given): a change of the map that moves only some faces compares the badness of those faces and of
+  // their vertices, the rest being the same before and after.
   struct Badness {
-    int folds = 0, windings = 0;
-    std::vector<char> wrong;
-    int total() const { return folds + windings; }
+    int folds = 0;
+    std::vector<int> wrong;  // the vertices winding wrong, ascending
+    int total() const { return folds + static_cast<int>(wrong.size()); }
     // Better: fewer problems in all, and no vertex winding wrong that did not before.
     bool better_than(const Badness& before) const {
-      for (size_t i = 0; i < wrong.size(); ++i)
-        if (wrong[i] && !before.wrong[i]) return false;
-      return total() < before.total();
+      return std::includes(before.wrong.begin(), before.wrong.end(), wrong.begin(), wrong.end()) && total() < before.total();
     }
   };
   auto badness = [&]() {
     Badness b;
     b.folds = count_folds();
-    b.wrong = winding_errors();
-    for (char w : b.wrong) b.windings += w;
+    for (int v = 0; v < nV; ++v)
+      if (winds_wrong(v)) b.wrong.push_back(v);
     return b;
+  };
+  auto badness_of = [&](const std::vector<int>& faces, const std::vector<int>& vertices) {
+    Badness b;
+    for (int f : faces) b.folds += folded(f);
+    for (int v : vertices)
+      if (winds_wrong(v)) b.wrong.push_back(v);
+    return b;
+  };
+  // (u, v) of the corners of `faces` only, from y (corner_uv does every corner).
+  auto corner_uv_of = [&](const std::vector<int>& faces) {
+    for (int f : faces)
+      for (int c = 3 * f; c < 3 * f + 3; ++c)
+        for (int r = 0; r < 2; ++r) {
+          double value_r = 0;
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * wedge[c] + r); it; ++it) value_r += it.value() * y[it.col()];
+          out.uv(c, r) = value_r;
+        }
   };
   // Untangles the region within `rings` rings of the vertices `seeds`; kept when the whole map has fewer folds
   // after it (returns true), else undone.
@@ -714,11 +773,12 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   int regions_left = 64 + nF / 256;
   double work_left = 2000.0 * nF + 2e7;  // faces × L-BFGS steps, over all regions
   const int too_many_folds = std::max(100, nF / 200);
+  std::vector<char> inside_scratch(nV, 0), moved_scratch(nF, 0);
+  std::vector<int> variable_scratch(nY, -1);
   auto untangle_around = [&](const std::vector<int>& seeds, int rings) {
     if (regions_left <= 0 || work_left <= 0) return false;
     --regions_left;
-    const Badness before = badness();
-    std::vector<char> inside(nV, 0);
+    std::vector<char>& inside = inside_scratch;
     std::vector<int> frontier, region;
     for (int v : seeds)
       if (!inside[v]) inside[v] = 1, frontier.push_back(v), region.push_back(v);
@@ -737,7 +797,9 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
       for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
         corners.push_back(3 * t.vertex_faces[j] + corner_of(t, t.vertex_faces[j], v));
     std::sort(corners.begin(), corners.end());
-    std::vector<int> variable(nY, -1), variables;
+    std::vector<int>& variable = variable_scratch;
+    std::vector<int> variables;
+    for (int v : region) inside[v] = 0;  // the scratch arrays are left clear for the next region
     for (int c : corners) {
       for (int r = 0; r < 2; ++r)
         for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * wedge[c] + r); it; ++it) {
@@ -746,7 +808,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
         }
     }
     if (variables.empty()) return false;
-    std::vector<char> moved(nF, 0);
+    std::vector<char>& moved = moved_scratch;
     std::vector<int> faces;
     for (int j : variables)
       for (Eigen::SparseMatrix<double>::InnerIterator it(P, j); it; ++it) {
@@ -755,6 +817,13 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
         for (int k = wedge_corner_start[w]; k < wedge_corner_start[w + 1]; ++k)
           if (const int f = wedge_corners[k] / 3; !moved[f]) moved[f] = 1, faces.push_back(f);
       }
+    for (int f : faces) moved[f] = 0;
+    std::vector<int> touched;  // the vertices of the faces that move
+    for (int f : faces)
+      for (int k = 0; k < 3; ++k) touched.push_back(t.F(f, k));
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    const Badness before = badness_of(faces, touched);
     quad::UntangleProblem problem;
     problem.num_variables = static_cast<int>(variables.size());
     for (int f : faces) {
@@ -774,24 +843,22 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
       problem.gradient.push_back(gradient);
       problem.corner.push_back(std::move(corner));
     }
+    for (int j : variables) variable[j] = -1;
     Eigen::VectorXd z(problem.num_variables);
     for (size_t k = 0; k < variables.size(); ++k) z[static_cast<int>(k)] = y[variables[k]];
-    const Eigen::VectorXd y0 = y;
+    const Eigen::VectorXd z0 = z;
     const quad::UntangleResult result = quad::untangle(problem, z);
     work_left -= static_cast<double>(faces.size()) * (result.inner_iterations + result.outer_iterations);
     for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z[static_cast<int>(k)];
-    corner_uv();
-    if (badness().better_than(before)) {
+    corner_uv_of(faces);
+    if (badness_of(faces, touched).better_than(before)) {
       ++q.untangling_regions;
       return true;
     }
-    y = y0;
-    corner_uv();
+    for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z0[static_cast<int>(k)];
+    corner_uv_of(faces);
     return false;
   };
-  // Each folded face in turn (the first still folded), in regions of 2, 4 and 8 rings; then, where a fold is
-  // left beside a singularity whose integer point is free, that point moved to each of its 8 neighbours (the
-  // solution is affine in it: two solves), the region around it untangled, the first that leaves fewer folds kept.
   std::vector<int> cone_of(nV, -1);
   for (int k = 0; k < nCone; ++k) cone_of[out.cones[k]] = k;
   // Each folded face in turn (the first still folded), in regions of 2, 4 and 8 rings.
@@ -848,6 +915,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
         check_cancelled();
         const int ju = free_index[cone0 + 2 * c], jv = free_index[cone0 + 2 * c + 1];
         const Eigen::VectorXd y0 = y, gu = response(ju), gv = response(jv);
+        const EnergyAlong energy = energy_along(y0, gu, gv);
         const Badness before = badness();
         std::vector<std::tuple<int, double, int, int>> order;
         for (int dx = -1; dx <= 1; ++dx)
@@ -855,7 +923,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
             if (dx == 0 && dy == 0) continue;
             y = y0 + dx * gu + dy * gv;
             corner_uv();
-            order.emplace_back(count_folds(), energy(y), dx, dy);
+            order.emplace_back(count_folds(), energy(dx, dy), dx, dy);
           }
         std::sort(order.begin(), order.end());
         bool kept = false;
