@@ -177,7 +177,8 @@ nlohmann::ordered_json quad_report(const QuadMesh& quads) {
             {"open_faces", q.open_faces},
             {"unused_vertices", q.unused_vertices},
             {"unclosed_vertices", q.unclosed_vertices},
-            {"map_folds", q.map_folds}}},
+            {"map_folds", q.map_folds},
+            {"relaxed_vertices", q.relaxed_vertices}}},
           {"problems", q.problems},
           {"seconds", {{"extract", q.seconds_extract}, {"check", q.seconds_check}}}};
 }

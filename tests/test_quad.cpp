@@ -19,6 +19,7 @@
 #include "trivcon/param.h"
 #include "trivcon/quad.h"
 #include "trivcon/request.h"
+#include "quad/relax.h"
 #include "support.h"
 
 namespace trivcon {
@@ -471,6 +472,44 @@ TEST(Quad, CheckFindsAHole) {
   QuadMesh bad = r.quads;
   bad.Q(0, 0) = static_cast<int>(bad.V.rows());
   EXPECT_THROW(check_quads(*r.designer, r.param, bad), Error);
+}
+
+// The relaxation (src/quad/relax.h): a vertex put onto its diagonal neighbour leaves its quads degenerate or
+// turned over; relaxing moves it back out, on the surface, without touching the connectivity or the others'
+// places more than around it.
+TEST(Quad, RelaxationUndoesAnInvertedQuad) {
+  const Mesh m = make_torus(48, 16);
+  ParamOptions o;
+  o.target_faces = 300;
+  Pipeline r = run(m, {}, o);
+  ASSERT_TRUE(r.quads.quality.problems.empty()) << quad_warning(r.quads);
+  ASSERT_EQ(inverted(r), 0);
+  QuadMesh& q = r.quads;
+  const Eigen::MatrixX4i Q = q.Q;
+  const int v = q.Q(0, 0), w = q.Q(0, 2);  // opposite corners of quad 0
+  q.V.row(v) = q.V.row(w);
+  q.vertex_face[v] = q.vertex_face[w];
+  q.vertex_barycentric.row(v) = q.vertex_barycentric.row(w);
+  q.vertex_cone[v] = -1;
+  const int broken = inverted(r);
+  ASSERT_GE(broken, 1);
+  const std::vector<char> aligned(r.designer->topology().num_edges, 0);
+  EXPECT_GE(quad::relax_quads(*r.designer, aligned, r.param.cones, q), 1);
+  EXPECT_EQ(inverted(r), 0);
+  EXPECT_TRUE(q.Q == Q);
+  EXPECT_LT(farthest_vertex(r), 1e-9);
+  // Each vertex is where its face and barycentric coordinates say.
+  const MatrixX3d& V = r.designer->V();
+  const MatrixX3i& F = r.designer->topology().F;
+  for (int i = 0; i < q.V.rows(); ++i) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) p += q.vertex_barycentric(i, k) * V.row(F(q.vertex_face[i], k)).transpose();
+    EXPECT_LT((p - q.V.row(i).transpose()).norm(), 1e-9) << "vertex " << i;
+  }
+  q.quality = {};
+  check_quads(*r.designer, r.param, q);
+  EXPECT_TRUE(q.quality.problems.empty()) << quad_warning(q);
+  EXPECT_GT(q.quality.min_scaled_jacobian, 0.2);
 }
 
 TEST(Quad, RefusesAMapOfAnotherMesh) {

@@ -81,6 +81,7 @@ struct Parametrization {
   Eigen::MatrixXi translation;      // per edge × 2, t on cut edges, 0 elsewhere
   std::vector<int> cones;           // singular interior vertices, increasing
   std::vector<int> cone_index;      // n per cone (index n / 4)
+  std::vector<int> aligned_edges;   // increasing edge ids on integer iso-lines (of ParamOptions::aligned_edges)
   double edge_length = 0;
   ParamQuality quality;
 };

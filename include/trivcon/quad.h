@@ -36,6 +36,9 @@ namespace trivcon {
 struct QuadOptions {
   int max_trace_faces = 0;  // input faces one iso-line trace may cross (0: the number of faces of the mesh)
   bool check = true;        // run check_quads on the result (fills the measures below the extraction's own)
+  // Move the vertices of inverted or nearly inverted quads on the surface (docs/quad.md, "Relaxation"): quads
+  // whose worst corner's sine about the surface's normal is below this; 0 or less: no relaxation.
+  double relax_below = 0.2;
 };
 
 struct QuadQuality {
@@ -51,6 +54,7 @@ struct QuadQuality {
   int unused_vertices = 0;         // integer points in no face (dropped from V)
   int unclosed_vertices = 0;       // input vertices whose (u, v) does not come back to itself around its fan
   int map_folds = 0;               // the map's flipped and degenerate faces (ParamQuality), for the warning
+  int relaxed_vertices = 0;        // vertices moved on the surface to undo inverted or nearly inverted quads
   std::vector<int> problem_faces;  // up to 10 input faces where points were dropped or traces failed
   // Of the quad mesh (check_quads).
   int quads = 0, vertices = 0, edges = 0, boundary_loops = 0, components = 0, euler_characteristic = 0;

@@ -342,7 +342,10 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
       any = true;
     }
     any ? ++q.aligned_edges : ++q.unaligned_edges;
+    if (any) out.aligned_edges.push_back(e);
   }
+  std::sort(out.aligned_edges.begin(), out.aligned_edges.end());
+  out.aligned_edges.erase(std::unique(out.aligned_edges.begin(), out.aligned_edges.end()), out.aligned_edges.end());
   const int nCone = static_cast<int>(out.cones.size()), nAligned = static_cast<int>(aligned.size()), nCut = static_cast<int>(out.cut_edges.size());
   const int cone0 = 2 * W, aligned0 = cone0 + 2 * nCone, cut0 = aligned0 + nAligned;
   Elimination elim(2 * W, 2 * nCone + nAligned + 2 * nCut);
