@@ -127,6 +127,8 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"untangling_regions", q.untangling_regions},
           {"flipped_faces", q.flipped_faces},
           {"degenerate_faces", q.degenerate_faces},
+          {"winding_errors", q.winding_errors},
+          {"attempts", q.attempts},
           {"first_flipped", q.first_flipped},
           {"max_transition_residual", q.max_transition_residual},
           {"max_cone_offset", q.max_cone_offset},
@@ -140,7 +142,8 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"target_squares", q.target_squares},
           {"non_unimodular", q.non_unimodular},
           {"seconds", {{"cut", q.seconds_cut}, {"setup", q.seconds_setup}, {"rounding", q.seconds_rounding},
-                       {"untangling", q.seconds_untangling}, {"stiffening", q.seconds_stiffening}, {"check", q.seconds_check}}}};
+                       {"untangling", q.seconds_untangling}, {"stiffening", q.seconds_stiffening}, {"check", q.seconds_check},
+                       {"retries", q.seconds_retries}}}};
 }
 
 nlohmann::ordered_json quad_report(const QuadMesh& quads) {

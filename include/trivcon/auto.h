@@ -45,11 +45,12 @@ struct AutoOptions {
   int iterations = 8;            // inverse-power iterations, ≥ 1
   double cancel_distance = 0;    // cancel ± pairs at most this far apart; 0: none
   bool cancel_absolute = false;  // cancel_distance in mesh units instead of mean edge lengths
-  // Split (after cancellation): singularities of one sign closer than split_distance (mesh units, along edges)
-  // whose summed |n| exceeds split_above (0: never) are gathered, and each such |n| > split_above becomes |n|
-  // singularities of ±1 on interior vertices about split_distance from it, far from each other. `trivcon param`
-  // and `quad` with --auto use split_above = N − 1 = 3 and one quad edge: a quad vertex has valence 4 − n, none
-  // for n ≥ 4.
+  // Split (after cancellation; split_above 0: never): singularities of one sign closer than split_distance (mesh
+  // units, along edges) are gathered at the member nearest their centroid; a gathered sum |n| > split_above, and
+  // any gathered positive sum, becomes |n| singularities of ±1 on interior vertices about split_distance from
+  // it, far from each other (gathered negative sums up to split_above stay: one −2 is a quad vertex of valence
+  // 6, two −1 a fraction of a unit apart fold the map). `trivcon param` and `quad` with --auto use
+  // split_above = N − 1 = 3 and one quad edge: a quad vertex has valence 4 − n, none for n ≥ 4.
   int split_above = 0;
   double split_distance = 0;
   std::map<int, double> fixed;   // face → angle in its frame (radians), held as Dirichlet values

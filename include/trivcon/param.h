@@ -40,6 +40,9 @@ struct ParamOptions {
   // least one), then re-solves.
   double rounding_fraction = 0.5;
   int max_stiffening_rounds = 20;  // re-solves with the flipped faces stiffened (MIQ's §5), integers kept
+  // A map left with a few flipped or degenerate faces or wrong windings is made again at up to this many other
+  // edge lengths (3 % and 6 % shorter and longer), the best kept (docs/param.md, "Near misses"); 0: never.
+  int retries = 4;
 };
 
 struct ParamQuality {
@@ -56,6 +59,10 @@ struct ParamQuality {
   int untangling_regions = 0; // regions untangled (each kept only when the map had fewer folds after it)
   int flipped_faces = 0;      // faces whose (u, v) triangle is inverted
   int degenerate_faces = 0;   // faces whose (u, v) triangle has (nearly) zero area
+  // Interior vertices whose (u, v) corner angles do not sum to 2π(1 − k) (k the index, 0 off the cones): where
+  // the quad mesh gets a vertex of another valence than the singularities say (0 expected).
+  int winding_errors = 0;
+  int attempts = 1;           // maps made (ParamOptions::retries); the one kept is described here
   std::vector<int> first_flipped;  // up to 10 ids of flipped or degenerate faces
   double max_transition_residual = 0;  // over cut edges: how far φ_R − J^r φ_L is from one whole vector at both ends
   double max_cone_offset = 0;          // distance of a singular vertex's (u, v) from the nearest integer point
@@ -68,6 +75,7 @@ struct ParamQuality {
   double target_squares = 0;           // mesh area / edge_length²
   int non_unimodular = 0;              // integer relations the elimination could not keep whole (0 expected)
   double seconds_cut = 0, seconds_setup = 0, seconds_rounding = 0, seconds_stiffening = 0, seconds_untangling = 0, seconds_check = 0;
+  double seconds_retries = 0;  // the attempts not kept
   // True when the map is seamless (transitions whole to 1e-6), every cone on an integer point, every aligned edge
   // on an iso-line: what the linear constraints promise. Folds (and a cone angle off by whole turns, which a
   // fold around the cone makes) are counted above.

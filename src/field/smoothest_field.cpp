@@ -13,6 +13,7 @@
 #include <memory>
 #include <queue>
 #include <random>
+#include <set>
 #include <string>
 
 #include "linalg/ordering.h"
@@ -382,6 +383,7 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
   // index at the member nearest to their centroid: two +1/4 on neighbouring vertices cannot sit on two integer
   // points of a map one unit apart, but their sum split below can.
   std::map<int, int> vertex;
+  std::set<int> spread;  // gathered positive clusters, split again whatever their sum
   {
     std::map<int, int> parent;
     for (auto [v, n] : given) parent[v] = v;
@@ -398,18 +400,22 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
       int total = 0;
       for (int v : list) centroid += V.row(v), total += given.at(v);
       centroid /= static_cast<double>(list.size());
-      if (std::abs(total) <= limit) {  // nothing to split: the members stay where they are
-        for (int v : list) vertex[v] += given.at(v);
+      if (list.size() == 1) {
+        vertex[list[0]] += total;
         continue;
       }
+      // Several: gathered at the member nearest their centroid. Negative ones stay gathered unless their sum is
+      // split below (two −1 closer than a unit fold the map between them; one −2 is a vertex of valence 6);
+      // positive ones are spread again one `distance` apart (gathered, two +1 would make a vertex of valence 2).
       int centre = list[0];
       for (int v : list)
         if ((V.row(v) - centroid).norm() < (V.row(centre) - centroid).norm()) centre = v;
       vertex[centre] += total;
+      if (total > 0) spread.insert(centre);
     }
   }
   for (auto [source, n] : vertex) {
-    if (std::abs(n) <= limit) {
+    if (std::abs(n) <= limit && !spread.count(source)) {
       out[source] += n;
       continue;
     }
