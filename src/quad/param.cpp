@@ -542,9 +542,12 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       int folds = 0;
       for (int f = 0; f < nF; ++f) folds += folded(f);
       if (folds == 0) return;
-      // Stop when three rounds in a row found no fewer folds than before them.
+      // Stop when three rounds in a row found no fewer folds than before them, or after three rounds when more
+      // than one face in 50 still folds (the map is wrong at large: far more singularities or feature lines than
+      // the squares can separate; each round is a factorization, and the stiffening only redistributes it).
       if (folds < fewest) fewest = folds, stalled = 0;
       else if (++stalled == 3) return;
+      if (round >= 3 && folds > std::max(1000, nF / 50)) return;
       for (int f = 0; f < nF; ++f) {
         const double ratio = folded(f) ? 20.0 : distortion(f);
         if (ratio > 2) weight[f] += std::min(ratio - 1, 20.0);
