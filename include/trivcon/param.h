@@ -39,6 +39,7 @@ struct ParamOptions {
   // Greedy rounding: each round fixes the integers nearest to whole numbers, this fraction of those left (at
   // least one), then re-solves.
   double rounding_fraction = 0.5;
+  int round_all_below = 16;  // when at most this many integers are left, one round fixes them all (a factorization each)
   int max_stiffening_rounds = 20;  // re-solves with the flipped faces stiffened (MIQ's §5), integers kept
   // A map left with a few flipped or degenerate faces or wrong windings is made again at up to this many other
   // edge lengths (3 % and 6 % shorter and longer), the best kept (docs/param.md, "Near misses"); 0: never.

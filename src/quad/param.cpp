@@ -598,6 +598,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       return da != dc ? da < dc : a < c;
     });
     size_t take = std::max<size_t>(1, static_cast<size_t>(std::ceil(options.rounding_fraction * left.size())));
+    if (static_cast<int>(left.size()) <= options.round_all_below) take = left.size();  // the last few at once
     while (take < left.size() && whole_offset(y[left[take]]) < 1e-9) ++take;  // already whole: free to fix
     for (size_t k = 0; k < take; ++k) fixed[left[k]] = 1, value[left[k]] = std::round(y[left[k]]);
     refactor = true;
