@@ -470,6 +470,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // The matrix depends on which unknowns are fixed, not on their values: it is factored again only after K or
   // the fixed set changed (refactor = true), so that trying other values (the local search below) costs one solve each.
   bool refactor = true;
+  Eigen::SparseMatrix<double> M;
   auto solve_fixed = [&]() -> Eigen::VectorXd {
     Eigen::VectorXd r = b;
     for (int j = 0; j < nY; ++j)
@@ -479,7 +480,16 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     for (int j = 0; j < nY; ++j)
       if (fixed[j]) r[j] = value[j];
     if (refactor) {
-      Eigen::SparseMatrix<double> M = K;
+      // M: K with the fixed rows and columns made the identity, kept between factorizations (its pattern is K's,
+      // which every assembly keeps) so that its storage is not allocated and first touched each time.
+      const bool same_pattern = M.nonZeros() == K.nonZeros() && M.cols() == K.cols() &&
+                                std::equal(K.outerIndexPtr(), K.outerIndexPtr() + K.cols() + 1, M.outerIndexPtr()) &&
+                                std::equal(K.innerIndexPtr(), K.innerIndexPtr() + K.nonZeros(), M.innerIndexPtr());
+      if (!same_pattern) {
+        M = K;
+      } else {
+        std::copy(K.valuePtr(), K.valuePtr() + K.nonZeros(), M.valuePtr());
+      }
       for (int j = 0; j < nY; ++j)
         for (Eigen::SparseMatrix<double>::InnerIterator it(M, j); it; ++it) {
           const int i = static_cast<int>(it.row());
