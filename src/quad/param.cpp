@@ -545,18 +545,18 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // it keeps its shape and the distortion spreads over its neighbours; a folded face counts as very distorted.
   // Before the rounding (on the real-valued map, so that the integers are chosen on a map without folds) and
   // after it (the integers held).
-  auto stiffen = [&](int rounds) {
+  auto stiffen = [&](int rounds, int patience) {
     int fewest = std::numeric_limits<int>::max(), stalled = 0;
     for (int round = 0; round < rounds; ++round) {
       check_cancelled();
       int folds = 0;
       for (int f = 0; f < nF; ++f) folds += folded(f);
       if (folds == 0) return;
-      // Stop when three rounds in a row found no fewer folds than before them, or after three rounds when more
+      // Stop when `patience` rounds in a row found no fewer folds than before them, or after three rounds when more
       // than one face in 50 still folds (the map is wrong at large: far more singularities or feature lines than
       // the squares can separate; each round is a factorization, and the stiffening only redistributes it).
       if (folds < fewest) fewest = folds, stalled = 0;
-      else if (++stalled == 3) return;
+      else if (++stalled == patience) return;
       if (round >= 3 && folds > std::max(1000, nF / 50)) return;
       for (int f = 0; f < nF; ++f) {
         const double ratio = folded(f) ? 20.0 : distortion(f);
@@ -598,7 +598,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     }
   }
   q.folds_real_valued = count_folds();
-  stiffen(options.max_stiffening_rounds);
+  stiffen(options.max_stiffening_rounds, 3);
   // --- Greedy rounding: the integers nearest to whole numbers first, a fraction of those left per solve --------
   std::vector<int> left = integer_free;
   while (!left.empty()) {
@@ -982,7 +982,9 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     untangle_all();
     q.untangled_faces += folds_before - count_folds();
   };
-  stiffen(options.max_stiffening_rounds);
+  // After the rounding, two rounds without fewer folds end it: the untangling below opens what is left locally,
+  // and the rounds the stiffening stalls on are a factorization each (armadillo 16 → 10 factorizations).
+  stiffen(options.max_stiffening_rounds, 2);
   q.seconds_stiffening = linalg::seconds_since(t3);
   const auto t5 = linalg::Clock::now();
   untangle_folds();
