@@ -63,7 +63,7 @@ void run_param(const ParamCommand& o) {
               << "flipped faces " << q.flipped_faces << ", degenerate " << q.degenerate_faces << " (" << q.untangled_faces
               << " untangled, " << q.stiffening_rounds << " stiffening rounds); distortion mean " << fmt(q.mean_distortion) << ", max " << fmt(q.max_distortion) << "\n"
               << "time: read " << fmt(read_seconds) << " s, field " << fmt(out.design.solve_seconds + out.design.field_seconds) << " s, map "
-              << fmt(q.seconds_cut + q.seconds_setup + q.seconds_rounding + q.seconds_untangling + q.seconds_stiffening + q.seconds_check + q.seconds_retries)
+              << fmt(q.seconds_total())
               << " s (cut " << fmt(q.seconds_cut) << ", setup " << fmt(q.seconds_setup) << ", rounding " << fmt(q.seconds_rounding)
               << ", untangling " << fmt(q.seconds_untangling) << ", stiffening "
               << fmt(q.seconds_stiffening) << ", check " << fmt(q.seconds_check) << ")\n";

@@ -70,7 +70,7 @@ void run_quad(const QuadCommand& o) {
               << "scaled Jacobian: min " << fmt(q.min_scaled_jacobian) << ", mean " << fmt(q.mean_scaled_jacobian) << "; inverted quads "
               << q.inverted_quads << "; distance to the input " << fmt(100 * q.hausdorff_relative) << " % of the bounding box diagonal\n"
               << "time: read " << fmt(run.read_seconds) << " s, field " << fmt(run.out.design.solve_seconds + run.out.design.field_seconds)
-              << " s, map " << fmt(p.seconds_cut + p.seconds_setup + p.seconds_rounding + p.seconds_untangling + p.seconds_stiffening + p.seconds_check + p.seconds_retries)
+              << " s, map " << fmt(p.seconds_total())
               << " s, quads " << fmt(q.seconds_extract + q.seconds_check) << " s (extract " << fmt(q.seconds_extract) << ", check "
               << fmt(q.seconds_check) << ")\n";
   }

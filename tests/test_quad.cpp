@@ -493,8 +493,7 @@ TEST(Quad, RelaxationUndoesAnInvertedQuad) {
   q.vertex_cone[v] = -1;
   const int broken = inverted(r);
   ASSERT_GE(broken, 1);
-  const std::vector<char> aligned(r.designer->topology().num_edges, 0);
-  EXPECT_GE(quad::relax_quads(*r.designer, aligned, r.param.cones, q), 1);
+  EXPECT_GE(quad::relax_quads(*r.designer, r.param, q), 1);
   EXPECT_EQ(inverted(r), 0);
   EXPECT_TRUE(q.Q == Q);
   EXPECT_LT(farthest_vertex(r), 1e-9);

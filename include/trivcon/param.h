@@ -77,6 +77,9 @@ struct ParamQuality {
   int non_unimodular = 0;              // integer relations the elimination could not keep whole (0 expected)
   double seconds_cut = 0, seconds_setup = 0, seconds_rounding = 0, seconds_stiffening = 0, seconds_untangling = 0, seconds_check = 0;
   double seconds_retries = 0;  // the attempts not kept
+  double seconds_total() const {  // every stage and the retries
+    return seconds_cut + seconds_setup + seconds_rounding + seconds_stiffening + seconds_untangling + seconds_check + seconds_retries;
+  }
   // True when the map is seamless (transitions whole to 1e-6), every cone on an integer point, every aligned edge
   // on an iso-line: what the linear constraints promise. Folds (and a cone angle off by whole turns, which a
   // fold around the cone makes) are counted above.

@@ -803,10 +803,7 @@ QuadMesh extract_quads(const FieldDesigner& designer, const Parametrization& par
   QuadMesh out = extractor.run();
   if (options.relax_below > 0) {
     const auto t0 = linalg::Clock::now();
-    std::vector<char> aligned(designer.topology().num_edges, 0);
-    for (int e : param.aligned_edges)
-      if (e >= 0 && e < designer.topology().num_edges) aligned[e] = 1;
-    out.quality.relaxed_vertices = quad::relax_quads(designer, aligned, param.cones, out, options.relax_below);
+    out.quality.relaxed_vertices = quad::relax_quads(designer, param, out, options.relax_below);
     out.quality.seconds_extract += linalg::seconds_since(t0);
   }
   if (options.check) check_quads(designer, param, out);

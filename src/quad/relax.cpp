@@ -12,8 +12,7 @@
 
 namespace trivcon::quad {
 
-int relax_quads(const FieldDesigner& designer, const std::vector<char>& aligned_edge, const std::vector<int>& cones, QuadMesh& quads,
-                double threshold, int sweeps) {
+int relax_quads(const FieldDesigner& designer, const Parametrization& param, QuadMesh& quads, double threshold, int sweeps) {
   const Topology& t = designer.topology();
   const MatrixX3d& Vin = designer.V();
   const MatrixX3d& normal = designer.geometry().normal;
@@ -23,10 +22,11 @@ int relax_quads(const FieldDesigner& designer, const std::vector<char>& aligned_
     if (quads.vertex_face[v] < 0 || quads.vertex_face[v] >= t.num_faces) return 0;  // not located: nothing to move on
 
   // Which vertices stay.
-  std::vector<char> pinned(nV, 0), is_cone(t.num_vertices, 0), near_aligned(t.num_vertices, 0);
-  for (int c : cones) is_cone[c] = 1;
-  for (int e = 0; e < t.num_edges && e < static_cast<int>(aligned_edge.size()); ++e)
-    if (aligned_edge[e]) near_aligned[t.edge_vertices(e, 0)] = near_aligned[t.edge_vertices(e, 1)] = 1;
+  std::vector<char> pinned(nV, 0), is_cone(t.num_vertices, 0), aligned_edge(t.num_edges, 0), near_aligned(t.num_vertices, 0);
+  for (int c : param.cones)
+    if (c >= 0 && c < t.num_vertices) is_cone[c] = 1;
+  for (int e : param.aligned_edges)
+    if (e >= 0 && e < t.num_edges) aligned_edge[e] = 1, near_aligned[t.edge_vertices(e, 0)] = near_aligned[t.edge_vertices(e, 1)] = 1;
   for (int v = 0; v < nV; ++v) {
     if (const int c = quads.vertex_cone[v]; c >= 0) {
       pinned[v] = is_cone[c] || near_aligned[c] || !t.is_interior_vertex(c);
@@ -36,7 +36,7 @@ int relax_quads(const FieldDesigner& designer, const std::vector<char>& aligned_
     for (int k = 0; k < 3; ++k)  // inside the edge opposite corner k
       if (quads.vertex_barycentric(v, k) == 0) {
         const int e = edge_between(t, t.F(f, (k + 1) % 3), t.F(f, (k + 2) % 3));
-        if (e < 0 || t.is_boundary_edge(e) || (e < static_cast<int>(aligned_edge.size()) && aligned_edge[e])) pinned[v] = 1;
+        if (e < 0 || t.is_boundary_edge(e) || aligned_edge[e]) pinned[v] = 1;
       }
   }
   for (const auto& face : quads.other_faces)
@@ -123,39 +123,38 @@ int relax_quads(const FieldDesigner& designer, const std::vector<char>& aligned_
     }
     return s;
   };
+  // Sweeps: the free vertices of the quads below the threshold try to move; the next sweep looks only at the
+  // quads around the vertices that moved (nothing else changed).
   int moved_vertices = 0;
-  std::vector<char> moved(nV, 0), active(nV, 0);
+  std::vector<char> moved(nV, 0), active(nV, 0), suspect(nQ, 1);
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     std::fill(active.begin(), active.end(), 0);
     bool any = false;
     for (int i = 0; i < nQ; ++i)
-      if (worst_corner(i, -1, Eigen::Vector3d::Zero(), -1) < threshold)
+      if (suspect[i] && worst_corner(i, -1, Eigen::Vector3d::Zero(), -1) < threshold)
         for (int k = 0; k < 4; ++k)
           if (!pinned[quads.Q(i, k)]) active[quads.Q(i, k)] = 1, any = true;
     if (!any) break;
+    std::fill(suspect.begin(), suspect.end(), 0);
     bool improved = false;
     for (int v = 0; v < nV; ++v) {
       if (!active[v]) continue;
       const Eigen::Vector3d p = quads.V.row(v).transpose();
-      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-      int count = 0;
-      for (int j = quad_start[v]; j < quad_start[v + 1]; ++j) {
-        const int i = quad_list[j];
-        for (int k = 0; k < 4; ++k)
-          if (quads.Q(i, k) == v) centre += quads.V.row(quads.Q(i, (k + 1) % 4)).transpose() + quads.V.row(quads.Q(i, (k + 3) % 4)).transpose(), count += 2;
-      }
-      if (count == 0) continue;
-      centre /= count;
       // Where to try: the mean of the neighbours, and for each quad around v the corner that completes the
       // parallelogram of its other three vertices; the whole step, half and a quarter; the best kept.
-      std::vector<Eigen::Vector3d> targets{centre};
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      std::vector<Eigen::Vector3d> targets(1);
       for (int j = quad_start[v]; j < quad_start[v + 1]; ++j) {
         const int i = quad_list[j];
         for (int k = 0; k < 4; ++k)
-          if (quads.Q(i, k) == v)
-            targets.push_back(quads.V.row(quads.Q(i, (k + 1) % 4)).transpose() + quads.V.row(quads.Q(i, (k + 3) % 4)).transpose() -
-                              quads.V.row(quads.Q(i, (k + 2) % 4)).transpose());
+          if (quads.Q(i, k) == v) {
+            const Eigen::Vector3d next = quads.V.row(quads.Q(i, (k + 1) % 4)).transpose(), previous = quads.V.row(quads.Q(i, (k + 3) % 4)).transpose();
+            centre += next + previous;
+            targets.push_back(next + previous - quads.V.row(quads.Q(i, (k + 2) % 4)).transpose());
+          }
       }
+      if (targets.size() == 1) continue;
+      targets[0] = centre / (2.0 * static_cast<double>(targets.size() - 1));
       Score best = score_around(v, p, quads.vertex_face[v]);
       const double best_before = best.penalty;
       Eigen::Vector3d best_point = p, best_bary = quads.vertex_barycentric.row(v).transpose();
@@ -174,6 +173,7 @@ int relax_quads(const FieldDesigner& designer, const std::vector<char>& aligned_
         quads.vertex_barycentric.row(v) = best_bary.transpose();
         quads.vertex_cone[v] = -1;  // no longer on an input vertex (cones do not move)
         if (!moved[v]) moved[v] = 1, ++moved_vertices;
+        for (int j = quad_start[v]; j < quad_start[v + 1]; ++j) suspect[quad_list[j]] = 1;
         improved = true;
       }
     }

@@ -10,17 +10,13 @@
 // around that vertex gets better. Cones, vertices on aligned input edges and on the quad mesh's boundary, and
 // vertices of faces that are not quads stay. The mesh's connectivity is never changed.
 #pragma once
-#include <vector>
-
 #include "trivcon/design.h"
 #include "trivcon/quad.h"
 
 namespace trivcon::quad {
 
-// `aligned_edge`: per input edge, whether it lies on an integer iso-line (its vertices stay on it). `cones`:
-// input vertices that are singular. Updates quads.V, vertex_face and vertex_barycentric; returns the number of
-// vertices moved.
-int relax_quads(const FieldDesigner& designer, const std::vector<char>& aligned_edge, const std::vector<int>& cones, QuadMesh& quads,
-                double threshold = 0.2, int sweeps = 20);
+// `param`: the map the quads were extracted from (its cones and aligned edges stay where they are). Updates
+// quads.V, vertex_face, vertex_barycentric and vertex_cone; returns the number of vertices moved.
+int relax_quads(const FieldDesigner& designer, const Parametrization& param, QuadMesh& quads, double threshold = 0.2, int sweeps = 20);
 
 }  // namespace trivcon::quad
