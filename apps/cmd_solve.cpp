@@ -58,13 +58,28 @@ void report_features(const SolveOptions& o, const FieldDesigner& designer, const
                          {"followed", {t.edge_vertices(k.followed, 0), t.edge_vertices(k.followed, 1)}},
                          {"other", {t.edge_vertices(k.other, 0), t.edge_vertices(k.other, 1)}},
                          {"difference", k.difference}});
-  extra["features"] = {{"sharp_edges", c.sharp_edges.size()}, {"convex", c.convex_edges},   {"fixed_faces", a.fixed.size()},
-                       {"corner_faces", a.corner_faces},      {"conflicts", conflicts}, {"boundary_overridden", c.boundary_overridden}};
+  nlohmann::ordered_json narrow = nlohmann::ordered_json::array();
+  for (const NarrowCorner& k : a.narrow)
+    narrow.push_back({{"vertex", k.vertex},
+                      {"first", {t.edge_vertices(k.first, 0), t.edge_vertices(k.first, 1)}},
+                      {"second", {t.edge_vertices(k.second, 0), t.edge_vertices(k.second, 1)}},
+                      {"angle", k.angle},
+                      {"faces", k.faces}});
+  extra["features"] = {{"sharp_edges", c.sharp_edges.size()},
+                       {"convex", c.convex_edges},
+                       {"fixed_faces", a.fixed.size()},
+                       {"corner_faces", a.corner_faces},
+                       {"conflicts", conflicts},
+                       {"narrow_corners", narrow},
+                       {"boundary_overridden", c.boundary_overridden}};
   if (o.field.features.degrees_option->count() > 0) extra["features"]["degrees"] = o.field.features.degrees;
   if (o.field.features.file_option->count() > 0) extra["features"]["file"] = o.field.features.file;
   std::ostringstream text;
   text << "features: " << c.sharp_edges.size() << " sharp edges (" << c.convex_edges << " convex), " << a.fixed.size()
        << " faces fixed beside them, " << a.corner_faces << " beside two or more\n";
+  if (!a.narrow.empty())
+    text << "features: " << a.narrow.size() << " narrow corners (sharp edges meeting at less than pi/N) turned through by one step, "
+         << "so that a map gives each a corner of its own (report: features.narrow_corners)\n";
   if (c.boundary_overridden > 0)
     text << "features: " << c.boundary_overridden << " faces beside both a boundary edge and a sharp edge follow the sharp edge\n";
   summary = text.str();

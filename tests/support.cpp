@@ -5,12 +5,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -176,6 +178,39 @@ std::vector<int> vertices_of_valence(const Mesh& m, int valence) {
   for (int v = 0; v < m.V.rows(); ++v)
     if (count[v] == valence) out.push_back(v);
   return out;
+}
+
+Mesh sheared_box(int n) {
+  // The cube [-1, 1]³, each side an n × n grid of squares, each square a fan of 4 triangles around its centre;
+  // vertices shared through their positions (exact: multiples of 1/n and 1/2n).
+  std::map<std::array<double, 3>, int> id;
+  std::vector<Eigen::Vector3d> V;
+  std::vector<Eigen::Vector3i> F;
+  auto vertex = [&](const Eigen::Vector3d& p) {
+    const auto [it, added] = id.try_emplace({p.x(), p.y(), p.z()}, static_cast<int>(V.size()));
+    if (added) V.push_back(p);
+    return it->second;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side : {-1, 1})
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          auto point = [&](double a, double b) {
+            Eigen::Vector3d p;
+            p[axis] = side, p[(axis + 1) % 3] = -1 + 2 * a / n, p[(axis + 2) % 3] = -1 + 2 * b / n;
+            return p;
+          };
+          std::array<int, 4> q{vertex(point(i, j)), vertex(point(i + 1, j)), vertex(point(i + 1, j + 1)), vertex(point(i, j + 1))};
+          if (side < 0) std::swap(q[1], q[3]);  // outward normals
+          const int c = vertex(point(i + 0.5, j + 0.5));
+          for (int k = 0; k < 4; ++k) F.emplace_back(q[k], q[(k + 1) % 4], c);
+        }
+  Mesh m;
+  m.V.resize(static_cast<Eigen::Index>(V.size()), 3);
+  for (size_t v = 0; v < V.size(); ++v) m.V.row(static_cast<Eigen::Index>(v)) = V[v].transpose() + Eigen::RowVector3d(2.5 * V[v].y(), 0, 0);
+  m.F.resize(static_cast<Eigen::Index>(F.size()), 3);
+  for (size_t f = 0; f < F.size(); ++f) m.F.row(static_cast<Eigen::Index>(f)) = F[f].transpose();
+  return m;
 }
 
 Mesh jittered_disk(int rings, int segments, double amount) {

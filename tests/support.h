@@ -60,6 +60,10 @@ std::vector<int> vertices_of_valence(const Mesh& m, int valence);
 // spacing in a pseudo-random direction (deterministic): no symmetry left, so a zero of order k of a field
 // splits into k simple ones as on a generic mesh (on the symmetric disk, zeros sit on the symmetry).
 Mesh jittered_disk(int rings, int segments, double amount);
+// The cube [-1, 1]³ (each side n × n squares, each square 4 triangles around its centre) sheared along x by
+// 2.5 y: its sides z = ±1 are parallelograms with corners of atan(1 / 2.5) ≈ 21.8° and 158.2° where the
+// sharp edges meet (narrow corners, trivcon/features.h), each corner of a side shared by two triangles.
+Mesh sheared_box(int n);
 
 // Checks every structural invariant of a Topology against F (the input) alone. Cheap: O(F log F).
 void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const std::string& what);

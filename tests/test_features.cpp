@@ -3,6 +3,7 @@
 // --auto's placement and with singularities given by hand), conflicts at corners, and the .sharp / .rosy
 // files QuadWild reads.
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -10,6 +11,7 @@
 #include "trivcon/auto.h"
 #include "trivcon/features.h"
 #include "trivcon/field_io.h"
+#include "trivcon/generate.h"
 #include "trivcon/io.h"
 
 namespace trivcon {
@@ -99,10 +101,12 @@ void expect_exact_and_aligned(const FieldDesigner& designer, const Solved& s) {
   EXPECT_EQ(read, s.singularities);
   std::set<std::pair<int, int>> conflicting;  // (face, edge it does not follow)
   for (const FeatureConflict& c : s.alignment.conflicts) conflicting.insert({c.face, c.other});
+  std::set<int> narrow;  // faces of narrow corners follow neither edge, by design
+  for (const NarrowCorner& k : s.alignment.narrow) narrow.insert(k.faces.begin(), k.faces.end());
   int checked = 0;
   for (const auto& [f, edges] : faces_beside(designer.topology(), s.edges))
     for (int e : edges) {
-      if (conflicting.count({f, e})) continue;
+      if (conflicting.count({f, e}) || narrow.count(f)) continue;
       const Eigen::Vector3d dir = designer.geometry().direction_in_face(f, d.field.angle(f));
       EXPECT_LE(off_edge(designer.V(), designer.topology(), f, e, dir), 1e-9) << "face " << f << " edge " << e;
       ++checked;
@@ -223,6 +227,36 @@ TEST(FeatureAlignment, CubeWithAutoGetsItsEightCorners) {
   ASSERT_EQ(corners.size(), 8u);
   EXPECT_EQ(s.singularities, corners);
   expect_exact_and_aligned(designer, s);
+}
+
+TEST(FeatureAlignment, NarrowCornersTurnByOneStep) {
+  // At the four 21.8° corners a field following both sharp edges would give the corner's sector no turn
+  // (a map would collapse it, and each such box corner would be a +1/2); the sector's faces take a step less
+  // instead, and --auto finds the box's eight corners at +1/4 each, like a cube's.
+  const Mesh m = test::sheared_box(6);
+  FieldDesigner designer(m.V, m.F);
+  const Solved s = solve_with_features(designer, 30);
+  ASSERT_EQ(s.alignment.narrow.size(), 4u);
+  const Topology& t = designer.topology();
+  for (const NarrowCorner& k : s.alignment.narrow) {
+    EXPECT_NEAR(k.angle, std::atan(1 / 2.5), 1e-9);
+    EXPECT_EQ(k.faces.size(), 2u);
+    // The two edges are sharp and meet at the corner, one of the box's eight.
+    for (int e : {k.first, k.second}) {
+      EXPECT_TRUE(std::count(s.edges.begin(), s.edges.end(), e));
+      EXPECT_TRUE(t.edge_vertices(e, 0) == k.vertex || t.edge_vertices(e, 1) == k.vertex);
+    }
+  }
+  // Eight +1/4 singularities: the four narrow corners, and one inside each side near each 158.2° corner (a
+  // side's quad corners are then 90°, 180°, 90°, 180°: two quarter turns short of a disk's four, made up inside).
+  ASSERT_EQ(s.singularities.size(), 8u);
+  for (auto [v, n] : s.singularities) EXPECT_EQ(n, 1) << "vertex " << v;
+  for (const NarrowCorner& k : s.alignment.narrow) EXPECT_EQ(s.singularities.count(k.vertex), 1u) << "corner " << k.vertex;
+  expect_exact_and_aligned(designer, s);
+  EXPECT_TRUE(design_verified(s.design));
+  // For N = 2 (lines), no corner is narrow: a line field has no quad corner to give.
+  const FeatureAlignment lines = feature_alignment(m.V, t, designer.geometry(), s.edges, 2);
+  EXPECT_TRUE(lines.narrow.empty());
 }
 
 TEST(FeatureAlignment, CubeWithSingularitiesByHand) {

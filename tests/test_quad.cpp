@@ -245,6 +245,30 @@ TEST(Quad, FlatCubeIsItsOwnGrid) {
   }
 }
 
+TEST(Quad, ShearedBoxGetsAQuadCornerAtEachNarrowCorner) {
+  // The sheared box's 21.8° corners between sharp edges (trivcon/features.h, narrow corners): each a quad
+  // corner (valence 3) instead of a collapsed sector, the map without a flipped or degenerate triangle.
+  const Mesh m = test::sheared_box(6);
+  FieldRequest req;
+  req.feature_degrees = 30;
+  req.auto_place = true;
+  for (int target : {300, 1000}) {
+    ParamOptions o;
+    o.target_faces = target;
+    const Pipeline r = run(m, req, o, true);
+    const std::string what = "target " + std::to_string(target);
+    ASSERT_EQ(r.outcome.constraints.features.narrow.size(), 4u) << what;
+    EXPECT_EQ(r.param.quality.flipped_faces + r.param.quality.degenerate_faces, 0) << what << ": " << param_warning(r.param);
+    EXPECT_EQ(r.param.quality.unaligned_edges, 0) << what;
+    expect_clean(r, what);
+    for (const NarrowCorner& k : r.outcome.constraints.features.narrow) {
+      const auto it = std::find(r.param.cones.begin(), r.param.cones.end(), k.vertex);
+      ASSERT_NE(it, r.param.cones.end()) << what << ": corner " << k.vertex;
+      EXPECT_EQ(r.param.cone_index[it - r.param.cones.begin()], 1) << what;
+    }
+  }
+}
+
 TEST(Quad, CubeSphereWithAutomaticCones) {
   const Mesh m = make_cube_sphere(12, true);
   FieldRequest req;

@@ -18,6 +18,13 @@
 //   follows the longest one; the others are compatible when their directions agree with it modulo 2π/N within kFeatureAngleTolerance (for N
 //   = 4 two perpendicular edges are: a cross along one is along the other), and every face where they do not is reported
 //   (FeatureAlignment::conflicts), never resolved silently.
+// - Narrow corners (N even, N ≥ 4): where two consecutive feature edges a, b around a vertex enclose a
+//   sector of angle θ < π/N (a tapering strip, the tip of a crease), a field following both would give the
+//   sector no turn of its own and a map aligned to both would collapse it. The sector's m faces are fixed
+//   instead to a's direction turned by δ, 2δ, …, mδ with δ = (θ − 2π/N)/(m + 1), so that the field turns
+//   through the sector by one step less than the edges do and the sector's quad corner is 2π/N (one quad
+//   corner at the tip). Each is listed (FeatureAlignment::narrow); its faces are not conflicts. Skipped
+//   where a sector face has another feature edge, or lies in a second narrow sector.
 // - QuadWild's .sharp file (written by write_sharp, read back by read_sharp): line 1 the number of lines
 //   that follow, then one line "convexity,face,edge" per side of each feature edge: convexity 1 convex, 0
 //   concave; `face` the face id; `edge` ∈ {0, 1, 2} the edge joining the face's vertices edge and edge + 1
@@ -58,9 +65,18 @@ struct FeatureConflict {
   double difference;    // |angle of other − angle of followed| modulo 2π/N, radians in (tolerance, π/N]
 };
 
+// Consecutive feature edges around `vertex` enclosing a sector narrower than π/N (see above).
+struct NarrowCorner {
+  int vertex;
+  int first, second;  // edge ids, in the counter-clockwise sense around the vertex
+  double angle;             // θ, radians
+  std::vector<int> faces;   // the sector's faces W_1..W_m, from `first` to `second`
+};
+
 struct FeatureAlignment {
   std::map<int, double> fixed;             // face → angle in the face's frame (IndexPrescription::fixed)
   std::vector<FeatureConflict> conflicts;  // one per (face, disagreeing edge), by face
+  std::vector<NarrowCorner> narrow;        // by vertex
   int corner_faces = 0;                    // faces beside two or more feature edges (compatible or not)
 };
 // The fixed directions for `edges` (interior edge ids) and symmetry N ≥ 1.

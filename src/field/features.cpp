@@ -20,6 +20,81 @@ int corner_of(const Topology& t, int f, int e) {
   return -1;
 }
 
+// Narrow corners (trivcon/features.h): at vertex v, consecutive feature edges a, b around v enclosing a sector
+// of angle θ < π/N (the corners at v of the faces between them). Following both, the field would turn by θ
+// through the sector, and a map that puts a and b on iso-lines would give the sector the angle 0: its faces
+// collapse. Instead the sector's faces W_1..W_m (in the turning sense from a) are fixed to the direction of a
+// turned by i·δ, δ = (θ − 2π/N)/(m + 1): with the faces across a and b (which follow their edges) every
+// step turns by |δ| < π/N, so the closest reading turns through the sector by θ − 2π/N and the sector gets one
+// step, 2π/N. Only sectors whose faces have no feature edges but a and b, and no face in two such sectors.
+void narrow_corners(const Topology& t, const Geometry& g, const std::vector<int>& edges, const std::map<int, std::vector<int>>& sharp_beside,
+                    int N, FeatureAlignment& out) {
+  if (N < 4 || N % 2 != 0) return;  // a sense-free step of 2π/N that a quad or hexagon corner can take
+  std::vector<char> sharp(t.num_edges, 0);
+  std::vector<int> count(t.num_vertices, 0);
+  for (int e : edges) {
+    sharp[e] = 1;
+    ++count[t.edge_vertices(e, 0)], ++count[t.edge_vertices(e, 1)];
+  }
+  std::vector<char> claimed(t.num_faces, 0);
+  auto corner_at = [&](int f, int v) {
+    for (int k = 0; k < 3; ++k)
+      if (t.F(f, k) == v) return k;
+    return -1;
+  };
+  for (int v = 0; v < t.num_vertices; ++v) {
+    if (count[v] < 2) continue;
+    // A face at v whose outgoing half-edge at v (corner k → k+1) is a feature edge: the walk starts there.
+    int start = -1;
+    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1] && start < 0; ++j) {
+      const int f = t.vertex_faces[j];
+      if (sharp[t.face_edges(f, corner_at(f, v))]) start = f;
+    }
+    if (start < 0) continue;
+    // Walk counter-clockwise: from face f across its incoming half-edge at v (corner k+2 → k) to the next face.
+    std::vector<int> sector;
+    double theta = 0;
+    int f = start;
+    const int degree = t.vertex_face_offsets[v + 1] - t.vertex_face_offsets[v];
+    for (int step = 0; step < degree; ++step) {
+      const int k = corner_at(f, v);
+      sector.push_back(f);
+      theta += g.corner_angles(f, k);
+      const int incoming = t.face_edges(f, (k + 2) % 3);
+      if (sharp[incoming]) {
+        const int a = t.face_edges(sector.front(), corner_at(sector.front(), v));
+        bool usable = theta < kPi / N;
+        for (int w : sector) {
+          usable = usable && !claimed[w];
+          const auto it = sharp_beside.find(w);
+          if (it != sharp_beside.end())
+            for (int e : it->second) usable = usable && (e == a || e == incoming);
+        }
+        if (usable) {
+          const int m = static_cast<int>(sector.size());
+          const double delta = (theta - 2 * kPi / N) / (m + 1);
+          double gamma = 0;  // the angle at v from a to W_i's outgoing half-edge
+          for (int i = 0; i < m; ++i) {
+            const int w = sector[i], c = corner_at(w, v);
+            out.fixed[w] = wrap_angle(g.half_edge_angle(w, c) - gamma + (i + 1) * delta);
+            claimed[w] = 1;
+            gamma += g.corner_angles(w, c);
+          }
+          out.narrow.push_back({v, a, incoming, theta, sector});
+        }
+        sector.clear();
+        theta = 0;
+      }
+      if (t.is_boundary_edge(incoming)) break;
+      f = t.edge_faces(incoming, 0) == f ? t.edge_faces(incoming, 1) : t.edge_faces(incoming, 0);
+    }
+  }
+  if (out.narrow.empty()) return;
+  // A face of a narrow corner follows neither edge on purpose: it is no conflict.
+  out.conflicts.erase(std::remove_if(out.conflicts.begin(), out.conflicts.end(), [&](const FeatureConflict& k) { return claimed[k.face]; }),
+                      out.conflicts.end());
+}
+
 }  // namespace
 
 double dihedral_angle(const Topology& t, const Geometry& g, int e) {
@@ -69,6 +144,9 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const 
     }
   }
   FeatureAlignment out;
+  std::map<int, std::vector<int>> sharp_beside;  // face → its feature edges (for the narrow corners below)
+  for (auto& [f, list] : beside)
+    for (const Candidate& c : list) sharp_beside[f].push_back(c.edge);
   for (auto& [f, list] : beside) {
     // The longest edge is followed; ties go to the smaller edge id, so the choice is deterministic.
     std::sort(list.begin(), list.end(),
@@ -80,6 +158,7 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const 
       if (difference > kFeatureAngleTolerance) out.conflicts.push_back({f, list[0].edge, list[k].edge, difference});
     }
   }
+  narrow_corners(t, g, edges, sharp_beside, N, out);
   return out;
 }
 
