@@ -72,6 +72,13 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                                    {"field", {{"verified", run.out.verified}, {"energy", run.out.design.connection.energy}}},
                                    {"param", param_report(param)}};
   if (const RepairedMesh* repair = run.repaired()) report["repair"] = repair_summary_json(*repair);
+  if (!run.out.sharp_edges.empty()) {
+    const FeatureAlignment& a = run.out.constraints.features;
+    report["features"] = {{"sharp_edges", run.out.sharp_edges.size()},
+                          {"conflicts", a.conflicts.size()},
+                          {"narrow_corners", a.narrow.size()},
+                          {"singularities_moved_onto_them", a.snapped.size()}};
+  }
   if (run.out.relax_result) report["relax"] = relax_summary_json(*run.out.relax_result);
   for (size_t i = 0; i < param.cones.size(); ++i)
     report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});

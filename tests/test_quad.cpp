@@ -269,6 +269,37 @@ TEST(Quad, ShearedBoxGetsAQuadCornerAtEachNarrowCorner) {
   }
 }
 
+TEST(Quad, SingularitiesNearASharpEdgeMoveOntoIt) {
+  // A capped cylinder of radius 1: --auto puts four +1/4 inside each cap. At 60 squares (a unit ≈ 0.6) they lie
+  // within 0.8 units of the rims and move onto them (trivcon/features.h): each rim vertex then turns its cap-side
+  // sector one step less (a quad corner of valence 3 on the rim). At 400 squares they stay inside the caps.
+  const Mesh m = make_capped_cylinder(6, 32, 12, 2.0);
+  for (int target : {60, 400}) {
+    FieldRequest req;
+    req.feature_degrees = 30;
+    req.auto_place = true;
+    cancel_for_map(req, FieldDesigner(m.V, m.F), 0, target);
+    ParamOptions o;
+    o.target_faces = target;
+    const Pipeline r = run(m, req, o, true);
+    const std::string what = "target " + std::to_string(target);
+    const std::vector<FeatureSnap>& moved = r.outcome.constraints.features.snapped;
+    ASSERT_EQ(r.param.cones.size(), 8u) << what;
+    int on_rim = 0;
+    for (int v : r.param.cones) {
+      const double radius = std::hypot(m.V(v, 0), m.V(v, 1));
+      on_rim += std::abs(radius - 1) < 1e-9 && std::abs(std::abs(m.V(v, 2)) - 1) < 1e-9;
+    }
+    for (int n : r.param.cone_index) EXPECT_EQ(n, 1) << what;
+    EXPECT_EQ(moved.size(), target == 60 ? 8u : 0u) << what;
+    EXPECT_EQ(on_rim, static_cast<int>(moved.size())) << what;
+    const double unit = std::sqrt(r.designer->geometry().face_area.sum() / target);
+    for (const FeatureSnap& k : moved) EXPECT_LT(k.distance, 0.8 * unit) << what;
+    EXPECT_EQ(r.param.quality.flipped_faces + r.param.quality.degenerate_faces, 0) << what;
+    expect_clean(r, what);
+  }
+}
+
 TEST(Quad, CubeSphereWithAutomaticCones) {
   const Mesh m = make_cube_sphere(12, true);
   FieldRequest req;

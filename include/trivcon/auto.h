@@ -54,6 +54,13 @@ struct AutoOptions {
   int split_above = 0;
   double split_distance = 0;
   std::map<int, double> fixed;   // face → angle in its frame (radians), held as Dirichlet values
+  // Vertices whose singularities are prescribed as found, never cancelled, gathered or split: the ends of
+  // sharp edges, where the fixed faces' turns make them (trivcon/features.h); moved, the turn would stay and
+  // the exact field would make it up with a large turn beside them.
+  std::vector<int> held;
+  // For a map (set by the map requests, trivcon/request.h; 0: never): singularities closer than this (mesh units,
+  // along edges) to a feature line are then moved onto it (move_singularities_onto_features, trivcon/features.h).
+  double onto_features = 0;
   bool align_curvature = false;  // follow the principal curvature directions (see above); N even
   double curvature_t = 0;        // its strength t < 1: 0 as geometry-central, → 1 smoother, < 0 closer to the curvature
 };

@@ -73,15 +73,32 @@ struct NarrowCorner {
   std::vector<int> faces;   // the sector's faces W_1..W_m, from `first` to `second`
 };
 
+// A singularity moved onto a feature line (move_singularities_onto_features).
+struct FeatureSnap {
+  int from, to;     // vertex ids
+  double distance;  // along edges
+};
+
 struct FeatureAlignment {
   std::map<int, double> fixed;             // face → angle in the face's frame (IndexPrescription::fixed)
   std::vector<FeatureConflict> conflicts;  // one per (face, disagreeing edge), by face
   std::vector<NarrowCorner> narrow;        // by vertex
+  std::vector<FeatureSnap> snapped;        // by `from`
   int corner_faces = 0;                    // faces beside two or more feature edges (compatible or not)
 };
 // The fixed directions for `edges` (interior edge ids) and symmetry N ≥ 1.
 FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
                                    int N);
+
+// For a map (N even, N ≥ 4): each singularity of index ±1/N in `vertex` (vertex → n) closer than `distance`
+// along edges to a feature line is moved onto the nearest vertex w of the line, if w has two sharp edges and
+// no singularity: the sector of w facing it (its faces beside no other sharp edge) is turned through with one
+// step more (−1/N) or fewer (+1/N) than the nearest to its angle, as a narrow corner's, so that w gets the
+// index. A singularity closer than half a unit to a feature line would otherwise be rounded onto the line's
+// iso-line beside it, squeezing the faces between them flat. Updates `vertex` and `alignment.fixed` (new
+// faces among them: the sector's middle ones), lists the moves in `alignment.snapped`.
+void move_singularities_onto_features(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
+                                      int N, double distance, std::map<int, int>& vertex, FeatureAlignment& alignment);
 
 // One line of a .sharp file.
 struct SharpFaceEdge {

@@ -4,10 +4,12 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "trivcon/error.h"
 #include "trivcon/field.h"
+#include "field/edge_dijkstra.h"
 
 namespace trivcon {
 
@@ -20,75 +22,111 @@ int corner_of(const Topology& t, int f, int e) {
   return -1;
 }
 
-// Narrow corners (trivcon/features.h): at vertex v, consecutive feature edges a, b around v enclosing a sector
-// of angle θ < π/N (the corners at v of the faces between them). Following both, the field would turn by θ
-// through the sector, and a map that puts a and b on iso-lines would give the sector the angle 0: its faces
-// collapse. Instead the sector's faces W_1..W_m (in the turning sense from a) are fixed to the direction of a
-// turned by i·δ, δ = (θ − 2π/N)/(m + 1): with the faces across a and b (which follow their edges) every
-// step turns by |δ| < π/N, so the closest reading turns through the sector by θ − 2π/N and the sector gets one
-// step, 2π/N. Only sectors whose faces have no feature edges but a and b, and no face in two such sectors.
-void narrow_corners(const Topology& t, const Geometry& g, const std::vector<int>& edges, const std::map<int, std::vector<int>>& sharp_beside,
-                    int N, FeatureAlignment& out) {
-  if (N < 4 || N % 2 != 0) return;  // a sense-free step of 2π/N that a quad or hexagon corner can take
+// The sectors around interior vertex v between consecutive sharp edges, counter-clockwise (none when fewer
+// than two sharp edges meet there). A face at v holds its corner k at v; its outgoing half-edge there is
+// face_edges(f, k) (k → k+1), its incoming one face_edges(f, k+2); the next face counter-clockwise is across
+// the incoming one.
+struct Sector {
+  int first = -1, second = -1;  // the sharp edges: the first face's outgoing, the last face's incoming half-edge
+  std::vector<int> faces;
+  double theta = 0;  // the corners' angles at v
+};
+
+int corner_at(const Topology& t, int f, int v) {
+  for (int k = 0; k < 3; ++k)
+    if (t.F(f, k) == v) return k;
+  return -1;
+}
+
+std::vector<Sector> sectors_at(const Topology& t, const Geometry& g, int v, const std::vector<char>& sharp) {
+  std::vector<Sector> out;
+  if (!t.is_interior_vertex(v)) return out;
+  int start = -1, count = 0;
+  for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
+    const int f = t.vertex_faces[j];
+    if (sharp[t.face_edges(f, corner_at(t, f, v))]) ++count, start = start < 0 ? f : start;
+  }
+  if (count < 2) return out;
+  Sector s;
+  int f = start;
+  for (int step = t.vertex_face_offsets[v + 1] - t.vertex_face_offsets[v]; step > 0; --step) {
+    const int k = corner_at(t, f, v);
+    if (s.faces.empty()) s.first = t.face_edges(f, k);
+    s.faces.push_back(f);
+    s.theta += g.corner_angles(f, k);
+    const int incoming = t.face_edges(f, (k + 2) % 3);
+    if (sharp[incoming]) {
+      s.second = incoming;
+      out.push_back(std::move(s));
+      s = Sector();
+    }
+    f = t.edge_faces(incoming, 0) == f ? t.edge_faces(incoming, 1) : t.edge_faces(incoming, 0);
+  }
+  return out;
+}
+
+// Whether a face of the sector lies beside a sharp edge other than the sector's two, or is taken already.
+bool sector_is_plain(const Sector& s, const std::map<int, std::vector<int>>& sharp_beside, const std::vector<char>& claimed) {
+  for (int w : s.faces) {
+    if (claimed[w]) return false;
+    const auto it = sharp_beside.find(w);
+    if (it != sharp_beside.end())
+      for (int e : it->second)
+        if (e != s.first && e != s.second) return false;
+  }
+  return true;
+}
+
+// Fixes the sector's faces W_1..W_m to the first edge's direction turned by i·δ, δ = (θ − steps·2π/N)/(m + 1):
+// with the faces across the two edges (which follow them), the field turns by δ at each of the m + 1 steps
+// and through the sector by θ − steps·2π/N, so a map gives the sector steps·2π/N.
+void turn_through(const Topology& t, const Geometry& g, int v, const Sector& s, int steps, int N, std::map<int, double>& fixed,
+                  std::vector<char>& claimed) {
+  const int m = static_cast<int>(s.faces.size());
+  const double delta = (s.theta - steps * 2 * kPi / N) / (m + 1);
+  double gamma = 0;  // the angle at v from the first edge to W_i's outgoing half-edge
+  for (int i = 0; i < m; ++i) {
+    const int w = s.faces[i], c = corner_at(t, w, v);
+    fixed[w] = wrap_angle(g.half_edge_angle(w, c) - gamma + (i + 1) * delta);
+    claimed[w] = 1;
+    gamma += g.corner_angles(w, c);
+  }
+}
+
+std::vector<char> sharp_flags(const Topology& t, const std::vector<int>& edges) {
   std::vector<char> sharp(t.num_edges, 0);
-  std::vector<int> count(t.num_vertices, 0);
-  for (int e : edges) {
-    sharp[e] = 1;
-    ++count[t.edge_vertices(e, 0)], ++count[t.edge_vertices(e, 1)];
-  }
-  std::vector<char> claimed(t.num_faces, 0);
-  auto corner_at = [&](int f, int v) {
-    for (int k = 0; k < 3; ++k)
-      if (t.F(f, k) == v) return k;
-    return -1;
-  };
-  for (int v = 0; v < t.num_vertices; ++v) {
-    if (count[v] < 2) continue;
-    // A face at v whose outgoing half-edge at v (corner k → k+1) is a feature edge: the walk starts there.
-    int start = -1;
-    for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1] && start < 0; ++j) {
-      const int f = t.vertex_faces[j];
-      if (sharp[t.face_edges(f, corner_at(f, v))]) start = f;
-    }
-    if (start < 0) continue;
-    // Walk counter-clockwise: from face f across its incoming half-edge at v (corner k+2 → k) to the next face.
-    std::vector<int> sector;
-    double theta = 0;
-    int f = start;
-    const int degree = t.vertex_face_offsets[v + 1] - t.vertex_face_offsets[v];
-    for (int step = 0; step < degree; ++step) {
-      const int k = corner_at(f, v);
-      sector.push_back(f);
-      theta += g.corner_angles(f, k);
-      const int incoming = t.face_edges(f, (k + 2) % 3);
-      if (sharp[incoming]) {
-        const int a = t.face_edges(sector.front(), corner_at(sector.front(), v));
-        bool usable = theta < kPi / N;
-        for (int w : sector) {
-          usable = usable && !claimed[w];
-          const auto it = sharp_beside.find(w);
-          if (it != sharp_beside.end())
-            for (int e : it->second) usable = usable && (e == a || e == incoming);
+  for (int e : edges) sharp[e] = 1;
+  return sharp;
+}
+
+std::map<int, std::vector<int>> sharp_faces(const Topology& t, const std::vector<int>& edges) {
+  std::map<int, std::vector<int>> out;
+  for (int e : edges)
+    for (int side = 0; side < 2; ++side)
+      if (t.edge_faces(e, side) >= 0) out[t.edge_faces(e, side)].push_back(e);
+  return out;
+}
+
+// Narrow corners (trivcon/features.h): sectors of angle θ < π/N between consecutive sharp edges. Following
+// both edges the field would turn by θ through the sector and a map aligned to both would collapse it; turned
+// through with one step (turn_through), it gets a corner of 2π/N.
+void narrow_corners(const Topology& t, const Geometry& g, const std::vector<int>& edges, int N, FeatureAlignment& out) {
+  if (N < 4 || N % 2 != 0) return;  // a sense-free step of 2π/N that a quad or hexagon corner can take
+  const std::vector<char> sharp = sharp_flags(t, edges);
+  const std::map<int, std::vector<int>> beside = sharp_faces(t, edges);
+  std::vector<char> claimed(t.num_faces, 0), seen(t.num_vertices, 0);
+  for (int e : edges)
+    for (int end = 0; end < 2; ++end) {
+      const int v = t.edge_vertices(e, end);
+      if (seen[v]) continue;
+      seen[v] = 1;
+      for (const Sector& s : sectors_at(t, g, v, sharp))
+        if (s.theta < kPi / N && sector_is_plain(s, beside, claimed)) {
+          turn_through(t, g, v, s, 1, N, out.fixed, claimed);
+          out.narrow.push_back({v, s.first, s.second, s.theta, s.faces});
         }
-        if (usable) {
-          const int m = static_cast<int>(sector.size());
-          const double delta = (theta - 2 * kPi / N) / (m + 1);
-          double gamma = 0;  // the angle at v from a to W_i's outgoing half-edge
-          for (int i = 0; i < m; ++i) {
-            const int w = sector[i], c = corner_at(w, v);
-            out.fixed[w] = wrap_angle(g.half_edge_angle(w, c) - gamma + (i + 1) * delta);
-            claimed[w] = 1;
-            gamma += g.corner_angles(w, c);
-          }
-          out.narrow.push_back({v, a, incoming, theta, sector});
-        }
-        sector.clear();
-        theta = 0;
-      }
-      if (t.is_boundary_edge(incoming)) break;
-      f = t.edge_faces(incoming, 0) == f ? t.edge_faces(incoming, 1) : t.edge_faces(incoming, 0);
     }
-  }
+  std::sort(out.narrow.begin(), out.narrow.end(), [](const NarrowCorner& a, const NarrowCorner& b) { return a.vertex < b.vertex; });
   if (out.narrow.empty()) return;
   // A face of a narrow corner follows neither edge on purpose: it is no conflict.
   out.conflicts.erase(std::remove_if(out.conflicts.begin(), out.conflicts.end(), [&](const FeatureConflict& k) { return claimed[k.face]; }),
@@ -144,9 +182,6 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const 
     }
   }
   FeatureAlignment out;
-  std::map<int, std::vector<int>> sharp_beside;  // face → its feature edges (for the narrow corners below)
-  for (auto& [f, list] : beside)
-    for (const Candidate& c : list) sharp_beside[f].push_back(c.edge);
   for (auto& [f, list] : beside) {
     // The longest edge is followed; ties go to the smaller edge id, so the choice is deterministic.
     std::sort(list.begin(), list.end(),
@@ -158,8 +193,66 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const 
       if (difference > kFeatureAngleTolerance) out.conflicts.push_back({f, list[0].edge, list[k].edge, difference});
     }
   }
-  narrow_corners(t, g, edges, sharp_beside, N, out);
+  narrow_corners(t, g, edges, N, out);
   return out;
+}
+
+void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, const Geometry& g, const std::vector<int>& edges, int N,
+                                      double distance, std::map<int, int>& vertex, FeatureAlignment& alignment) {
+  if (N < 4 || N % 2 != 0 || edges.empty() || !(distance > 0)) return;
+  const std::vector<char> sharp = sharp_flags(t, edges);
+  const std::map<int, std::vector<int>> beside = sharp_faces(t, edges);
+  std::vector<int> degree(t.num_vertices, 0);
+  for (int e : edges) ++degree[t.edge_vertices(e, 0)], ++degree[t.edge_vertices(e, 1)];
+  std::vector<char> claimed(t.num_faces, 0);
+  for (const NarrowCorner& k : alignment.narrow)
+    for (int f : k.faces) claimed[f] = 1;
+  std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
+  const std::map<int, int> given = vertex;
+  for (auto [s, n] : given) {
+    if (std::abs(n) != 1 || degree[s] > 0 || !t.is_interior_vertex(s)) continue;
+    // The feature vertices nearest s, reached without passing another one: on the border of s's patch.
+    std::map<int, double> reached;  // every vertex reached → its distance
+    std::vector<std::pair<double, int>> candidates;
+    field::edge_dijkstra(V, t, s, distance, false, dist, [&](int v, double d) {
+      reached[v] = d;
+      if (degree[v] == 0) return true;
+      candidates.emplace_back(d, v);
+      return false;
+    });
+    std::sort(candidates.begin(), candidates.end());
+    for (auto [d, w] : candidates) {
+      if (degree[w] != 2 || vertex.count(w)) continue;
+      // The sector of w facing s: the one holding the reached neighbour of w nearest s.
+      int x = -1;
+      double best = std::numeric_limits<double>::infinity();
+      for (int j = t.vertex_edge_offsets[w]; j < t.vertex_edge_offsets[w + 1]; ++j) {
+        const int e = t.vertex_edges[j];
+        const int y = t.edge_vertices(e, 0) == w ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+        const auto it = reached.find(y);
+        if (!sharp[e] && it != reached.end() && degree[y] == 0 && it->second < best) best = it->second, x = y;
+      }
+      if (x < 0) continue;
+      const std::vector<Sector> sectors = sectors_at(t, g, w, sharp);
+      for (const Sector& sector : sectors) {
+        bool holds = false;
+        for (int f : sector.faces)
+          for (int k = 0; k < 3; ++k) holds = holds || t.F(f, k) == x;
+        if (!holds) continue;
+        const double step = 2 * kPi / N;
+        const int steps = static_cast<int>(std::lround(sector.theta / step)) - n;  // one more for −1/N, one fewer for +1/N
+        const int m = static_cast<int>(sector.faces.size());
+        if (steps < 1 || !(std::abs(sector.theta - steps * step) / (m + 1) < 0.9 * kPi / N) || !sector_is_plain(sector, beside, claimed))
+          break;
+        turn_through(t, g, w, sector, steps, N, alignment.fixed, claimed);
+        vertex.erase(s);
+        vertex[w] = n;
+        alignment.snapped.push_back({s, w, d});
+        break;
+      }
+      break;  // the nearest candidate only: farther ones may lie across the patch
+    }
+  }
 }
 
 }  // namespace trivcon

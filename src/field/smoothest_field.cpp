@@ -23,6 +23,7 @@
 #include "linalg/supernodal.h"
 #include "linalg/symbolic.h"
 #include "linalg/timing.h"
+#include "field/edge_dijkstra.h"
 #include "trivcon/constraints.h"
 #include "trivcon/curvature.h"
 #include "trivcon/design.h"
@@ -309,32 +310,6 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
   return S.u;
 }
 
-// Dijkstra along edges from `source`: visit(v, d) for each vertex reached, nearest first; a vertex is expanded
-// when visit returns true, and a neighbour reached only while its distance is below `radius` (at most, when
-// `inclusive`). `dist` is a work vector of infinities, left so.
-template <class Visit>
-void edge_dijkstra(const MatrixX3d& V, const Topology& t, int source, double radius, bool inclusive, std::vector<double>& dist, Visit visit) {
-  using Item = std::pair<double, int>;
-  std::vector<int> touched{source};
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  dist[source] = 0, queue.emplace(0.0, source);
-  while (!queue.empty()) {
-    auto [d, v] = queue.top();
-    queue.pop();
-    if (d > dist[v] || !visit(v, d)) continue;
-    for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q) {
-      const int e = t.vertex_edges[q];
-      const int w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
-      const double dw = d + edge_length(V, t, e);
-      if ((inclusive ? dw <= radius : dw < radius) && dw < dist[w]) {
-        if (std::isinf(dist[w])) touched.push_back(w);
-        dist[w] = dw, queue.emplace(dw, w);
-      }
-    }
-  }
-  for (int v : touched) dist[v] = std::numeric_limits<double>::infinity();
-}
-
 }  // namespace
 
 std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
@@ -353,7 +328,7 @@ std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& 
   for (auto [source, n] : vertex) {
     if (n <= 0) continue;
     if (source < 0 || source >= t.num_vertices) throw Error("singularity cancellation: vertex " + std::to_string(source) + " out of range");
-    edge_dijkstra(V, t, source, distance, true, dist, [&, source = source, n = n](int v, double d) {
+    field::edge_dijkstra(V, t, source, distance, true, dist, [&, source = source, n = n](int v, double d) {
       if (v != source)
         if (auto it = vertex.find(v); it != vertex.end() && it->second == -n) candidates.push_back({d, source, v});
       return true;
@@ -389,7 +364,7 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
     for (auto [v, n] : given) parent[v] = v;
     std::function<int(int)> root = [&](int v) { return parent[v] == v ? v : parent[v] = root(parent[v]); };
     for (auto [source, n] : given)
-      edge_dijkstra(V, t, source, distance, false, dist, [&, source = source, n = n](int v, double) {
+      field::edge_dijkstra(V, t, source, distance, false, dist, [&, source = source, n = n](int v, double) {
         if (auto it = given.find(v); v != source && it != given.end() && (it->second > 0) == (n > 0)) parent[root(v)] = root(source);
         return true;
       });
@@ -420,7 +395,7 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
       continue;
     }
     std::vector<std::pair<double, int>> reached;  // the first interior vertices at or past `distance`
-    edge_dijkstra(V, t, source, std::numeric_limits<double>::infinity(), true, dist, [&](int v, double d) {
+    field::edge_dijkstra(V, t, source, std::numeric_limits<double>::infinity(), true, dist, [&](int v, double d) {
       if (d < distance) return true;
       if (t.is_interior_vertex(v) && !given.count(v)) reached.emplace_back(d, v);
       return false;  // the ring: no further
@@ -557,12 +532,19 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
   if (!(o.cancel_distance >= 0) || !std::isfinite(o.cancel_distance))
     throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
   const double distance = o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
-  r.vertex = cancel_singularity_pairs(V, t, merged, distance, &r.pairs);
+  std::map<int, int> free = merged, held;
+  for (int v : o.held) {
+    if (v < 0 || v >= t.num_vertices) throw Error("automatic singularities: held vertex " + std::to_string(v) + " out of range");
+    if (auto it = free.find(v); it != free.end()) held.insert(*it), free.erase(it);
+  }
+  r.vertex = cancel_singularity_pairs(V, t, free, distance, &r.pairs);
   if (o.split_above > 0) {
     if (!(o.split_distance > 0) || !std::isfinite(o.split_distance))
       throw Error("automatic singularities: invalid split distance " + std::to_string(o.split_distance) + " (need a finite number > 0)");
     r.vertex = split_singularities(V, t, r.vertex, o.split_above, o.split_distance, r.split);
   }
+  for (auto [v, n] : held)
+    if ((r.vertex[v] += n) == 0) r.vertex.erase(v);
   r.seconds.cancel = seconds_since(t0);
   return r;
 }

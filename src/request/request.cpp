@@ -88,6 +88,8 @@ AutoResult request_auto(const FieldDesigner& designer, const FieldRequest& reque
   AutoOptions o = request.auto_options;
   o.N = request.prescription.N;
   o.fixed = constraints.fixed;
+  const Topology& t = designer.topology();
+  for (int e : constraints.sharp_edges) o.held.push_back(t.edge_vertices(e, 0)), o.held.push_back(t.edge_vertices(e, 1));
   return auto_singularities(designer, o);
 }
 
@@ -134,6 +136,22 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
   if (request.auto_place) {
     out.auto_result = request_auto(designer, request, out.constraints);
     p.vertex = out.auto_result->vertex;
+    if (request.auto_options.onto_features > 0 && !request.split_large_turns && !out.constraints.sharp_edges.empty()) {
+      FeatureAlignment& a = out.constraints.features;
+      const std::map<int, double> before = a.fixed;
+      move_singularities_onto_features(designer.V(), designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N,
+                                       request.auto_options.onto_features, p.vertex, a);
+      if (!a.snapped.empty()) {  // the sectors turned anew, unless a direction given by hand holds the face
+        for (auto [f, angle] : a.fixed) {
+          const auto it = before.find(f);
+          if ((it == before.end() || it->second != angle) && !request.prescription.fixed.count(f)) out.constraints.fixed[f] = angle;
+        }
+        out.constraints.fixed_faces.clear();
+        for (auto [f, angle] : out.constraints.fixed) out.constraints.fixed_faces.push_back(f);
+        p.fixed = out.constraints.fixed;
+        designer.set_fixed_faces(out.constraints.fixed_faces);
+      }
+    }
   }
   if (request.relax) {
     out.relax_result = relax(designer, p, request.relax_options);
@@ -214,6 +232,7 @@ void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double
   if (!request.auto_place) return;
   const double unit = map_unit(designer, edge_length, target_faces);
   if (request.auto_options.split_above == 0) request.auto_options.split_above = 3, request.auto_options.split_distance = unit;
+  if (request.auto_options.onto_features == 0) request.auto_options.onto_features = 0.8 * unit;
   if (request.auto_options.cancel_distance != 0) return;
   request.auto_options.cancel_distance = unit;
   request.auto_options.cancel_absolute = true;
