@@ -271,7 +271,7 @@ TEST(Quad, ShearedBoxGetsAQuadCornerAtEachNarrowCorner) {
 
 TEST(Quad, SingularitiesNearASharpEdgeMoveOntoIt) {
   // A capped cylinder of radius 1: --auto puts four +1/4 inside each cap. At 60 squares (a unit ≈ 0.6) they lie
-  // within 0.8 units of the rims and move onto them (trivcon/features.h): each rim vertex then turns its cap-side
+  // within 1.5 units of the rims and move onto them (trivcon/features.h): each rim vertex then turns its cap-side
   // sector one step less (a quad corner of valence 3 on the rim). At 400 squares they stay inside the caps.
   const Mesh m = make_capped_cylinder(6, 32, 12, 2.0);
   for (int target : {60, 400}) {
@@ -294,7 +294,7 @@ TEST(Quad, SingularitiesNearASharpEdgeMoveOntoIt) {
     EXPECT_EQ(moved.size(), target == 60 ? 8u : 0u) << what;
     EXPECT_EQ(on_rim, static_cast<int>(moved.size())) << what;
     const double unit = std::sqrt(r.designer->geometry().face_area.sum() / target);
-    for (const FeatureSnap& k : moved) EXPECT_LT(k.distance, 0.8 * unit) << what;
+    for (const FeatureSnap& k : moved) EXPECT_LT(k.distance, 1.5 * unit) << what;
     EXPECT_EQ(r.param.quality.flipped_faces + r.param.quality.degenerate_faces, 0) << what;
     expect_clean(r, what);
   }

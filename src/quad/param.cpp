@@ -1053,7 +1053,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
 Parametrization parametrize(const FieldDesigner& designer, const Design& design, const ParamOptions& options) {
   const auto start = linalg::Clock::now();
   Parametrization best = parametrize_at(designer, design, options, 1.0);
-  const double first_seconds = linalg::seconds_since(start);
+  const int first_factorizations = best.quality.factorizations;
+  int retry_factorizations = 0;
   auto problems = [](const ParamQuality& q) { return q.flipped_faces + q.degenerate_faces + q.winding_errors; };
   const int near_miss = std::max(16, best.quality.faces / 20000);
   bool necessary = false;
@@ -1061,10 +1062,12 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   int attempts = 1;
   if (problems(best.quality) > 0 && problems(best.quality) <= near_miss && !necessary)
     for (double scale : {0.97, 1.03, 0.94, 1.06}) {
-      // At most `retries` more, and while they have cost less than twice the first.
-      if (attempts > options.retries || linalg::seconds_since(start) >= 3 * first_seconds) break;
+      // At most `retries` more, and while they have cost less than twice the first, counted in factorizations
+      // (each a solve's main cost; unlike wall time, the same on every machine, so the same map everywhere).
+      if (attempts > options.retries || retry_factorizations >= 2 * first_factorizations) break;
       Parametrization other = parametrize_at(designer, design, options, scale);
       ++attempts;
+      retry_factorizations += other.quality.factorizations;
       if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other);
       if (problems(best.quality) == 0) break;
     }

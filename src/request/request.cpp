@@ -232,7 +232,7 @@ void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double
   if (!request.auto_place) return;
   const double unit = map_unit(designer, edge_length, target_faces);
   if (request.auto_options.split_above == 0) request.auto_options.split_above = 3, request.auto_options.split_distance = unit;
-  if (request.auto_options.onto_features == 0) request.auto_options.onto_features = 0.8 * unit;
+  if (request.auto_options.onto_features == 0) request.auto_options.onto_features = 1.5 * unit;
   if (request.auto_options.cancel_distance != 0) return;
   request.auto_options.cancel_distance = unit;
   request.auto_options.cancel_absolute = true;
