@@ -42,7 +42,9 @@ struct ParamOptions {
   int round_all_below = 16;  // when at most this many integers are left, one round fixes them all (a factorization each)
   int max_stiffening_rounds = 20;  // re-solves with the flipped faces stiffened (MIQ's §5), integers kept
   // A map left with a few flipped or degenerate faces or wrong windings is made again at up to this many other
-  // edge lengths (3 % and 6 % shorter and longer), the best kept (docs/param.md, "Near misses"); 0: never.
+  // edge lengths (3 % and 6 % shorter and longer), the best kept (docs/param.md, "Near misses"), while the
+  // retries' factorizations stay below twice the first attempt's (not wall time: the same map on any machine);
+  // 0: never.
   int retries = 4;
 };
 
