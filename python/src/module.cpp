@@ -987,7 +987,7 @@ PYBIND11_MODULE(_core, m) {
              std::map<int, double> fixed, bool align_boundary, std::optional<double> feature_degrees,
              std::vector<std::pair<int, int>> feature_edges, std::vector<std::pair<int, double>> roots, double auto_cancel, bool auto_cancel_absolute, int auto_iterations,
              std::optional<double> curvature_t, bool split, int max_rounds, bool relax, std::vector<int> relax_pins, int relax_cancel,
-             int relax_max_moves) {
+             int relax_max_moves, double map_edge_length, double map_target_faces) {
             // The library's request layer (trivcon/request.h) does the work; here only the conversion.
             FieldRequest q;
             q.prescription.N = N;
@@ -1027,11 +1027,13 @@ PYBIND11_MODULE(_core, m) {
               std::vector<int> sharp;
               std::optional<RelaxResult> relaxed;
             };
-            Out out = interruptible(s->threads, [s, q = std::move(q)] {
+            Out out = interruptible(s->threads, [s, q = std::move(q), map_edge_length, map_target_faces] {
               Out o;
               std::lock_guard<std::mutex> lock(s->mutex);
               check_cancelled();  // abandoned while it waited for the designer
-              FieldOutcome r = solve_request(*s->designer, s->F, q);
+              FieldRequest request = q;
+              if (map_edge_length > 0 || map_target_faces > 0) cancel_for_map(request, *s->designer, map_edge_length, map_target_faces);
+              FieldOutcome r = solve_request(*s->designer, s->F, request);
               s->fixed_faces = s->designer->fixed_faces();
               o.designer = s;
               if (r.refined) {
@@ -1094,7 +1096,9 @@ PYBIND11_MODULE(_core, m) {
           py::arg("feature_degrees"), py::arg("feature_edges"), py::arg("roots"), py::arg("auto_cancel"), py::arg("auto_cancel_absolute"),
           py::arg("auto_iterations"), py::arg("curvature_t"), py::arg("split"), py::arg("max_rounds"), py::arg("relax") = false,
           py::arg("relax_pins") = std::vector<int>{}, py::arg("relax_cancel") = 0, py::arg("relax_max_moves") = 10000,
-          "One field request (trivcon/request.h; vertex None: the smoothest field's singularities): (designer of the final mesh, "
+          py::arg("map_edge_length") = 0.0, py::arg("map_target_faces") = 0.0,
+          "One field request (trivcon/request.h; vertex None: the smoothest field's singularities, chosen for a map at the given "
+          "scale as the map commands do when one is > 0, cancel_for_map): (designer of the final mesh, "
           "DesignResult, AutoResult or None, parent face of each face (with split), rounds, converged, sharp edges, relaxation "
           "as a dict or None).")
       .def(

@@ -77,3 +77,29 @@ def test_quad_needs_a_cross_field_and_a_scale():
         d.solve(6, "auto").quad(target_faces=100)
     with pytest.raises(trivcon.Error, match="give exactly one of target_faces and edge_length"):
         d.solve(4, "auto").quad()
+
+
+def test_auto_for_a_map_is_the_programs(cli, tmp_path):
+    # solve(..., "auto", map_target_faces=K) chooses the singularities as `trivcon quad --auto --target-faces K`
+    # does (cancelled, gathered, kept and moved for the map): the same singularities and the same quads.
+    V, F = trivcon.make_genus_surface(2, 3)
+    mesh = tmp_path / "g2.obj"
+    trivcon.write_mesh(str(mesh), V, F)
+    report, out, sing = tmp_path / "r.json", tmp_path / "q.obj", tmp_path / "s.txt"
+    cli("quad", mesh, "--auto", "--align-features", 30, "--target-faces", 300, "-o", out, "--report", report, "--sing-out", sing)
+    j = json.loads(report.read_text())
+    d = trivcon.FieldDesigner(V, F)
+    r = d.solve(4, "auto", align_features=30, map_target_faces=300)
+    program = {int(v): k for v, k in (line.split() for line in sing.read_text().splitlines() if not line.startswith("#"))}
+    assert {v: str(k) for v, k in r.singularities.items()} == program
+    q = r.quad(target_faces=300)
+    assert q.quality["quads"] == j["quad"]["quads"] and q.ok == (j["quad"]["singular_mismatches"] == 0)
+    # Without it, the smoothest field's singularities as `solve --auto` finds them (no cancelling for a map).
+    plain = d.solve(4, "auto", align_features=30)
+    assert sum(plain.singularities.values()) == sum(r.singularities.values())
+    with pytest.raises(trivcon.Error, match="map_target_faces needs singularities='auto'"):
+        d.solve(4, {}, map_target_faces=300)
+    with pytest.raises(trivcon.Error, match="give at most one of map_target_faces and map_edge_length"):
+        d.solve(4, "auto", map_target_faces=300, map_edge_length=0.1)
+    with pytest.raises(trivcon.Error, match="map_edge_length must be a positive number"):
+        d.solve(4, "auto", map_edge_length=-1)

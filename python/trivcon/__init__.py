@@ -825,7 +825,8 @@ class FieldDesigner(_Cached):
 
     def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False,
               align_features=None, feature_edges=None, roots=None, auto_cancel=0.0, align_curvature=None,
-              split_large_turns=False, max_rounds=8, relax=False, relax_pins=None, relax_cancel=0, relax_max_moves=10000):
+              split_large_turns=False, max_rounds=8, relax=False, relax_pins=None, relax_cancel=0, relax_max_moves=10000,
+              map_target_faces=None, map_edge_length=None):
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
@@ -866,6 +867,12 @@ class FieldDesigner(_Cached):
           boundary and the sharp edges are aligned again on every refined mesh; fixed faces pass their
           direction to their children. Not with generators or boundary indices (the refined mesh has cycles
           of its own), nor with roots or feature_edges.
+
+        map_target_faces or map_edge_length (N = 4, singularities="auto"): choose the singularities for a map at
+          that scale, as `trivcon param`/`quad --auto` do (docs/param.md): +- pairs closer than one unit
+          cancelled (unless auto_cancel is given), close same-sign ones gathered or spread, those at the ends of
+          sharp edges kept, a +-1/4 within 1.5 units of a sharp edge moved onto it. Then
+          Result.parametrize/quad at the same scale give what the program gives.
 
         The request means the same as the CLI's and the editor's (the library's trivcon/request.h does it).
         Errors in the prescription raise trivcon.Error with the library's message. The result is
@@ -921,10 +928,21 @@ class FieldDesigner(_Cached):
                 raise Error(f"{name} must be a whole number >= 0, not {value!r}")
         if not relax and (pins or relax_cancel or relax_max_moves != 10000):
             raise Error("relax_pins, relax_cancel and relax_max_moves need relax=True")
+        map_scale = [0.0, 0.0]  # edge length, target faces
+        for k, (name, value) in enumerate((("map_edge_length", map_edge_length), ("map_target_faces", map_target_faces))):
+            if value is None:
+                continue
+            if isinstance(value, bool) or not isinstance(value, _numbers.Real) or not _math.isfinite(value) or value <= 0:
+                raise Error(f"{name} must be a positive number, not {value!r}")
+            if vertex is not None:
+                raise Error(f"{name} needs singularities='auto' (it chooses them for a map)")
+            map_scale[k] = float(value)
+        if map_scale[0] and map_scale[1]:
+            raise Error("give at most one of map_target_faces and map_edge_length")
         core, r, a, parent, rounds, converged, sharp, relaxed = self._d.solve_request(
             N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), explicit, bool(align_boundary),
             degrees, edge_pairs, root_list, cancel, False, 8, curvature_t, bool(split_large_turns), int(max_rounds),
-            bool(relax), pins, int(relax_cancel), int(relax_max_moves))
+            bool(relax), pins, int(relax_cancel), int(relax_max_moves), map_scale[0], map_scale[1])
         auto = AutoResult(a, self) if a is not None else None
         designer = self if core is self._d else FieldDesigner._of_core(core, self)
         result = Result(designer, r, auto)
@@ -1292,6 +1310,8 @@ class Result(_Cached):
         """The seamless integer-grid map of this cross field (N = 4), as `trivcon param`: a Parametrization.
 
         target_faces: about this many unit squares; or edge_length: one unit of (u, v) in the mesh's units.
+        With singularities="auto", solve with map_target_faces (or map_edge_length) at the same scale to get the
+        program's singularities and map (`trivcon param --auto` chooses them for the map).
         align_boundary: put every boundary edge the field runs along on an integer iso-line (default: as
           this field was solved, solve(align_boundary=...)). aligned_edges: (n, 2) vertex pairs of more edges
           to put on iso-lines (default: the sharp edges the solve followed, Result.sharp_edges).

@@ -155,6 +155,8 @@ class FieldDesigner:
         relax_pins: Optional[npt.ArrayLike] = ...,
         relax_cancel: int = ...,
         relax_max_moves: int = ...,
+        map_target_faces: Optional[float] = ...,
+        map_edge_length: Optional[float] = ...,
     ) -> Result: ...
     def relax(
         self,
