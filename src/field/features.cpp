@@ -250,7 +250,7 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
         alignment.snapped.push_back({s, w, d});
         break;
       }
-      break;  // the nearest candidate only: farther ones may lie across the patch
+      break;  // the nearest eligible candidate only, moved or not
     }
   }
 }
