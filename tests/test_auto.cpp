@@ -198,6 +198,21 @@ TEST(Auto, CancellationRemovesACloseOppositePairAndKeepsGaussBonnet) {
   EXPECT_EQ(index_sum(rn.found), 8);
   EXPECT_EQ(index_sum(rn.vertex), 8);
   EXPECT_EQ(rn.found.size(), rn.vertex.size() + 2 * rn.pairs.size());
+  // Held vertices (AutoOptions::held, the ends of sharp edges) keep what was found there: only pairs of two
+  // free singularities are cancelled.
+  ASSERT_FALSE(rn.pairs.empty());
+  AutoOptions h = c;
+  std::set<int> held;
+  for (auto [plus, minus] : rn.pairs) held.insert(plus);
+  h.held.assign(held.begin(), held.end());
+  const AutoResult rh = auto_singularities(noisy.V, noisy.F, h);
+  EXPECT_EQ(rh.found, rn.found);
+  for (int v : held) EXPECT_EQ(rh.vertex.count(v) ? rh.vertex.at(v) : 0, rn.found.at(v)) << "held vertex " << v;
+  for (auto [plus, minus] : rh.pairs) EXPECT_TRUE(!held.count(plus) && !held.count(minus));
+  EXPECT_EQ(index_sum(rh.vertex), 8);
+  h.held = {static_cast<int>(noisy.V.rows())};
+  EXPECT_EQ(test::error_of([&] { auto_singularities(noisy.V, noisy.F, h); }),
+            "automatic singularities: held vertex " + std::to_string(noisy.V.rows()) + " out of range");
 }
 
 TEST(Auto, BadInputIsAClearError) {
