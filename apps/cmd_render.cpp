@@ -69,7 +69,9 @@ void run_render(const RenderCommand& c) {
   // Without --field (a checkerboard of --uv alone): a zero field, not drawn.
   const MatrixX3d directions = c.field.empty() ? MatrixX3d(g.frame_x)
                                                : rows_on_mesh(loaded, read_field(c.field, loaded.input_faces(), &file_N));
-  const int N = c.N > 0 ? c.N : std::max(1, file_N);
+  // N: given, else the field file's, else 4 for a map alone (a map is of a cross field: its singularity files say
+  // 1/4), else 1.
+  const int N = c.N > 0 ? c.N : file_N > 0 ? file_N : c.field.empty() && !c.uv.empty() ? 4 : 1;
   const Field field = field_from_directions(g, directions, N);
 
   std::vector<std::pair<int, int>> singularities;
@@ -134,7 +136,7 @@ void register_render(CLI::App& app) {
                              "OBJ with (u, v) per corner (trivcon param -o): draw its unit squares as a checkerboard on the surface");
 
   cmd->add_option("-o,--output", c.output, "PNG to write")->required();
-  cmd->add_option("-N,--symmetry", c.N, "Symmetry N (default: the field file's)")->check(CLI::Range(1, 1000));
+  cmd->add_option("-N,--symmetry", c.N, "Symmetry N (default: the field file's; 4 with --uv and no --field)")->check(CLI::Range(1, 1000));
   cmd->add_option("-s,--singularities", c.sing_files, "Singularity file to mark (default: the field's own singular vertices)");
   cmd->add_option("--sing", c.sings, "A singular vertex to mark, V:INDEX; repeatable");
   cmd->add_option("--size", c.size, "Image size WIDTHxHEIGHT (default 1200x900)");

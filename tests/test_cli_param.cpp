@@ -95,6 +95,10 @@ TEST(CliParam, CubeGridInTheObj) {
   int listed = 0;
   for (const std::string& line : test::lines_of(slurp(sings))) listed += !line.empty() && line[0] != '#';
   EXPECT_EQ(listed, 8);
+  // The checkerboard with the singularities marked: a map is of a cross field, so --uv alone reads indices of 1/4.
+  const auto picture = run_cli("render " + q(mesh) + " --uv " + q(obj) + " -s " + q(sings) + " --size 200x150 -o " + q(temp_file("cube_uv.png")));
+  EXPECT_EQ(picture.status, 0) << picture.err;
+  EXPECT_EQ(picture.err, "");
 }
 
 TEST(CliParam, DiskWithAlignedBoundary) {
