@@ -72,7 +72,8 @@ struct ParamQuality {
   double max_cone_angle_error = 0;     // |Σ (u, v) corner angles − 2π(1 − k)| at singular vertices, radians
   int aligned_edges = 0, unaligned_edges = 0;
   double max_alignment_error = 0;      // distance of an aligned edge's constant coordinate from a whole number
-  double mean_distortion = 0;          // area-weighted mean of σ_max / σ_min of the map's Jacobian
+  double mean_distortion = 0;          // area-weighted mean of σ_max / σ_min of the map's Jacobian over the faces
+                                       // neither flipped nor degenerate (those, counted above, would swamp it)
   double max_distortion = 0;           // its largest (infinite on a degenerate (u, v) triangle)
   double unit_squares = 0;             // total (u, v) area
   double target_squares = 0;           // mesh area / edge_length²

@@ -991,21 +991,24 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
 
   // --- What the map promises, checked on the result --------------------------------------------------------
   const auto t4 = linalg::Clock::now();
+  double mapped_area = 0;  // of the faces neither flipped nor degenerate: the mean distortion's weights
   for (int f = 0; f < nF; ++f) {
     const double a = uv_area(f);
+    const double ratio = distortion(f);
+    q.max_distortion = std::max(q.max_distortion, ratio);
     if (a < -1e-12 * face_area[f] * s * s) {
       ++q.flipped_faces;
       if (q.first_flipped.size() < 10) q.first_flipped.push_back(f);
     } else if (!(a > 1e-12 * face_area[f] * s * s)) {
       ++q.degenerate_faces;
       if (q.first_flipped.size() < 10) q.first_flipped.push_back(f);
+    } else if (std::isfinite(ratio)) {
+      q.mean_distortion += g.face_area[f] * ratio;
+      mapped_area += g.face_area[f];
     }
-    const double ratio = distortion(f);
-    q.max_distortion = std::max(q.max_distortion, ratio);
-    if (std::isfinite(ratio)) q.mean_distortion += g.face_area[f] * ratio;
     q.unit_squares += a;
   }
-  if (area > 0) q.mean_distortion /= area;
+  if (mapped_area > 0) q.mean_distortion /= mapped_area;
   for (int i = 0; i < nCut; ++i) {
     const int e = out.cut_edges[i];
     const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1), r = out.rotation[e];
