@@ -75,8 +75,9 @@ struct NarrowCorner {
 
 // A singularity moved onto a feature line (move_singularities_onto_features).
 struct FeatureSnap {
-  int from, to;     // vertex ids
-  double distance;  // along edges
+  int from, to;            // vertex ids
+  double distance;         // along edges
+  std::vector<int> faces;  // the sector of `to` turned anew (their directions in FeatureAlignment::fixed)
 };
 
 struct FeatureAlignment {

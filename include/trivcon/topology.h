@@ -65,6 +65,12 @@ struct Topology {
   bool is_boundary_edge(int e) const { return edge_faces(e, 0) < 0 || edge_faces(e, 1) < 0; }
   bool is_boundary_vertex(int v) const { return vertex_boundary_loop[v] >= 0; }
   bool is_interior_vertex(int v) const { return vertex_component[v] >= 0 && vertex_boundary_loop[v] < 0; }
+  // The corner k of face f at vertex v (F(f, k) == v), or −1 when v is not one of f's.
+  int corner_of(int f, int v) const {
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) == v) return k;
+    return -1;
+  }
   int euler_characteristic() const;
 };
 

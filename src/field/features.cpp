@@ -16,7 +16,7 @@ namespace trivcon {
 namespace {
 
 // Corner k of face f such that the face's half-edge k → k+1 is edge e (in the oriented Topology::F).
-int corner_of(const Topology& t, int f, int e) {
+int corner_of_edge(const Topology& t, int f, int e) {
   for (int k = 0; k < 3; ++k)
     if (t.face_edges(f, k) == e) return k;
   return -1;
@@ -32,25 +32,19 @@ struct Sector {
   double theta = 0;  // the corners' angles at v
 };
 
-int corner_at(const Topology& t, int f, int v) {
-  for (int k = 0; k < 3; ++k)
-    if (t.F(f, k) == v) return k;
-  return -1;
-}
-
 std::vector<Sector> sectors_at(const Topology& t, const Geometry& g, int v, const std::vector<char>& sharp) {
   std::vector<Sector> out;
   if (!t.is_interior_vertex(v)) return out;
   int start = -1, count = 0;
   for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
     const int f = t.vertex_faces[j];
-    if (sharp[t.face_edges(f, corner_at(t, f, v))]) ++count, start = start < 0 ? f : start;
+    if (sharp[t.face_edges(f, t.corner_of(f, v))]) ++count, start = start < 0 ? f : start;
   }
   if (count < 2) return out;
   Sector s;
   int f = start;
   for (int step = t.vertex_face_offsets[v + 1] - t.vertex_face_offsets[v]; step > 0; --step) {
-    const int k = corner_at(t, f, v);
+    const int k = t.corner_of(f, v);
     if (s.faces.empty()) s.first = t.face_edges(f, k);
     s.faces.push_back(f);
     s.theta += g.corner_angles(f, k);
@@ -86,7 +80,7 @@ void turn_through(const Topology& t, const Geometry& g, int v, const Sector& s, 
   const double delta = (s.theta - steps * 2 * kPi / N) / (m + 1);
   double gamma = 0;  // the angle at v from the first edge to W_i's outgoing half-edge
   for (int i = 0; i < m; ++i) {
-    const int w = s.faces[i], c = corner_at(t, w, v);
+    const int w = s.faces[i], c = t.corner_of(w, v);
     fixed[w] = wrap_angle(g.half_edge_angle(w, c) - gamma + (i + 1) * delta);
     claimed[w] = 1;
     gamma += g.corner_angles(w, c);
@@ -177,7 +171,7 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const 
     for (int side = 0; side < 2; ++side) {
       const int f = t.edge_faces(e, side);
       // L holds i → j, R holds j → i: R's half-edge is turned by π to give the same sense.
-      const double angle = wrap_angle(g.half_edge_angle(f, corner_of(t, f, e)) + (side == 1 ? kPi : 0.0));
+      const double angle = wrap_angle(g.half_edge_angle(f, corner_of_edge(t, f, e)) + (side == 1 ? kPi : 0.0));
       beside[f].push_back({e, angle, length});
     }
   }
@@ -247,7 +241,7 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
         turn_through(t, g, w, sector, steps, N, alignment.fixed, claimed);
         vertex.erase(s);
         vertex[w] = n;
-        alignment.snapped.push_back({s, w, d});
+        alignment.snapped.push_back({s, w, d, sector.faces});
         break;
       }
       break;  // the nearest eligible candidate only, moved or not

@@ -109,11 +109,6 @@ class Extractor {
   QuadMesh run();
 
  private:
-  int corner(int f, int v) const {
-    for (int k = 0; k < 3; ++k)
-      if (t_.F(f, k) == v) return k;
-    return -1;
-  }
   int other_face(int e, int f) const { return t_.edge_faces(e, 0) == f ? t_.edge_faces(e, 1) : t_.edge_faces(e, 0); }
   int chart_face(int e) const { return t_.edge_faces(e, 0) >= 0 ? t_.edge_faces(e, 0) : t_.edge_faces(e, 1); }
   const P2& at(int f, int k) const { return U_[3 * f + ((k % 3) + 3) % 3]; }
@@ -183,7 +178,7 @@ void Extractor::build_fans() {
     int f = t_.vertex_faces[begin];
     if (t_.is_boundary_vertex(v)) {
       for (int k = 0; k < degree; ++k) {  // clockwise: across the edge from v to its next corner
-        const int g = other_face(t_.face_edges(f, corner(f, v)), f);
+        const int g = other_face(t_.face_edges(f, t_.corner_of(f, v)), f);
         if (g < 0) break;
         f = g;
       }
@@ -191,7 +186,7 @@ void Extractor::build_fans() {
     const int first = f;
     for (int k = 0; k < degree; ++k) {
       fan_faces_.push_back(f);
-      const int g = other_face(t_.face_edges(f, (corner(f, v) + 2) % 3), f);
+      const int g = other_face(t_.face_edges(f, (t_.corner_of(f, v) + 2) % 3), f);
       if (g < 0 || g == first) break;
       f = g;
     }
@@ -207,7 +202,7 @@ void Extractor::build_charts() {
   for (int v = 0; v < t_.num_vertices; ++v) {
     const int begin = fan_offsets_[v], end = fan_offsets_[v + 1];
     if (begin == end) continue;
-    int f = fan_faces_[begin], k = corner(f, v);
+    int f = fan_faces_[begin], k = t_.corner_of(f, v);
     const double u = param_.uv(3 * f + k, 0), w = param_.uv(3 * f + k, 1);
     if (!std::isfinite(u) || !std::isfinite(w) || std::abs(u) >= kLargest || std::abs(w) >= kLargest)
       throw Error("quad: the map's (u, v) at vertex " + std::to_string(v) + " is not finite or beyond 2^30 in magnitude");
@@ -216,13 +211,13 @@ void Extractor::build_charts() {
     for (int j = begin + 1; j < end; ++j) {
       const int e = t_.face_edges(f, (k + 2) % 3);
       p = across(e, f, p);
-      f = fan_faces_[j], k = corner(f, v);
+      f = fan_faces_[j], k = t_.corner_of(f, v);
       U_[3 * f + k] = p;
     }
     if (t_.is_interior_vertex(v)) {  // around the fan, the transitions must bring the value back
       const int e = t_.face_edges(f, (k + 2) % 3);
       const int first = fan_faces_[begin];
-      if (across(e, f, p) != U_[3 * first + corner(first, v)]) ++q_.unclosed_vertices;
+      if (across(e, f, p) != U_[3 * first + t_.corner_of(first, v)]) ++q_.unclosed_vertices;
     }
   }
   positive_.assign(nF, 0);
@@ -235,7 +230,7 @@ void Extractor::find_points() {
   for (int v = 0; v < nV; ++v) {
     if (fan_offsets_[v] == fan_offsets_[v + 1]) continue;
     const int f = fan_faces_[fan_offsets_[v]];
-    const P2 p = at(f, corner(f, v));
+    const P2 p = at(f, t_.corner_of(f, v));
     if (!whole(p)) continue;
     vertex_node_[v] = static_cast<int>(nodes_.size());
     nodes_.push_back({Kind::kVertex, v, f, p, t_.is_boundary_vertex(v)});
@@ -246,7 +241,7 @@ void Extractor::find_points() {
   for (int e = 0; e < nE; ++e) {
     edge_node_offsets_[e] = static_cast<int>(nodes_.size());
     const int f = chart_face(e);
-    const P2 A = at(f, corner(f, t_.edge_vertices(e, 0))), B = at(f, corner(f, t_.edge_vertices(e, 1)));
+    const P2 A = at(f, t_.corner_of(f, t_.edge_vertices(e, 0))), B = at(f, t_.corner_of(f, t_.edge_vertices(e, 1)));
     const P2 d = B - A;
     if (d.x == 0 && d.y == 0) continue;
     const bool along_x = std::abs(d.x) >= std::abs(d.y);
@@ -327,7 +322,7 @@ void Extractor::fan_slots(int v, std::vector<Slot>& out) const {
   for (int j = begin; j < end; ++j) {
     const int f = fan_faces_[j];
     if (!positive_[f]) continue;
-    const int k = corner(f, v);
+    const int k = t_.corner_of(f, v);
     const P2 p = at(f, k), e1 = at(f, k + 1) - p, e2 = at(f, k + 2) - p;
     std::array<int, 4> codes{};
     int n = 0;
@@ -379,7 +374,7 @@ int Extractor::find_slot(int node, int face, int code) const {
 // The slot of vertex node `node` for direction `code` of `face`'s chart, a direction in the closed sector of the
 // face's corner: one along the sector's second edge belongs to the next face counter-clockwise.
 int Extractor::arrive_at_vertex(int node, int face, int code) const {
-  const int v = nodes_[node].element, k = corner(face, v);
+  const int v = nodes_[node].element, k = t_.corner_of(face, v);
   const P2 e2 = at(face, k + 2) - at(face, k), d = unit(code);
   if (cross(e2, d) == 0 && dot(e2, d) > 0) {
     const int e = t_.face_edges(face, (k + 2) % 3), g = other_face(e, face);
@@ -443,7 +438,7 @@ State Extractor::start(int node, int slot) const {
       }
     return s;
   }
-  const int v = n.element, k = corner(sl.face, v);
+  const int v = n.element, k = t_.corner_of(sl.face, v);
   const P2 p = at(sl.face, k);
   s.target = p + d * kUnit;
   const P2 e1 = at(sl.face, k + 1) - p, e2 = at(sl.face, k + 2) - p;
@@ -468,7 +463,7 @@ State Extractor::through_vertex(int v, int face, int code, P2 target) const {
   // The way back, in the fan's terms (as arrive_at_vertex).
   int back_face = face, back_code = turn(code, 2);
   {
-    const int k = corner(face, v);
+    const int k = t_.corner_of(face, v);
     const P2 e2 = at(face, k + 2) - at(face, k), d = unit(back_code);
     if (cross(e2, d) == 0 && dot(e2, d) > 0) {
       const int e = t_.face_edges(face, (k + 2) % 3), g = other_face(e, face);
@@ -489,10 +484,10 @@ State Extractor::through_vertex(int v, int face, int code, P2 target) const {
   } else {
     return s;
   }
-  const P2 here = at(face, corner(face, v));
+  const P2 here = at(face, t_.corner_of(face, v));
   const i64 left = static_cast<i64>(dot(target - here, unit(code)));
   const Slot& out = fan[next];
-  const int k = corner(out.face, v);
+  const int k = t_.corner_of(out.face, v);
   const P2 p = at(out.face, k), d = unit(out.code);
   s.face = out.face, s.code = out.code, s.target = p + d * left;
   const P2 e1 = at(out.face, k + 1) - p, e2 = at(out.face, k + 2) - p;
@@ -603,12 +598,12 @@ Eigen::Vector3d Extractor::barycentric(const Node& n, int& face) const {
   face = n.face;
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   if (n.kind == Kind::kVertex) {
-    b[corner(face, n.element)] = 1;
+    b[t_.corner_of(face, n.element)] = 1;
     return b;
   }
   auto coordinate = [](P2 p) { return Eigen::Vector2d(static_cast<double>(p.x), static_cast<double>(p.y)); };
   if (n.kind == Kind::kEdge) {
-    const int ka = corner(face, t_.edge_vertices(n.element, 0)), kb = corner(face, t_.edge_vertices(n.element, 1));
+    const int ka = t_.corner_of(face, t_.edge_vertices(n.element, 0)), kb = t_.corner_of(face, t_.edge_vertices(n.element, 1));
     const Eigen::Vector2d a = coordinate(at(face, ka)), ab = coordinate(at(face, kb)) - a;
     const double lambda = std::clamp((coordinate(n.p) - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
     b[ka] = 1 - lambda, b[kb] = lambda;

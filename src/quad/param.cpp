@@ -156,12 +156,6 @@ double rotation_entry(int r, int a, int b) {
   return column[a];
 }
 
-int corner_of(const Topology& t, int f, int v) {
-  for (int k = 0; k < 3; ++k)
-    if (t.F(f, k) == v) return k;
-  return -1;
-}
-
 // Face f laid out in its frame (x along corner 0 → 1), from its edge lengths plus `epsilon` (the
 // mollification of trivcon/geometry.h, so that no face is degenerate): the corners' 2D positions.
 std::array<Eigen::Vector2d, 3> layout(const MatrixX3d& V, const Topology& t, int f, double epsilon) {
@@ -308,7 +302,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     const int L = t.edge_faces(e, 0), R = t.edge_faces(e, 1);
     for (int end = 0; end < 2; ++end) {
       const int v = t.edge_vertices(e, end);
-      const int a = find_root(parent, 3 * L + corner_of(t, L, v)), b = find_root(parent, 3 * R + corner_of(t, R, v));
+      const int a = find_root(parent, 3 * L + t.corner_of(L, v)), b = find_root(parent, 3 * R + t.corner_of(R, v));
       if (a != b) parent[a] = b;
     }
   }
@@ -319,7 +313,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     if (wedge_id[r] < 0) wedge_id[r] = W++;
     wedge[c] = wedge_id[r];
   }
-  auto wedge_at = [&](int f, int v) { return wedge[3 * f + corner_of(t, f, v)]; };
+  auto wedge_at = [&](int f, int v) { return wedge[3 * f + t.corner_of(f, v)]; };
 
   // Combed frame per face: the angle of u's direction, θ_f = β_f + k_f π/2, in the face's frame.
   std::vector<double> theta(nF);
@@ -519,7 +513,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   auto uv_angle_sum = [&](int v, bool rough = false) {
     double angle = 0;
     for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
-      const int f = t.vertex_faces[j], k = corner_of(t, f, v);
+      const int f = t.vertex_faces[j], k = t.corner_of(f, v);
       const Eigen::Vector2d p = out.uv.row(3 * f + k).transpose();
       const Eigen::Vector2d a = out.uv.row(3 * f + (k + 1) % 3).transpose() - p, c = out.uv.row(3 * f + (k + 2) % 3).transpose() - p;
       const double sine = a.x() * c.y() - a.y() * c.x(), cosine = a.dot(c);
@@ -643,7 +637,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
       const int f = t.vertex_faces[j];
       if (folded(f)) return true;
-      const int i = corner_of(t, f, v);
+      const int i = t.corner_of(f, v);
       for (int k = 1; k < 3; ++k)
         if (singular[t.F(f, (i + k) % 3)] && (out.uv.row(3 * f + i) - out.uv.row(3 * f + (i + k) % 3)).lpNorm<Eigen::Infinity>() < 1e-6)
           return true;
@@ -817,7 +811,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     std::vector<int> corners;
     for (int v : region)
       for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
-        corners.push_back(3 * t.vertex_faces[j] + corner_of(t, t.vertex_faces[j], v));
+        corners.push_back(3 * t.vertex_faces[j] + t.corner_of(t.vertex_faces[j], v));
     std::sort(corners.begin(), corners.end());
     std::vector<int>& variable = variable_scratch;
     std::vector<int> variables;
@@ -1015,7 +1009,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     Eigen::Vector2d d[2];
     for (int end = 0; end < 2; ++end) {
       const int v = t.edge_vertices(e, end);
-      const Eigen::Vector2d pL = out.uv.row(3 * L + corner_of(t, L, v)).transpose(), pR = out.uv.row(3 * R + corner_of(t, R, v)).transpose();
+      const Eigen::Vector2d pL = out.uv.row(3 * L + t.corner_of(L, v)).transpose(), pR = out.uv.row(3 * R + t.corner_of(R, v)).transpose();
       d[end] = pR - rotate(r, pL);
     }
     const Eigen::Vector2d whole(std::round(d[0].x()), std::round(d[0].y()));
@@ -1025,7 +1019,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   for (int i = 0; i < nCone; ++i) {
     const int v = out.cones[i];
     for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
-      const int f = t.vertex_faces[j], k = corner_of(t, f, v);
+      const int f = t.vertex_faces[j], k = t.corner_of(f, v);
       q.max_cone_offset = std::max({q.max_cone_offset, whole_offset(out.uv(3 * f + k, 0)), whole_offset(out.uv(3 * f + k, 1))});
     }
   }
@@ -1039,7 +1033,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   for (int i = 0; i < nAligned; ++i) {
     const auto [e, f] = aligned[i];
     const int c = aligned_coordinate[i];
-    const double a = out.uv(3 * f + corner_of(t, f, t.edge_vertices(e, 0)), c), bb = out.uv(3 * f + corner_of(t, f, t.edge_vertices(e, 1)), c);
+    const double a = out.uv(3 * f + t.corner_of(f, t.edge_vertices(e, 0)), c), bb = out.uv(3 * f + t.corner_of(f, t.edge_vertices(e, 1)), c);
     q.max_alignment_error = std::max({q.max_alignment_error, whole_offset(a), std::abs(a - bb)});
   }
   q.seamless = q.max_transition_residual < 1e-6 && q.max_cone_offset < 1e-6 && q.max_alignment_error < 1e-6 && q.non_unimodular == 0;
@@ -1084,7 +1078,7 @@ Eigen::MatrixXd input_corner_uv(const Parametrization& param, const Topology& to
   Eigen::MatrixXd out(F.rows(), 6);
   for (int f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) {
-      const int c = corner_of(topology, f, F(f, k));
+      const int c = topology.corner_of(f, F(f, k));
       if (c < 0) throw Error("param: face " + std::to_string(f) + " does not match the map's mesh");
       out(f, 2 * k) = param.uv(3 * f + c, 0), out(f, 2 * k + 1) = param.uv(3 * f + c, 1);
     }

@@ -138,14 +138,12 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
     p.vertex = out.auto_result->vertex;
     if (request.auto_options.onto_features > 0 && !request.split_large_turns && !out.constraints.sharp_edges.empty()) {
       FeatureAlignment& a = out.constraints.features;
-      const std::map<int, double> before = a.fixed;
       move_singularities_onto_features(designer.V(), designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N,
                                        request.auto_options.onto_features, p.vertex, a);
       if (!a.snapped.empty()) {  // the sectors turned anew, unless a direction given by hand holds the face
-        for (auto [f, angle] : a.fixed) {
-          const auto it = before.find(f);
-          if ((it == before.end() || it->second != angle) && !request.prescription.fixed.count(f)) out.constraints.fixed[f] = angle;
-        }
+        for (const FeatureSnap& k : a.snapped)
+          for (int f : k.faces)
+            if (!request.prescription.fixed.count(f)) out.constraints.fixed[f] = a.fixed.at(f);
         out.constraints.fixed_faces.clear();
         for (auto [f, angle] : out.constraints.fixed) out.constraints.fixed_faces.push_back(f);
         p.fixed = out.constraints.fixed;
