@@ -125,6 +125,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"integers_moved", q.integers_moved},
           {"untangled_faces", q.untangled_faces},
           {"untangling_regions", q.untangling_regions},
+          {"rewound_regions", q.rewound_regions},
           {"flipped_faces", q.flipped_faces},
           {"degenerate_faces", q.degenerate_faces},
           {"winding_errors", q.winding_errors},

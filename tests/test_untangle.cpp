@@ -121,5 +121,21 @@ TEST(Untangle, SaysWhenItCannot) {
   EXPECT_TRUE(z.allFinite());
 }
 
+// The least-squares start: on the grid, whose ideal map is reachable, it is the ideal map whatever the start.
+TEST(Untangle, LeastSquaresStartIsTheIdealMapWhenOneExists) {
+  const Grid grid(6);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> inside(0.5, 5.5);
+  Eigen::VectorXd z(2 * grid.num_interior);
+  for (int k = 0; k < z.size(); ++k) z[k] = inside(rng);
+  const Eigen::VectorXd start = least_squares_start(grid.problem(), z);
+  ASSERT_EQ(start.size(), z.size());
+  for (int v = 0; v < (grid.n + 1) * (grid.n + 1); ++v)
+    if (grid.variable[v] >= 0) {
+      EXPECT_LT((start.segment<2>(2 * grid.variable[v]) - grid.rest(v)).norm(), 1e-6) << v;
+    }
+  EXPECT_GT(grid.min_signed_area(start), 0.49);
+}
+
 }  // namespace
 }  // namespace trivcon::quad

@@ -60,6 +60,7 @@ struct ParamQuality {
   int integers_moved = 0;     // other integers (iso-lines, translations) moved by ±1 against a fold
   int untangled_faces = 0;    // folded or degenerate faces opened by the local untangling (docs/param.md)
   int untangling_regions = 0; // regions untangled (each kept only when the map had fewer folds after it)
+  int rewound_regions = 0;    // of those, regions untangled again from their least squares against a wrong winding
   int flipped_faces = 0;      // faces whose (u, v) triangle is inverted
   int degenerate_faces = 0;   // faces whose (u, v) triangle has (nearly) zero area
   // Interior vertices whose (u, v) corner angles do not sum to 2π(1 − k) (k the index, 0 off the cones): where

@@ -791,7 +791,9 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   const int too_many_folds = std::max(100, nF / 200);
   std::vector<char> inside_scratch(nV, 0), moved_scratch(nF, 0);
   std::vector<int> variable_scratch(nY, -1);
-  auto untangle_around = [&](const std::vector<int>& seeds, int rings) {
+  // `restart`: the untangling starts from the region's least squares (quad::least_squares_start), not from the
+  // map as it is.
+  auto untangle_around = [&](const std::vector<int>& seeds, int rings, bool restart = false) {
     if (regions_left <= 0 || work_left <= 0) return false;
     --regions_left;
     std::vector<char>& inside = inside_scratch;
@@ -863,6 +865,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     Eigen::VectorXd z(problem.num_variables);
     for (size_t k = 0; k < variables.size(); ++k) z[static_cast<int>(k)] = y[variables[k]];
     const Eigen::VectorXd z0 = z;
+    if (restart) z = quad::least_squares_start(problem, z);
     const quad::UntangleResult result = quad::untangle(problem, z, 1e-3, 0.5, 30, 30);
     work_left -= static_cast<double>(faces.size()) * (result.inner_iterations + result.outer_iterations);
     for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z[static_cast<int>(k)];
@@ -903,13 +906,16 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // Where a fold is left within 2 rings of a singularity whose integer point is free, that point is moved to
   // its neighbours (the solution is affine in it: two solves), the `candidates` that leave the fewest folds
   // before untangling first, the region around it untangled; the first that leaves fewer folds is kept.
-  auto move_cones = [&](size_t candidates) {
+  auto move_cones = [&](size_t candidates, bool restart = false) {
     std::vector<char> cone_tried(nCone, 0);
     std::vector<int> trouble;  // folded faces, and a face of each singularity whose ring winds wrong
     for (int f = 0; f < nF; ++f)
       if (folded(f)) trouble.push_back(f);
     for (int i = 0; i < nCone; ++i)
       if (cone_winds_wrong(i)) trouble.push_back(t.vertex_faces[t.vertex_face_offsets[out.cones[i]]]);
+    if (restart)  // and a face of each other vertex winding wrong (a cone's turn passed to it)
+      for (int v = 0; v < nV; ++v)
+        if (cone_of[v] < 0 && winds_wrong(v)) trouble.push_back(t.vertex_faces[t.vertex_face_offsets[v]]);
     for (int f : trouble) {
       if (regions_left <= 0 || work_left <= 0) return;
       if (hopeless[f]) continue;
@@ -947,7 +953,10 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
           const auto [folds, e, dx, dy] = order[k];
           y = y0 + dx * gu + dy * gv;
           corner_uv();
-          untangle_around({out.cones[c]}, 4);
+          for (int rings : {4, 8}) {
+            untangle_around({out.cones[c]}, rings, restart);
+            if (!restart || badness().total() < before.total()) break;
+          }
           if (badness().better_than(before)) {
             value[ju] += dx, value[jv] += dy;
             ++q.cones_moved;
@@ -969,11 +978,37 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     }
     untangle_faces();
   };
+  // A ring that winds once too often beside one that winds once too few (a cone's turn passed to a neighbour)
+  // is fold-free, so the barrier keeps it: around each vertex winding wrong, with those of its neighbours, the
+  // region (2, 4, 8 rings) is untangled again from its least squares, which winds as the field does.
+  auto rewind = [&]() {
+    std::vector<char> tried(nV, 0);
+    for (int v = 0; v < nV && regions_left > 0 && work_left > 0; ++v) {
+      if (tried[v] || !winds_wrong(v)) continue;
+      check_cancelled();
+      std::vector<int> seeds{v};
+      for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
+        for (int k = 0; k < 3; ++k)
+          if (const int u = t.F(t.vertex_faces[j], k); u != v && winds_wrong(u)) seeds.push_back(u);
+      std::sort(seeds.begin(), seeds.end());
+      seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+      for (int u : seeds) tried[u] = 1;
+      for (int rings : {2, 4, 8})
+        if (untangle_around(seeds, rings, true) && !winds_wrong(v)) {
+          ++q.rewound_regions;
+          break;
+        }
+    }
+    // Still wrong: the singularities nearby are moved to a neighbouring integer point, each try untangled from
+    // its least squares.
+    if (!badness().wrong.empty()) move_cones(8, true);
+  };
   auto untangle_folds = [&]() {
     const int folds_before = count_folds();
     if (folds_before > too_many_folds) return;
     untangle_all();
     q.untangled_faces += folds_before - count_folds();
+    rewind();
   };
   // After the rounding, two rounds without fewer folds end it: the untangling below opens what is left locally,
   // and the rounds the stiffening stalls on are a factorization each (armadillo 16 → 10 factorizations).

@@ -3,12 +3,14 @@
 #include "quad/untangle.h"
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 
 #include <algorithm>
 #include <cmath>
 #include <deque>
 #include <limits>
 
+#include "linalg/sparse_cholesky.h"
 #include "trivcon/cancel.h"
 
 namespace trivcon::quad {
@@ -163,6 +165,53 @@ UntangleResult untangle(const UntangleProblem& problem, Eigen::VectorXd& z, doub
   }
   result.unfolded = result.min_determinant > min_determinant;
   return result;
+}
+
+Eigen::VectorXd least_squares_start(const UntangleProblem& problem, const Eigen::VectorXd& z) {
+  // Rows: per face, the four entries of J − I, each weighted by √area; J is affine in z. The normal equations
+  // get a small multiple of the identity (toward z) so that a variable no face pins keeps its value.
+  const int n = problem.num_variables;
+  if (n == 0) return z;
+  std::vector<Eigen::Triplet<double>> triplets;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+  double largest = 0;
+  std::vector<std::pair<int, double>> row;
+  for (size_t f = 0; f < problem.area.size(); ++f) {
+    const double w = problem.area[f];
+    for (int r = 0; r < 2; ++r)
+      for (int d = 0; d < 2; ++d) {
+        // Σ_i gradient_i[d] · (constant + Σ coefficient · z) − δ_rd
+        row.clear();
+        double constant = r == d ? -1.0 : 0.0;
+        for (int i = 0; i < 3; ++i) {
+          const double g = problem.gradient[f][i][d];
+          const AffineForm& a = problem.corner[f][i][r];
+          constant += g * a.constant;
+          for (const auto& [j, c] : a.terms) row.emplace_back(j, g * c);
+        }
+        for (const auto& [j, cj] : row) {
+          rhs[j] -= w * cj * constant;
+          for (const auto& [k, ck] : row)
+            if (j <= k) triplets.emplace_back(j, k, w * cj * ck);
+        }
+      }
+  }
+  Eigen::SparseMatrix<double> A(n, n);
+  A.setFromTriplets(triplets.begin(), triplets.end());
+  for (int k = 0; k < A.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, k); it; ++it)
+      if (it.row() == it.col()) largest = std::max(largest, it.value());
+  const double ridge = 1e-9 * std::max(largest, 1e-300);
+  for (int j = 0; j < n; ++j) triplets.emplace_back(j, j, ridge), rhs[j] += ridge * z[j];
+  A.setFromTriplets(triplets.begin(), triplets.end());
+  try {
+    linalg::SparseCholesky solver(A, "the untangling's least squares");
+    if (solver.factorize(A) >= 0) return z;  // not positive definite: keep the start as it was
+    const Eigen::VectorXd x = solver.solve(rhs);
+    return x.allFinite() ? x : z;
+  } catch (const std::exception&) {
+    return z;
+  }
 }
 
 }  // namespace trivcon::quad

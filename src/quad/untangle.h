@@ -49,4 +49,10 @@ struct UntangleResult {
 UntangleResult untangle(const UntangleProblem& problem, Eigen::VectorXd& z, double min_determinant = 1e-3, double lambda = 0.5,
                         int max_outer = 30, int max_inner = 100);
 
+// The z minimising Σ area · |J − I|² (the map's own least squares on these faces, folds allowed), a start for
+// `untangle` that winds around each vertex as the field does: a map the barrier untangled can keep a ring that
+// winds once too often beside one that winds once too few (a cone's turn passed to its neighbour), which no
+// fold-free path leaves. Returns z unchanged when the system cannot be factored.
+Eigen::VectorXd least_squares_start(const UntangleProblem& problem, const Eigen::VectorXd& z);
+
 }  // namespace trivcon::quad
