@@ -36,12 +36,12 @@ MapRun run_map(const MapCommand& o) {
   const MeshData& mesh = run.loaded.mesh;
   run.designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F, o.field.solver_options());
   run.request = o.field.request(*run.designer, run.repaired());
-  cancel_for_map(run.request, *run.designer, o.edge_length, o.target_faces);
-  run.out = solve_request(*run.designer, mesh.F, run.request);
+  MapOutcome made = map_request(*run.designer, mesh.F, run.request, o.edge_length, o.target_faces);
+  run.out = std::move(made.field);
   if (!run.out.verified)
     throw Error("the field did not pass verification, so no map was made: " + verification_failure(*run.designer, run.out.design));
-  run.param = parametrize(*run.designer, run.out.design,
-                          request_param_options(*run.designer, run.request, run.out, o.edge_length, o.target_faces));
+  run.param = std::move(made.param);
+  run.placements = made.placements, run.cancel_units = made.cancel_units, run.first_problems = made.first_problems;
   return run;
 }
 
@@ -80,6 +80,8 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                           {"singularities_moved_onto_them", a.snapped.size()}};
   }
   if (run.out.relax_result) report["relax"] = relax_summary_json(*run.out.relax_result);
+  if (run.request.auto_place)
+    report["placement"] = {{"placements", run.placements}, {"cancel_units", run.cancel_units}, {"first_problems", run.first_problems}};
   for (size_t i = 0; i < param.cones.size(); ++i)
     report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
   return report;
@@ -90,8 +92,14 @@ std::string map_summary(const MapCommand& o, const MapRun& run) {
   return "mesh " + o.mesh + ": " + std::to_string(t.num_vertices) + " vertices, " + std::to_string(t.num_faces) + " faces, " +
          std::to_string(t.components.size()) + " component(s), chi " + std::to_string(t.euler_characteristic()) + ", " +
          std::to_string(t.boundary_loops.size()) + " boundary loop(s)\n" +
-         (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string()) + "field: N 4, " +
-         std::to_string(run.param.cones.size()) + " singular vertices, verified\n";
+         (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string()) +
+         (run.placements > 1 ? "placement: the map of the singularities found had " + std::to_string(run.first_problems) +
+                                   " folded or degenerate faces or wrong windings; placed again " + std::to_string(run.placements - 1) +
+                                   " time(s) with opposite pairs cancelled further apart; kept: " +
+                                   (run.cancel_units > 1 ? "pairs cancelled within " + std::to_string(static_cast<int>(run.cancel_units)) + " units"
+                                                         : std::string("the first")) + "\n"
+                             : std::string()) +
+         "field: N 4, " + std::to_string(run.param.cones.size()) + " singular vertices, verified\n";
 }
 
 }  // namespace trivcon::cli

@@ -37,11 +37,15 @@ struct MapRun {
   FieldRequest request;
   FieldOutcome out;
   Parametrization param;
+  int placements = 1;        // MapOutcome's
+  double cancel_units = 0;
+  int first_problems = 0;
   const RepairedMesh* repaired() const { return loaded.repaired(); }
 };
 
-// Reads the mesh (repaired unless --no-repair), solves the request (with --auto, ± pairs within one unit of the
-// map cancel unless --auto-cancel says otherwise: cancel_for_map) and makes the map. Throws trivcon::Error, also
+// Reads the mesh (repaired unless --no-repair), solves the request and makes the map (map_request: with --auto,
+// ± pairs within one unit of the map cancel unless --auto-cancel says otherwise, within 2 or 3 when the map
+// folds). Throws trivcon::Error, also
 // when the field does not pass verification.
 MapRun run_map(const MapCommand& command);
 

@@ -184,6 +184,36 @@ TEST(CliQuad, ArmadilloAt4000QuadsWindsRightAroundEveryVertex) {
   expect_quads_at_the_singularities("armadillo.obj", "--auto --target-faces 4000", 2, true);
 }
 
+// A detailed scan at a coarse scale (armadillo, 86k faces, 1,000 quads): the 103 singularities found fold the map
+// (43 folded faces and wrong windings); placed again with pairs cancelled within 2 and then 4 units, the map is
+// clean and the quads are at the singularities written.
+TEST(CliQuad, ArmadilloAt1000QuadsIsPlacedAgainUntilTheMapIsClean) {
+  TRIVCON_REQUIRE_SHARED();
+  expect_quads_at_the_singularities("armadillo.obj", "--auto --target-faces 1000", 2, true);
+}
+
+// The placement is made again only with --auto and no --auto-cancel, and says so in the report (bones at 1,000
+// quads: 26 small closed components, every map folds).
+TEST(CliQuad, PlacedAgainOnlyWhenTheCancelDistanceIsTheProgramsOwn) {
+  TRIVCON_REQUIRE_SHARED();
+  const std::string out = temp_file("q.obj"), report = temp_file("r.json");
+  for (const std::string extra : {"", " --auto-cancel 2"}) {
+    const auto r = run_cli("quad " + test::shared_mesh("bones.off") + " --auto --target-faces 1000 -o " + out + " --report " + report + extra);
+    ASSERT_EQ(r.status, 3) << extra << ": " << r.err;  // the map folds either way
+    const nlohmann::json j = nlohmann::json::parse(slurp(report));
+    const int placements = j["placement"]["placements"].get<int>();
+    if (extra.empty()) {
+      EXPECT_EQ(placements, 3);
+      EXPECT_GT(j["placement"]["first_problems"].get<int>(), j["param"]["flipped_faces"].get<int>() + j["param"]["degenerate_faces"].get<int>());
+      EXPECT_NE(r.out.find("placement: the map of the singularities found had"), std::string::npos) << r.out;
+    } else {
+      EXPECT_EQ(placements, 1);
+      EXPECT_EQ(j["placement"]["cancel_units"].get<double>(), 0.0);
+      EXPECT_EQ(r.out.find("placement:"), std::string::npos) << r.out;
+    }
+  }
+}
+
 // Meshes that failed before the gathering of close negative singularities (face: two −1/4 a third of a unit
 // apart folded the map), the spreading of close positive ones and the relaxation of inverted quads (camelhead,
 // bones: quads turned over on fold-free maps).

@@ -122,4 +122,20 @@ double map_unit(const FieldDesigner& designer, double edge_length, double target
 // move ±1/4 singularities closer than 1.5 units to a feature line onto it (AutoOptions::onto_features).
 void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double edge_length, double target_faces);
 
+// A field and its map, as `param`, `quad` and Python's solve with a map scale make them.
+struct MapOutcome {
+  FieldOutcome field;
+  Parametrization param;   // not made (empty) when the field did not pass verification
+  int placements = 1;      // automatic placements tried (map_request)
+  double cancel_units = 0; // with automatic placement: the cancel distance used, in units of the map (0: the request's own)
+  int first_problems = 0;  // the first map's folded and degenerate faces and wrong windings, when it was placed again
+};
+// cancel_for_map, solve_request, and the map with request_param_options. With automatic placement and no cancel
+// distance in the request, a map left with folded or degenerate faces or wrong windings is made again from
+// singularities whose ± pairs were cancelled within 2, then 4 units: at a scale too coarse for the singularities
+// found (a detailed scan at a thousand quads), fewer of them give a map without folds. The first without problems
+// is kept, else the one with the fewest (the earliest of equals). `request` is left as the kept one was made.
+// Throws what solve_request and parametrize throw.
+MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces);
+
 }  // namespace trivcon

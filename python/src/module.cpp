@@ -1032,8 +1032,10 @@ PYBIND11_MODULE(_core, m) {
               std::lock_guard<std::mutex> lock(s->mutex);
               check_cancelled();  // abandoned while it waited for the designer
               FieldRequest request = q;
-              if (map_edge_length > 0 || map_target_faces > 0) cancel_for_map(request, *s->designer, map_edge_length, map_target_faces);
-              FieldOutcome r = solve_request(*s->designer, s->F, request);
+              // With a map's scale: the field of map_request (the program's: placed again when its map folds).
+              FieldOutcome r = request.auto_place && (map_edge_length > 0 || map_target_faces > 0)
+                                   ? map_request(*s->designer, s->F, request, map_edge_length, map_target_faces).field
+                                   : solve_request(*s->designer, s->F, request);
               s->fixed_faces = s->designer->fixed_faces();
               o.designer = s;
               if (r.refined) {

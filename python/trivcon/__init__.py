@@ -871,8 +871,10 @@ class FieldDesigner(_Cached):
         map_target_faces or map_edge_length (N = 4, singularities="auto"): choose the singularities for a map at
           that scale, as `trivcon param`/`quad --auto` do (docs/param.md): +- pairs closer than one unit
           cancelled (unless auto_cancel is given), close same-sign ones gathered or spread, those at the ends of
-          sharp edges kept, a +-1/4 within 1.5 units of a sharp edge moved onto it. Then
-          Result.parametrize/quad at the same scale give what the program gives.
+          sharp edges kept, a +-1/4 within 1.5 units of a sharp edge moved onto it; when their map folds
+          (the scale too coarse for them), placed again with pairs cancelled within 2, then 4 units, the
+          cleanest map's kept (this makes the map once or more). Then Result.parametrize/quad at the same scale
+          give what the program gives.
 
         The request means the same as the CLI's and the editor's (the library's trivcon/request.h does it).
         Errors in the prescription raise trivcon.Error with the library's message. The result is

@@ -236,4 +236,48 @@ void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double
   request.auto_options.cancel_absolute = true;
 }
 
+MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces) {
+  const bool escalate = request.auto_place && request.auto_options.cancel_distance == 0;
+  cancel_for_map(request, designer, edge_length, target_faces);
+  const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
+  auto problems = [](const Parametrization& p) {
+    return p.quality.flipped_faces + p.quality.degenerate_faces + p.quality.winding_errors;
+  };
+  MapOutcome best;
+  FieldRequest kept = request;
+  int tried = 0, kept_at = 0;
+  for (double units : {1.0, 2.0, 4.0}) {
+    if (tried > 0 && !escalate) break;
+    FieldRequest r = request;
+    if (escalate) r.auto_options.cancel_distance = units * unit;
+    MapOutcome m;
+    m.field = solve_request(designer, F, r);
+    ++tried;
+    if (!m.field.verified) {
+      if (tried == 1) {
+        request = r;
+        return m;  // no map of an unverified field (the caller says why)
+      }
+      continue;
+    }
+    ParamOptions options = request_param_options(designer, r, m.field, edge_length, target_faces);
+    m.param = parametrize(m.field.designer(designer), m.field.design, options);
+    m.cancel_units = escalate ? units : 0.0;
+    if (tried == 1 || problems(m.param) < problems(best.param)) {
+      const int first = tried == 1 ? problems(m.param) : best.first_problems;
+      best = std::move(m);
+      best.first_problems = first;
+      kept = r, kept_at = tried;
+    }
+    if (problems(best.param) == 0) break;
+  }
+  // The designer holds the last attempt's set-up (fixed faces turned for singularities moved onto features): the
+  // kept one is solved again, which gives the same design, so that the designer is the kept field's.
+  if (kept_at != tried) best.field = solve_request(designer, F, kept);
+  best.placements = tried;
+  if (tried == 1) best.first_problems = 0;
+  request = kept;
+  return best;
+}
+
 }  // namespace trivcon
