@@ -123,6 +123,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"folds_rounded", q.folds_rounded},
           {"cones_moved", q.cones_moved},
           {"integers_moved", q.integers_moved},
+          {"segments_opened", q.segments_opened},
           {"untangled_faces", q.untangled_faces},
           {"untangling_regions", q.untangling_regions},
           {"rewound_regions", q.rewound_regions},

@@ -58,6 +58,7 @@ struct ParamQuality {
   int folds_rounded = 0;      // folded faces right after the rounding (before stiffening again)
   int cones_moved = 0;        // singularities moved to a neighbouring integer point against a fold or a shared point
   int integers_moved = 0;     // other integers (iso-lines, translations) moved by ±1 against a fold
+  int segments_opened = 0;    // aligned edges between two integer points the rounding would have collapsed
   int untangled_faces = 0;    // folded or degenerate faces opened by the local untangling (docs/param.md)
   int untangling_regions = 0; // regions untangled (each kept only when the map had fewer folds after it)
   int rewound_regions = 0;    // of those, regions untangled again from their least squares against a wrong winding

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <map>
 #include <memory>
 #include <cmath>
 #include <numeric>
@@ -593,6 +594,71 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   q.folds_real_valued = count_folds();
   stiffen(options.max_stiffening_rounds, 3);
   // --- Greedy rounding: the integers nearest to whole numbers first, a fraction of those left per solve --------
+  // An aligned edge whose two ends both sit on integers in the coordinate along it (a feature edge from a corner
+  // or a junction of feature lines to a singularity, both on integer points) has a whole length: rounded to 0,
+  // the edge and its faces collapse. Its length along, as a combination of integers, keeps the sign of the
+  // real-valued map's and at least one unit: when the rounding of one of its integers would make it 0 or turn
+  // it, that integer is rounded the other way (or further).
+  struct Segment {
+    std::vector<std::pair<int, double>> terms;  // free unknown, coefficient: the (along) length
+    double real = 0;                           // in the real-valued map
+  };
+  std::vector<Segment> segments;
+  std::vector<std::vector<int>> segments_of(nY);  // per free integer, the segments it enters
+  {
+    std::vector<char> integer(nY, 0);
+    for (int j : integer_free) integer[j] = 1;
+    const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = P;
+    auto along_row = [&](int w, int c, std::map<int, double>& acc, double sign) {
+      bool whole = true;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, 2 * w + c); it; ++it) {
+        acc[static_cast<int>(it.col())] += sign * it.value();
+        whole &= integer[it.col()] != 0;
+      }
+      return whole;
+    };
+    for (int i = 0; i < nAligned; ++i) {
+      const auto [e, f] = aligned[i];
+      const int c = 1 - aligned_coordinate[i];
+      std::map<int, double> acc;
+      const bool a = along_row(wedge_at(f, t.edge_vertices(e, 0)), c, acc, -1.0);
+      const bool bb = along_row(wedge_at(f, t.edge_vertices(e, 1)), c, acc, 1.0);
+      if (!a || !bb) continue;
+      Segment seg;
+      for (auto [j, coefficient] : acc)
+        if (std::abs(coefficient) > 1e-12) seg.terms.emplace_back(j, coefficient), seg.real += coefficient * y[j];
+      if (seg.terms.empty() || std::abs(seg.real) < 1e-6) continue;
+      for (auto [j, coefficient] : seg.terms) segments_of[j].push_back(static_cast<int>(segments.size()));
+      segments.push_back(std::move(seg));
+    }
+  }
+  // After a round's integers are given values: every segment now whole that the round completed, and that would be
+  // 0 or turned, gets one unit in the real map's sense through one of its integers of coefficient ±1 (the one in
+  // the fewest other segments: a corner between two segments moves neither); the segments that integer enters
+  // are looked at again, a bounded number of times.
+  auto keep_segments_open = [&](const std::vector<int>& round) {
+    std::vector<int> queue;
+    for (int j : round) queue.insert(queue.end(), segments_of[j].begin(), segments_of[j].end());
+    for (int budget = 4 * static_cast<int>(queue.size()) + 16; !queue.empty() && budget > 0; --budget) {
+      const Segment& seg = segments[queue.back()];
+      const int k = queue.back();
+      queue.pop_back();
+      double length = 0;
+      bool whole = true;
+      for (auto [i, coefficient] : seg.terms) whole &= fixed[i] != 0, length += coefficient * value[i];
+      if (!whole || length * seg.real > 0.5) continue;
+      int pick = -1;
+      double pick_coefficient = 0;
+      for (auto [i, coefficient] : seg.terms)
+        if (std::abs(std::abs(coefficient) - 1) < 1e-9 && (pick < 0 || segments_of[i].size() < segments_of[pick].size()))
+          pick = i, pick_coefficient = coefficient;
+      if (pick < 0) continue;
+      value[pick] += ((seg.real > 0 ? 1.0 : -1.0) - length) * pick_coefficient;  // the length becomes ±1
+      ++q.segments_opened;
+      for (int other : segments_of[pick])
+        if (other != k) queue.push_back(other);
+    }
+  };
   std::vector<int> left = integer_free;
   while (!left.empty()) {
     check_cancelled();
@@ -604,6 +670,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     if (static_cast<int>(left.size()) <= options.round_all_below) take = left.size();  // the last few at once
     while (take < left.size() && whole_offset(y[left[take]]) < 1e-9) ++take;  // already whole: free to fix
     for (size_t k = 0; k < take; ++k) fixed[left[k]] = 1, value[left[k]] = std::round(y[left[k]]);
+    if (!segments.empty()) keep_segments_open(std::vector<int>(left.begin(), left.begin() + static_cast<long>(take)));
     refactor = true;
     left.erase(left.begin(), left.begin() + static_cast<long>(take));
     y = solve_fixed();
