@@ -32,10 +32,10 @@ std::string fmt(double v) {
 }
 
 void run_quad(const QuadCommand& o) {
-  const MapRun run = run_map(o.map);
+  MapRun run = run_map(o.map, true);
   const Parametrization& param = run.param;
   const ParamQuality& p = param.quality;
-  const QuadMesh quads = extract_quads(*run.designer, param);
+  const QuadMesh quads = std::move(*run.quads);
   const QuadQuality& q = quads.quality;
 
   const auto t1 = Clock::now();

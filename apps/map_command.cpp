@@ -28,7 +28,7 @@ void MapCommand::check(const std::string& command) const {
                                                           ": the map uses the connection's own matching, so large turns are no problem");
 }
 
-MapRun run_map(const MapCommand& o) {
+MapRun run_map(const MapCommand& o, bool quads) {
   MapRun run;
   const auto t0 = Clock::now();
   run.loaded = load_mesh(o.mesh, o.mesh_options, o.quiet);
@@ -36,12 +36,13 @@ MapRun run_map(const MapCommand& o) {
   const MeshData& mesh = run.loaded.mesh;
   run.designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F, o.field.solver_options());
   run.request = o.field.request(*run.designer, run.repaired());
-  MapOutcome made = map_request(*run.designer, mesh.F, run.request, o.edge_length, o.target_faces);
+  MapOutcome made = map_request(*run.designer, mesh.F, run.request, o.edge_length, o.target_faces, quads);
   run.out = std::move(made.field);
   if (!run.out.verified)
     throw Error("the field did not pass verification, so no map was made: " + verification_failure(*run.designer, run.out.design));
   run.param = std::move(made.param);
   run.placements = made.placements, run.cancel_units = made.cancel_units, run.first_problems = made.first_problems;
+  run.quads = std::move(made.quads);
   return run;
 }
 
@@ -93,8 +94,9 @@ std::string map_summary(const MapCommand& o, const MapRun& run) {
          std::to_string(t.components.size()) + " component(s), chi " + std::to_string(t.euler_characteristic()) + ", " +
          std::to_string(t.boundary_loops.size()) + " boundary loop(s)\n" +
          (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string()) +
-         (run.placements > 1 ? "placement: the map of the singularities found had " + std::to_string(run.first_problems) +
-                                   " folded or degenerate faces or wrong windings; placed again " + std::to_string(run.placements - 1) +
+         (run.placements > 1 ? "placement: the singularities found gave " + std::to_string(run.first_problems) +
+                                   (run.quads ? " problems (map folds, wrong windings, failed quad checks)" : " problems (map folds, wrong windings)") +
+                                   "; placed again " + std::to_string(run.placements - 1) +
                                    " time(s) with opposite pairs cancelled further apart; kept: " +
                                    (run.cancel_units > 1 ? "pairs cancelled within " + std::to_string(static_cast<int>(run.cancel_units)) + " units"
                                                          : std::string("the first")) + "\n"

@@ -2,6 +2,7 @@
 // What `param` and `quad` share: the mesh, the field request and the scale of the map, parsed once, and the run
 // from the file to the seamless integer-grid map (trivcon/param.h) of a verified field.
 #pragma once
+#include <optional>
 #include <CLI/CLI.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -40,6 +41,7 @@ struct MapRun {
   int placements = 1;        // MapOutcome's
   double cancel_units = 0;
   int first_problems = 0;
+  std::optional<QuadMesh> quads;  // run_map(…, true): the kept map's quad mesh
   const RepairedMesh* repaired() const { return loaded.repaired(); }
 };
 
@@ -47,7 +49,8 @@ struct MapRun {
 // ± pairs within one unit of the map cancel unless --auto-cancel says otherwise, within 2 or 3 when the map
 // folds). Throws trivcon::Error, also
 // when the field does not pass verification.
-MapRun run_map(const MapCommand& command);
+// With `quads`, the quad mesh too, and a map whose quad mesh fails a check counts as one that folds.
+MapRun run_map(const MapCommand& command, bool quads = false);
 
 // The map as `param -o` writes it: the input file's mesh (repaired or not) with one vt per corner.
 void write_map_obj(const std::string& path, const MapRun& run);

@@ -25,6 +25,7 @@
 #include "trivcon/design.h"
 #include "trivcon/features.h"
 #include "trivcon/param.h"
+#include "trivcon/quad.h"
 #include "trivcon/relax.h"
 #include "trivcon/repair.h"
 #include "trivcon/split_large_turns.h"
@@ -128,14 +129,17 @@ struct MapOutcome {
   Parametrization param;   // not made (empty) when the field did not pass verification
   int placements = 1;      // automatic placements tried (map_request)
   double cancel_units = 0; // with automatic placement: the cancel distance used, in units of the map (0: the request's own)
-  int first_problems = 0;  // the first map's folded and degenerate faces and wrong windings, when it was placed again
+  int first_problems = 0;  // the first attempt's problems (below), when it was placed again
+  std::optional<QuadMesh> quads;  // with quads = true: the kept map's quad mesh (extract_quads)
 };
-// cancel_for_map, solve_request, and the map with request_param_options. With automatic placement and no cancel
-// distance in the request, a map left with folded or degenerate faces or wrong windings is made again from
+// cancel_for_map, solve_request, and the map with request_param_options (and its quad mesh with `quads`). With
+// automatic placement and no cancel distance in the request, a map left with folded or degenerate faces or wrong
+// windings (or, with `quads`, whose quad mesh fails a check of check_quads) is made again from
 // singularities whose ± pairs were cancelled within 2, then 4 units: at a scale too coarse for the singularities
 // found (a detailed scan at a thousand quads), fewer of them give a map without folds. The first without problems
 // is kept, else the one with the fewest (the earliest of equals). `request` is left as the kept one was made.
 // Throws what solve_request and parametrize throw.
-MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces);
+MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
+                       bool quads = false);
 
 }  // namespace trivcon

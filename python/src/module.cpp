@@ -1034,7 +1034,7 @@ PYBIND11_MODULE(_core, m) {
               FieldRequest request = q;
               // With a map's scale: the field of map_request (the program's: placed again when its map folds).
               FieldOutcome r = request.auto_place && (map_edge_length > 0 || map_target_faces > 0)
-                                   ? map_request(*s->designer, s->F, request, map_edge_length, map_target_faces).field
+                                   ? map_request(*s->designer, s->F, request, map_edge_length, map_target_faces, true).field
                                    : solve_request(*s->designer, s->F, request);
               s->fixed_faces = s->designer->fixed_faces();
               o.designer = s;

@@ -236,12 +236,15 @@ void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double
   request.auto_options.cancel_absolute = true;
 }
 
-MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces) {
+MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
+                       bool quads) {
   const bool escalate = request.auto_place && request.auto_options.cancel_distance == 0;
   cancel_for_map(request, designer, edge_length, target_faces);
   const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
-  auto problems = [](const Parametrization& p) {
-    return p.quality.flipped_faces + p.quality.degenerate_faces + p.quality.winding_errors;
+  // The map's folded and degenerate faces and wrong windings, and with quads the quad mesh's failed checks.
+  auto problems = [&](const MapOutcome& m) {
+    const ParamQuality& q = m.param.quality;
+    return q.flipped_faces + q.degenerate_faces + q.winding_errors + (m.quads ? static_cast<int>(m.quads->quality.problems.size()) : 0);
   };
   MapOutcome best;
   FieldRequest kept = request;
@@ -262,14 +265,15 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     }
     ParamOptions options = request_param_options(designer, r, m.field, edge_length, target_faces);
     m.param = parametrize(m.field.designer(designer), m.field.design, options);
+    if (quads) m.quads = extract_quads(m.field.designer(designer), m.param);
     m.cancel_units = escalate ? units : 0.0;
-    if (tried == 1 || problems(m.param) < problems(best.param)) {
-      const int first = tried == 1 ? problems(m.param) : best.first_problems;
+    if (tried == 1 || problems(m) < problems(best)) {
+      const int first = tried == 1 ? problems(m) : best.first_problems;
       best = std::move(m);
       best.first_problems = first;
       kept = r, kept_at = tried;
     }
-    if (problems(best.param) == 0) break;
+    if (problems(best) == 0) break;
   }
   // The designer holds the last attempt's set-up (fixed faces turned for singularities moved onto features): the
   // kept one is solved again, which gives the same design, so that the designer is the kept field's.
