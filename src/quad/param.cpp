@@ -646,7 +646,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       double length = 0;
       bool whole = true;
       for (auto [i, coefficient] : seg.terms) whole &= fixed[i] != 0, length += coefficient * value[i];
-      if (!whole || length * seg.real > 0.5) continue;
+      if (!whole || (seg.real > 0 ? length : -length) > 0.5) continue;  // at least one unit in the real map's sense
       int pick = -1;
       double pick_coefficient = 0;
       for (auto [i, coefficient] : seg.terms)
