@@ -391,6 +391,9 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   for (int j = 0; j < nY; ++j)
     if (elim.is_integer(free_vars[j])) integer_free.push_back(j);
   q.integer_unknowns = static_cast<int>(integer_free.size());
+  std::vector<char> is_integer(nY, 0);
+  for (int j : integer_free) is_integer[j] = 1;
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> P_rows = P;  // P by rows: a wedge coordinate's unknowns
   q.seconds_cut = linalg::seconds_since(t0);
 
   // --- The least-squares system -------------------------------------------------------------------------------
@@ -606,14 +609,11 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   std::vector<Segment> segments;
   std::vector<std::vector<int>> segments_of(nY);  // per free integer, the segments it enters
   {
-    std::vector<char> integer(nY, 0);
-    for (int j : integer_free) integer[j] = 1;
-    const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = P;
     auto along_row = [&](int w, int c, std::map<int, double>& acc, double sign) {
       bool whole = true;
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, 2 * w + c); it; ++it) {
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * w + c); it; ++it) {
         acc[static_cast<int>(it.col())] += sign * it.value();
-        whole &= integer[it.col()] != 0;
+        whole &= is_integer[it.col()] != 0;
       }
       return whole;
     };
@@ -640,9 +640,9 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     std::vector<int> queue;
     for (int j : round) queue.insert(queue.end(), segments_of[j].begin(), segments_of[j].end());
     for (int budget = 4 * static_cast<int>(queue.size()) + 16; !queue.empty() && budget > 0; --budget) {
-      const Segment& seg = segments[queue.back()];
       const int k = queue.back();
       queue.pop_back();
+      const Segment& seg = segments[k];
       double length = 0;
       bool whole = true;
       for (auto [i, coefficient] : seg.terms) whole &= fixed[i] != 0, length += coefficient * value[i];
@@ -752,7 +752,6 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // Then the other integers a folded or degenerate face depends on (an iso-line rounded onto its neighbour, a
   // translation): each, once, tries ±1, kept when it leaves fewer folds (the solution is affine in it: one solve).
   {
-    const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = P;
     std::vector<char> is_cone_value(nY, 0), seen(nY, 0);
     for (int k = 0; k < nCone; ++k)
       for (int c = 0; c < 2; ++c)
@@ -763,7 +762,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       std::vector<int> candidates;
       for (int i = 0; i < 3; ++i)
         for (int c = 0; c < 2; ++c)
-          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, 2 * wedge[3 * f + i] + c); it; ++it) {
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * wedge[3 * f + i] + c); it; ++it) {
             const int j = static_cast<int>(it.col());
             if (fixed[j] && !is_cone_value[j] && !seen[j]) seen[j] = 1, candidates.push_back(j);
           }
@@ -793,9 +792,6 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // move, so that no new fold appears. Kept only when the map is better after it (Badness); the region grows
   // when a fold is left; singularities whose rings cannot open are moved to a neighbouring integer point.
   const auto t3 = linalg::Clock::now();
-  std::vector<char> is_integer(nY, 0);
-  for (int j : integer_free) is_integer[j] = 1;
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> P_rows = P;
   std::vector<int> wedge_corner_start(W + 1, 0), wedge_corners(3 * nF);
   for (int c = 0; c < 3 * nF; ++c) ++wedge_corner_start[wedge[c] + 1];
   for (int w = 0; w < W; ++w) wedge_corner_start[w + 1] += wedge_corner_start[w];
