@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "map_command.h"
 
+#include <iomanip>
+#include <sstream>
+
 #include "outputs.h"
 #include "report.h"
 #include "summary.h"
@@ -42,6 +45,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
     throw Error("the field did not pass verification, so no map was made: " + verification_failure(*run.designer, run.out.design));
   run.param = std::move(made.param);
   run.placements = made.placements, run.cancel_units = made.cancel_units, run.first_problems = made.first_problems;
+  run.first_distortion = made.first_distortion, run.relaxed = made.relaxed;
   run.quads = std::move(made.quads);
   return run;
 }
@@ -82,11 +86,31 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
   }
   if (run.out.relax_result) report["relax"] = relax_summary_json(*run.out.relax_result);
   if (run.request.auto_place)
-    report["placement"] = {{"placements", run.placements}, {"cancel_units", run.cancel_units}, {"first_problems", run.first_problems}};
+    report["placement"] = {{"placements", run.placements},
+                           {"cancel_units", run.cancel_units},
+                           {"relaxed", run.relaxed},
+                           {"first_problems", run.first_problems},
+                           {"first_distortion", run.first_distortion}};
   for (size_t i = 0; i < param.cones.size(); ++i)
     report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
   return report;
 }
+
+namespace {
+
+std::string placement_line(const MapRun& run) {
+  std::ostringstream line;
+  line << "placement: the singularities found gave " << run.first_problems
+       << (run.quads ? " problems (map folds, wrong windings, failed quad checks)" : " problems (map folds, wrong windings)")
+       << " and a mean distortion of " << std::setprecision(3) << run.first_distortion << " (goal " << kMapDistortionGoal << "); placed again "
+       << run.placements - 1 << " time(s), relaxed or with opposite pairs cancelled further apart; kept: ";
+  if (run.cancel_units > 1) line << (run.relaxed ? "relaxed, " : "") << "pairs cancelled within " << static_cast<int>(run.cancel_units) << " units";
+  else line << (run.relaxed ? "the singularities found, relaxed" : "the first");
+  line << "\n";
+  return line.str();
+}
+
+}  // namespace
 
 std::string map_summary(const MapCommand& o, const MapRun& run) {
   const Topology& t = run.designer->topology();
@@ -94,13 +118,7 @@ std::string map_summary(const MapCommand& o, const MapRun& run) {
          std::to_string(t.components.size()) + " component(s), chi " + std::to_string(t.euler_characteristic()) + ", " +
          std::to_string(t.boundary_loops.size()) + " boundary loop(s)\n" +
          (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string()) +
-         (run.placements > 1 ? "placement: the singularities found gave " + std::to_string(run.first_problems) +
-                                   (run.quads ? " problems (map folds, wrong windings, failed quad checks)" : " problems (map folds, wrong windings)") +
-                                   "; placed again " + std::to_string(run.placements - 1) +
-                                   " time(s) with opposite pairs cancelled further apart; kept: " +
-                                   (run.cancel_units > 1 ? "pairs cancelled within " + std::to_string(static_cast<int>(run.cancel_units)) + " units"
-                                                         : std::string("the first")) + "\n"
-                             : std::string()) +
+         (run.placements > 1 ? placement_line(run) : std::string()) +
          "field: N 4, " + std::to_string(run.param.cones.size()) + " singular vertices, verified\n";
 }
 

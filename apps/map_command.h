@@ -41,13 +41,15 @@ struct MapRun {
   int placements = 1;        // MapOutcome's
   double cancel_units = 0;
   int first_problems = 0;
+  double first_distortion = 0;
+  bool relaxed = false;
   std::optional<QuadMesh> quads;  // run_map(…, true): the kept map's quad mesh
   const RepairedMesh* repaired() const { return loaded.repaired(); }
 };
 
 // Reads the mesh (repaired unless --no-repair), solves the request and makes the map (map_request: with --auto,
-// ± pairs within one unit of the map cancel unless --auto-cancel says otherwise, within 2 or 3 when the map
-// folds). Throws trivcon::Error, also
+// ± pairs within one unit of the map cancel unless --auto-cancel says otherwise; a map that folds or stretches
+// beyond the goal is made again, relaxed, then with pairs cancelled within 2 or 4). Throws trivcon::Error, also
 // when the field does not pass verification.
 // With `quads`, the quad mesh too, and a map whose quad mesh fails a check counts as one that folds.
 MapRun run_map(const MapCommand& command, bool quads = false);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Singularity relaxation (trivcon/relax.h): singularities spread apart on a sphere and reach a cube's
-// corners; the energy only decreases and the result verifies; pins hold; the duals give the exact first-order
+// corners; the energy only decreases and the result verifies; pins, avoided vertices and a separation hold; the duals give the exact first-order
 // change of every candidate and the estimate its second order; opposite indices cancel when that helps.
 #include <algorithm>
 #include <cmath>
@@ -137,6 +137,76 @@ TEST(Relax, PinsHoldAndMaxMovesStops) {
   EXPECT_EQ(error_of([&] { relax(designer, p, bad); }), "relax: cancel_distance must be at least 0, not -2");
   bad = {}, bad.max_seconds = -1;
   EXPECT_EQ(error_of([&] { relax(designer, p, bad); }), "relax: max_seconds must be at least 0");
+}
+
+// Avoided vertices receive nothing, but a singularity on one may leave; a separation keeps two singularities
+// that attract (on a cube-like sphere, +1/4 next to its corner and another by the neighbouring corner's edge)
+// from stepping within it.
+TEST(Relax, AvoidedVerticesAndTheSeparationHold) {
+  const Mesh m = make_icosphere(3);
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  const int a = 0, b = ring(t, a, 1)[0];
+  IndexPrescription p;
+  p.N = 4, p.vertex = {{a, 4}, {b, 4}};
+  // a and the ring 3 edges from it avoided: a's singularity leaves, and neither crosses the ring (they repel,
+  // and without it would end far apart).
+  RelaxOptions options;
+  options.avoid = ring(t, a, 3);
+  options.avoid.push_back(a);
+  RelaxResult r = relax(designer, p, options);
+  expect_sound(designer, p, r, options);
+  EXPECT_FALSE(r.moves.empty());
+  EXPECT_FALSE(r.prescription.vertex.count(a));
+  const std::set<int> avoided(options.avoid.begin(), options.avoid.end()), inside = [&] {
+    std::set<int> out{a};
+    for (int d = 1; d <= 2; ++d)
+      for (int v : ring(t, a, d)) out.insert(v);
+    return out;
+  }();
+  for (const RelaxMove& move : r.moves) EXPECT_FALSE(avoided.count(move.to)) << move.from << " -> " << move.to;
+  for (auto [v, n] : r.prescription.vertex) EXPECT_TRUE(inside.count(v)) << v;
+  options.avoid = {100000};
+  EXPECT_EQ(error_of([&] { relax(designer, p, options); }), "relax: avoided vertex 100000 out of range (mesh has 642 vertices)");
+
+  // +9/4 and −1/4 six rings apart attract (without cancelling they end side by side); with a separation of three
+  // edges' length no step brings them closer than that along edges.
+  auto path_length = [&](int from, int to) {  // Dijkstra along edges
+    std::vector<double> dist(t.num_vertices, 1e300);
+    std::set<std::pair<double, int>> queue{{0.0, from}};
+    dist[from] = 0;
+    while (!queue.empty()) {
+      const auto [d, v] = *queue.begin();
+      queue.erase(queue.begin());
+      if (v == to) return d;
+      for (int k = t.vertex_edge_offsets[v]; k < t.vertex_edge_offsets[v + 1]; ++k) {
+        const int e = t.vertex_edges[k], w = t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+        const double dw = d + (m.V.row(t.edge_vertices(e, 0)) - m.V.row(t.edge_vertices(e, 1))).norm();
+        if (dw < dist[w]) queue.erase({dist[w], w}), dist[w] = dw, queue.insert({dw, w});
+      }
+    }
+    return 1e300;
+  };
+  const int c = ring(t, a, 6)[0];
+  IndexPrescription q;
+  q.N = 4, q.vertex = {{a, 9}, {c, -1}};  // Gauss-Bonnet: the indices sum to 2
+  auto pair_length = [&](const IndexPrescription& x) { return path_length(x.vertex.begin()->first, x.vertex.rbegin()->first); };
+  const RelaxResult free = relax(designer, q);
+  expect_sound(designer, q, free);
+  ASSERT_EQ(free.prescription.vertex.size(), 2u);
+  const double edge = (m.V.row(t.edge_vertices(0, 0)) - m.V.row(t.edge_vertices(0, 1))).norm();
+  EXPECT_LT(pair_length(free.prescription), 1.5 * edge);
+  RelaxOptions apart;
+  apart.separation = 3 * edge;
+  const RelaxResult held = relax(designer, q, apart);
+  expect_sound(designer, q, held, apart);
+  ASSERT_EQ(held.prescription.vertex.size(), 2u);
+  EXPECT_FALSE(held.moves.empty());
+  EXPECT_GE(pair_length(held.prescription), apart.separation);
+  EXPECT_LT(pair_length(held.prescription), pair_length(q));
+  EXPECT_GT(held.energy_after, free.energy_after);
+  apart.separation = -1;
+  EXPECT_EQ(error_of([&] { relax(designer, q, apart); }), "relax: separation must be a finite distance of at least 0");
 }
 
 TEST(Relax, AlignedDiskKeepsItsBoundaryAndFixedFaces) {

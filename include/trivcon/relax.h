@@ -8,8 +8,9 @@
 // A move takes a singular vertex v's whole index n/N to an interior neighbour u (one edge away) that is
 // not singular; with cancel_distance > 0 it may also take it onto a vertex holding −n/N at most that many
 // edges away, where both vanish. Boundary vertices never receive a singularity, pinned vertices neither
-// move nor receive one, nothing moves between components, so each component keeps its multiset of
-// indices (less the cancelled pairs). Generator and loop indices, and the fixed directions, stay as the
+// move nor receive one, avoided vertices receive none, a step within `separation` of another singularity
+// is not taken (see RelaxOptions), nothing moves between components, so each component keeps its multiset
+// of indices (less the cancelled pairs). Generator and loop indices, and the fixed directions, stay as the
 // prescription gives them (free ones are chosen smoothest by every solve, as in any design). A move is
 // accepted only when a real solve (designer.solver().solve) lowers the energy by more than 1e-12 of it;
 // relax stops when no candidate does, or after max_moves moves.
@@ -45,6 +46,9 @@ namespace trivcon {
 
 struct RelaxOptions {
   std::vector<int> pins;    // vertices that keep their index (none moves away, none arrives)
+  std::vector<int> avoid;   // vertices no singularity moves onto (one there may leave)
+  double separation = 0;    // > 0: no step brings a singularity closer than this (along edges, mesh units) to
+                            // another one, unless they were closer already and it brings them no closer
   int max_moves = 10000;    // accepted moves at most (≥ 0)
   int cancel_distance = 0;  // > 0: an index n may meet a −n at most this many edges away, both vanishing; 0: never
   double max_seconds = 0;   // > 0: stop after about this long (checked between solves), with the moves made so far

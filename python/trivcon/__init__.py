@@ -872,7 +872,8 @@ class FieldDesigner(_Cached):
           that scale, as `trivcon param`/`quad --auto` do (docs/param.md): +- pairs closer than one unit
           cancelled (unless auto_cancel is given), close same-sign ones gathered or spread, those at the ends of
           sharp edges kept, a +-1/4 within 1.5 units of a sharp edge moved onto it; when their map folds
-          or its quad mesh fails a check (the scale too coarse for them), placed again with pairs cancelled within 2, then 4 units, the
+          or its quad mesh fails a check (the scale too coarse for them), or it stretches (mean singular-value
+          ratio above 1.5), placed again: relaxed, with pairs cancelled within 2, then 4 units, and those relaxed, the
           cleanest map's kept (this makes the map once or more). Then Result.parametrize/quad at the same scale
           give what the program gives.
 

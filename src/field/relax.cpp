@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <map>
+#include <queue>
 #include <utility>
 #include <string>
 
@@ -26,11 +29,17 @@ std::vector<char> pinned_vertices(const Topology& t, const RelaxOptions& options
   if (options.max_moves < 0) throw Error("relax: max_moves must be at least 0, not " + std::to_string(options.max_moves));
   if (options.cancel_distance < 0) throw Error("relax: cancel_distance must be at least 0, not " + std::to_string(options.cancel_distance));
   if (!(options.max_seconds >= 0)) throw Error("relax: max_seconds must be at least 0");
+  if (!(options.separation >= 0) || !std::isfinite(options.separation)) throw Error("relax: separation must be a finite distance of at least 0");
   std::vector<char> pinned(t.num_vertices, 0);
   for (int v : options.pins) {
     if (v < 0 || v >= t.num_vertices)
       throw Error("relax: pinned vertex " + std::to_string(v) + " out of range (mesh has " + std::to_string(t.num_vertices) + " vertices)");
     pinned[v] = 1;
+  }
+  for (int v : options.avoid) {
+    if (v < 0 || v >= t.num_vertices)
+      throw Error("relax: avoided vertex " + std::to_string(v) + " out of range (mesh has " + std::to_string(t.num_vertices) + " vertices)");
+    if (!pinned[v]) pinned[v] = 2;
   }
   return pinned;
 }
@@ -94,12 +103,45 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
     out.push_back(m);
   };
   auto other_end = [&](int e, int v) { return t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0); };
+  // With a separation: the distance (along edges, below the separation) from x to the nearest singular vertex
+  // other than `self`; the separation when there is none that close.
+  std::vector<double> dist(options.separation > 0 ? t.num_vertices : 0, std::numeric_limits<double>::infinity());
+  std::vector<int> touched;
+  auto nearest_other = [&](int x, int self) {
+    using Item = std::pair<double, int>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+    double found = options.separation;
+    dist[x] = 0, queue.emplace(0.0, x), touched.assign(1, x);
+    while (!queue.empty()) {
+      const auto [d, y] = queue.top();
+      queue.pop();
+      if (d > dist[y]) continue;
+      if (y != self && index_at(prescription, y) != 0) {
+        found = d;
+        break;
+      }
+      for (int a = t.vertex_edge_offsets[y]; a < t.vertex_edge_offsets[y + 1]; ++a) {
+        const int e = t.vertex_edges[a], z = other_end(e, y);
+        const double dz = d + (designer.V().row(t.edge_vertices(e, 1)) - designer.V().row(t.edge_vertices(e, 0))).norm();
+        if (dz < options.separation && dz < dist[z]) {
+          if (std::isinf(dist[z])) touched.push_back(z);
+          dist[z] = dz, queue.emplace(dz, z);
+        }
+      }
+    }
+    for (int y : touched) dist[y] = std::numeric_limits<double>::infinity();
+    return found;
+  };
   std::vector<int> seen(t.num_vertices, -1), frontier, next;
   for (auto [v, n] : prescription.vertex) {
-    if (n == 0 || pinned[v]) continue;
+    if (n == 0 || pinned[v] == 1) continue;
+    const double room = options.separation > 0 ? nearest_other(v, v) : 0.0;
     for (int a = t.vertex_edge_offsets[v]; a < t.vertex_edge_offsets[v + 1]; ++a) {
       const int e = t.vertex_edges[a], u = other_end(e, v);
-      if (t.is_interior_vertex(u) && !pinned[u] && index_at(prescription, u) == 0) add(v, u, n, 1, false, e);
+      if (!t.is_interior_vertex(u) || pinned[u] || index_at(prescription, u) != 0) continue;
+      // Not closer to another singularity than the separation, unless it was closer still.
+      if (options.separation > 0 && nearest_other(u, v) < std::min(room, options.separation)) continue;
+      add(v, u, n, 1, false, e);
     }
     if (options.cancel_distance == 0) continue;
     // Breadth-first to cancel_distance edges, for the vertices holding −n (each pair once, from its smaller vertex).
