@@ -245,7 +245,7 @@ Mesh perforated_plate(int nx, int ny, int m, int layers, double r) {
 }
 
 // A plate with 27 round holes, its boundary aligned, at 3,000 quads: the smoothest field's −1/4 (four around each
-// hole) twist the map around the holes in the middle row (hundreds of folds, mean singular-value ratio 3.4);
+// hole) twist the map around the holes in the middle row (dozens of folds, mean singular-value ratio 2.5);
 // `quad` relaxes them, a unit away from the holes and from each other, and the map is clean and within the goal.
 TEST(CliQuad, PlateWith27HolesIsRelaxedUntilTheMapIsClean) {
   const Mesh plate = perforated_plate(9, 3, 8, 6, 0.15);
@@ -255,7 +255,7 @@ TEST(CliQuad, PlateWith27HolesIsRelaxedUntilTheMapIsClean) {
   const nlohmann::json j = nlohmann::json::parse(slurp(report));
   EXPECT_EQ(j["boundary_loops"], 28);
   EXPECT_EQ(j["placement"]["relaxed"], true);
-  EXPECT_GT(j["placement"]["first_problems"].get<int>(), 100);
+  EXPECT_GT(j["placement"]["first_problems"].get<int>(), 10);
   EXPECT_GT(j["placement"]["first_distortion"].get<double>(), 2.0);
   EXPECT_EQ(j["param"]["flipped_faces"], 0);
   EXPECT_EQ(j["param"]["degenerate_faces"], 0);

@@ -46,6 +46,9 @@ struct ParamOptions {
   // retries' factorizations stay below twice the first attempt's (not wall time: the same map on any machine);
   // 0: never.
   int retries = 4;
+  // Rounds of sizing before the rounding (docs/param.md, "Sizing"): each lets a face's target size follow the
+  // real-valued map's own scale there, smoothed; 0: the field's unit length everywhere.
+  int sizing_rounds = 2;
 };
 
 struct ParamQuality {
@@ -54,6 +57,7 @@ struct ParamQuality {
   int rounding_rounds = 0;    // solves of the rounding
   int factorizations = 0;     // numeric factorizations of the map's system in all
   int stiffening_rounds = 0;  // re-solves against flips
+  int sizing_rounds = 0;      // re-solves with the target's size per face following the map (ParamOptions::sizing_rounds)
   int folds_real_valued = 0;  // folded faces of the first, real-valued map (before stiffening)
   int folds_rounded = 0;      // folded faces right after the rounding (before stiffening again)
   int cones_moved = 0;        // singularities moved to a neighbouring integer point against a fold or a shared point
