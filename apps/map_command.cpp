@@ -19,6 +19,8 @@ void MapCommand::add_to(CLI::App* cmd, const std::string& what_unit) {
   length = cmd->add_option("--edge-length", edge_length, "The length of one unit of (u, v) (one " + what_unit + "'s side), in the mesh's units")
                ->check(CLI::PositiveNumber);
   target->excludes(length);
+  cmd->add_flag("--uniform-size", uniform_size,
+                "One unit of (u, v) everywhere (a texture's even density): no sizing, which lets the unit follow the map's own scale where the field turns (docs/param.md)");
   cmd->add_flag("-q,--quiet", quiet, "Print nothing on success");
   add_mesh_options(cmd, mesh_options);
 }
@@ -39,6 +41,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   const MeshData& mesh = run.loaded.mesh;
   run.designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F, o.field.solver_options());
   run.request = o.field.request(*run.designer, run.repaired());
+  run.request.uniform_size = o.uniform_size;
   MapOutcome made = map_request(*run.designer, mesh.F, run.request, o.edge_length, o.target_faces, quads);
   run.out = std::move(made.field);
   if (!run.out.verified)

@@ -20,6 +20,7 @@ struct MapCommand {
   FieldOptions field;
   double target_faces = 0, edge_length = 0;
   bool quiet = false;
+  bool uniform_size = false;  // --uniform-size
   MeshOptions mesh_options;  // --no-repair, --weld
   CLI::Option* target = nullptr;
   CLI::Option* length = nullptr;

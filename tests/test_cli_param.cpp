@@ -116,6 +116,25 @@ TEST(CliParam, DiskWithAlignedBoundary) {
   EXPECT_EQ(uv.vt.size(), 3 * static_cast<size_t>(m.F.rows()));
 }
 
+// --uniform-size: no sizing (one unit of (u, v) everywhere); without it two rounds, and an annulus with its
+// circles aligned (iso-lines ringing the hole as many at every radius) stretches less.
+TEST(CliParam, UniformSizeTurnsTheSizingOff) {
+  const std::string mesh = mesh_file(make_annulus(12, 96, 0.5, 1.0), "annulus.obj"), obj = temp_file("annulus_uv.obj");
+  double ratio[2] = {0, 0};
+  for (int uniform = 0; uniform < 2; ++uniform) {
+    const std::string report = temp_file("annulus_" + std::to_string(uniform) + ".json");
+    const auto r = run_cli("param " + q(mesh) + " --auto --align-boundary --target-faces 400 -o " + q(obj) + " --report " + q(report) +
+                           (uniform ? " --uniform-size" : ""));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(report));
+    EXPECT_TRUE(j["param"]["seamless"].get<bool>());
+    EXPECT_EQ(j["param"]["flipped_faces"], 0);
+    EXPECT_EQ(j["param"]["sizing_rounds"], uniform ? 0 : 2);
+    ratio[uniform] = j["param"]["mean_distortion"].get<double>();
+  }
+  EXPECT_LT(ratio[0], ratio[1] - 0.05) << "sized " << ratio[0] << ", uniform " << ratio[1];
+}
+
 TEST(CliParam, UsageErrors) {
   const std::string mesh = mesh_file(make_torus(12, 6), "torus.obj"), obj = temp_file("torus_uv.obj");
   auto r = run_cli("param " + q(mesh) + " -o " + q(obj));

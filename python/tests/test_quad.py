@@ -103,3 +103,18 @@ def test_auto_for_a_map_is_the_programs(cli, tmp_path):
         d.solve(4, "auto", map_target_faces=300, map_edge_length=0.1)
     with pytest.raises(trivcon.Error, match="map_edge_length must be a positive number"):
         d.solve(4, "auto", map_edge_length=-1)
+
+
+def test_uniform_size_turns_the_sizing_off():
+    # An annulus with its circles aligned: by default the unit follows the map's own scale (two sizing rounds)
+    # and stretches less; uniform_size=True keeps one unit everywhere, as `--uniform-size`.
+    V, F = trivcon.make_annulus(12, 96, 0.5, 1.0)
+    r = trivcon.FieldDesigner(V, F).solve(4, "auto", align_boundary=True)
+    sized = r.parametrize(target_faces=400)
+    uniform = r.parametrize(target_faces=400, uniform_size=True)
+    assert sized.quality["sizing_rounds"] == 2 and uniform.quality["sizing_rounds"] == 0
+    assert sized.quality["flipped_faces"] == 0 and uniform.quality["flipped_faces"] == 0
+    assert sized.quality["mean_distortion"] < uniform.quality["mean_distortion"] - 0.05
+    q = r.quad(target_faces=400, uniform_size=True)
+    chi, boundary, over, _ = census(*q)
+    assert (chi, over) == (0, 0) and boundary > 0

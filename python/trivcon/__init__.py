@@ -1309,7 +1309,7 @@ class Result(_Cached):
         """Write the singularities used, as --sing-out does (readable by `trivcon solve -s`)."""
         self._r.write_singularities(str(path))
 
-    def parametrize(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None):
+    def parametrize(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None, uniform_size=False):
         """The seamless integer-grid map of this cross field (N = 4), as `trivcon param`: a Parametrization.
 
         target_faces: about this many unit squares; or edge_length: one unit of (u, v) in the mesh's units.
@@ -1318,6 +1318,8 @@ class Result(_Cached):
         align_boundary: put every boundary edge the field runs along on an integer iso-line (default: as
           this field was solved, solve(align_boundary=...)). aligned_edges: (n, 2) vertex pairs of more edges
           to put on iso-lines (default: the sharp edges the solve followed, Result.sharp_edges).
+        uniform_size: one unit of (u, v) everywhere (a texture's even density), as `--uniform-size`; by default
+          the unit follows the map's own scale where the field turns (docs/param.md, "Sizing").
         The mathematics and what is checked: docs/param.md. Raises trivcon.Error for N other than 4, a
         missing or non-positive scale, or an aligned edge that is not an edge of the mesh.
         """
@@ -1337,10 +1339,10 @@ class Result(_Cached):
             if pairs.size and (pairs.ndim != 2 or pairs.shape[1] != 2 or pairs.dtype.kind not in "iu"):
                 raise Error(f"aligned_edges: expected (n, 2) vertex ids, got an array of shape {pairs.shape} and type {pairs.dtype}")
         edge_pairs = [(int(a), int(b)) for a, b in _np.asarray(pairs).reshape(-1, 2)]
-        args = (float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs)
+        args = (float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs, bool(uniform_size))
         return Parametrization(self, *self._r.parametrize(*args), args=args)
 
-    def quad(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None):
+    def quad(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None, uniform_size=False):
         """The quad mesh of this cross field (N = 4), as `trivcon quad`: a QuadMesh (V, Q = result.quad(...) works too).
 
         The map is made as by parametrize (same arguments), then its integer grid is extracted (trivcon/quad.h,
@@ -1348,7 +1350,7 @@ class Result(_Cached):
         QuadMesh.quality has every guarantee checked on the result and QuadMesh.warning says what failed ("" when
         nothing did); nothing is raised for a failed guarantee, so that the mesh can be looked at.
         """
-        return self.parametrize(target_faces, edge_length, align_boundary, aligned_edges).quads()
+        return self.parametrize(target_faces, edge_length, align_boundary, aligned_edges, uniform_size).quads()
 
     def render(self, size=(1200, 900), view=(30, 20), up="y", style="hedgehog", spacing=11, flat=False, legend=True,
                singularities=None, supersampling=3):

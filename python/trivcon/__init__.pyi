@@ -271,6 +271,7 @@ class Result:
         edge_length: Optional[float] = ...,
         align_boundary: Optional[bool] = ...,
         aligned_edges: Optional[npt.ArrayLike] = ...,
+        uniform_size: bool = ...,
     ) -> Parametrization: ...
     def quad(
         self,
@@ -278,6 +279,7 @@ class Result:
         edge_length: Optional[float] = ...,
         align_boundary: Optional[bool] = ...,
         aligned_edges: Optional[npt.ArrayLike] = ...,
+        uniform_size: bool = ...,
     ) -> QuadMesh: ...
     def render(
         self,
