@@ -1211,27 +1211,32 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   for (int n : best.cone_index) necessary |= n >= 4;
   int attempts = 1;
   // The sizing moves the rounding's integers: where its map keeps problems, the map of the field's unit size is
-  // made too, and the one with fewer problems kept (with it, the retries below). Armadillo at 1,000 squares after
+  // made too, and the one with fewer problems kept; the retries below try both. Armadillo at 1,000 squares after
   // the cancelling within 4 units: 18 problems (folds and failed quad checks) sized, none without.
-  ParamOptions kept = options;
-  if (problems(best.quality) > 0 && options.sizing_rounds > 0) {
-    ParamOptions unsized = options;
-    unsized.sizing_rounds = 0;
-    Parametrization other = parametrize_at(designer, design, unsized, 1.0);
-    ++attempts;
-    if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other), kept = unsized;
+  std::vector<ParamOptions> variants{options};
+  if (options.sizing_rounds > 0) {
+    variants.push_back(options);
+    variants.back().sizing_rounds = 0;
   }
+  if (problems(best.quality) > 0 && variants.size() > 1) {
+    Parametrization other = parametrize_at(designer, design, variants[1], 1.0);
+    ++attempts;
+    if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other);
+  }
+  int retried = 0;
   if (problems(best.quality) > 0 && problems(best.quality) <= near_miss && !necessary)
-    for (double scale : {0.97, 1.03, 0.94, 1.06}) {
-      // At most `retries` more, and while they have cost less than twice the first, counted in factorizations
-      // (each a solve's main cost; unlike wall time, the same on every machine, so the same map everywhere).
-      if (attempts > options.retries || retry_factorizations >= 2 * first_factorizations) break;
-      Parametrization other = parametrize_at(designer, design, kept, scale);
-      ++attempts;
-      retry_factorizations += other.quality.factorizations;
-      if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other);
-      if (problems(best.quality) == 0) break;
-    }
+    for (double scale : {0.97, 1.03, 0.94, 1.06})
+      for (const ParamOptions& variant : variants) {
+        // At most `retries` edge lengths, and while they have cost less than twice the first per variant, counted
+        // in factorizations (each a solve's main cost; unlike wall time, the same on every machine, so the same map
+        // everywhere).
+        const int n = static_cast<int>(variants.size());
+        if (problems(best.quality) == 0 || retried >= options.retries * n || retry_factorizations >= 2 * n * first_factorizations) break;
+        Parametrization other = parametrize_at(designer, design, variant, scale);
+        ++attempts, ++retried;
+        retry_factorizations += other.quality.factorizations;
+        if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other);
+      }
   best.quality.attempts = attempts;
   best.quality.seconds_retries = linalg::seconds_since(start) - best.quality.seconds_total();  // the attempts not kept
   return best;
