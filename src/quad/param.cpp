@@ -608,8 +608,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // d = ∇v·Y, as the size of its face, s·e^φ with φ = log(√(a d) / s), smooths φ over neighbouring faces
   // (three passes of half the face's value and half its neighbours' mean), bounds it to [−1, 1] and solves again
   // with the target s·e^φ (X, Y) instead (the same matrix: only the right-hand side changes), normalized so that
-  // Σ area·e^{2φ} is the area. A conformal map's scale varies this way; the mean singular-value ratio falls
-  // (fandisk at 30°: 1.53 → 1.43, a bunny at 4,000 squares 1.19 → 1.13; BENCHMARKS.md).
+  // Σ area·e^{2φ} is the area. A conformal map's scale varies this way, and the mean singular-value ratio falls
+  // (docs/param.md, "Sizing").
   for (int round = 0; round < options.sizing_rounds; ++round) {
     check_cancelled();
     std::vector<double> phi(nF);
@@ -967,7 +967,9 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       std::array<Eigen::Vector2d, 3> gradient;
       std::array<std::array<quad::AffineForm, 2>, 3> corner;
       for (int i = 0; i < 3; ++i) {
-        gradient[i] = Eigen::Vector2d(grad[f][i].dot(X), grad[f][i].dot(Y)) / s;  // relative to the ideal s·(X Y)ᵀ (the field's unit size: what the untangling was measured with)
+        // Relative to the ideal s·(X Y)ᵀ: the field's unit size, also where the sizing changed the target (the
+        // untangling only opens folds; measured against the sized target it opened fewer, BENCHMARKS.md).
+        gradient[i] = Eigen::Vector2d(grad[f][i].dot(X), grad[f][i].dot(Y)) / s;
         for (int r = 0; r < 2; ++r)
           for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * wedge[3 * f + i] + r); it; ++it) {
             const int j = static_cast<int>(it.col());
@@ -1211,8 +1213,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   for (int n : best.cone_index) necessary |= n >= 4;
   int attempts = 1;
   // The sizing moves the rounding's integers: where its map keeps problems, the map of the field's unit size is
-  // made too, and the one with fewer problems kept; the retries below try both. Armadillo at 1,000 squares after
-  // the cancelling within 4 units: 18 problems (folds and failed quad checks) sized, none without.
+  // made too, and the one with fewer problems kept; the retries below try both.
   std::vector<ParamOptions> variants{options};
   if (options.sizing_rounds > 0) {
     variants.push_back(options);

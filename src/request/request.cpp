@@ -290,8 +290,8 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   // The attempts: the placement found; the same relaxed (trivcon/relax.h: the field's energy is lower where
   // the singularities sit as the surface's curvature and the aligned lines ask, and a map of a field with less
   // rotation stretches less); then with pairs cancelled within 2 and 4 units, then those relaxed. Neither kind
-  // wins everywhere: relaxed, a plate's −1/4 around round holes stop twisting the map (27 holes at 3,000
-  // quads: 256 problems to none), while armadillo's at 1,000 fold more.
+  // wins everywhere: relaxed, a plate's −1/4 around round holes stop twisting the map, while a coarse scan's
+  // fold more (docs/param.md; BENCHMARKS.md).
   struct Attempt {
     double units;
     bool relax;
