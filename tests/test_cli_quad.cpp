@@ -185,8 +185,8 @@ TEST(CliQuad, ArmadilloAt4000QuadsWindsRightAroundEveryVertex) {
 }
 
 // A detailed scan at a coarse scale (armadillo, 86k faces, 1,000 quads): the 103 singularities found fold the map
-// (43 folded faces and wrong windings); placed again with pairs cancelled within 2 and then 4 units, the map is
-// clean and the quads are at the singularities written.
+// (43 folded faces and wrong windings); placed again (relaxed, which folds more, then with pairs cancelled within 2
+// and then 4 units), the map is clean and the quads are at the singularities written.
 TEST(CliQuad, ArmadilloAt1000QuadsIsPlacedAgainUntilTheMapIsClean) {
   TRIVCON_REQUIRE_SHARED();
   expect_quads_at_the_singularities("armadillo.obj", "--auto --target-faces 1000", 2, true);

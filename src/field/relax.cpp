@@ -4,13 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <map>
-#include <queue>
 #include <utility>
 #include <string>
 
+#include "field/edge_dijkstra.h"
 #include "linalg/timing.h"
 #include "trivcon/cancel.h"
 #include "trivcon/error.h"
@@ -106,30 +105,13 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
   // With a separation: the distance (along edges, below the separation) from x to the nearest singular vertex
   // other than `self`; the separation when there is none that close.
   std::vector<double> dist(options.separation > 0 ? t.num_vertices : 0, std::numeric_limits<double>::infinity());
-  std::vector<int> touched;
   auto nearest_other = [&](int x, int self) {
-    using Item = std::pair<double, int>;
-    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
     double found = options.separation;
-    dist[x] = 0, queue.emplace(0.0, x), touched.assign(1, x);
-    while (!queue.empty()) {
-      const auto [d, y] = queue.top();
-      queue.pop();
-      if (d > dist[y]) continue;
-      if (y != self && index_at(prescription, y) != 0) {
-        found = d;
-        break;
-      }
-      for (int a = t.vertex_edge_offsets[y]; a < t.vertex_edge_offsets[y + 1]; ++a) {
-        const int e = t.vertex_edges[a], z = other_end(e, y);
-        const double dz = d + (designer.V().row(t.edge_vertices(e, 1)) - designer.V().row(t.edge_vertices(e, 0))).norm();
-        if (dz < options.separation && dz < dist[z]) {
-          if (std::isinf(dist[z])) touched.push_back(z);
-          dist[z] = dz, queue.emplace(dz, z);
-        }
-      }
-    }
-    for (int y : touched) dist[y] = std::numeric_limits<double>::infinity();
+    field::edge_dijkstra(designer.V(), t, x, options.separation, false, dist, [&](int y, double d) {
+      if (found < options.separation) return false;  // found (nearest first): expand nothing more
+      if (y != self && index_at(prescription, y) != 0) found = d;
+      return found == options.separation;
+    });
     return found;
   };
   std::vector<int> seen(t.num_vertices, -1), frontier, next;

@@ -533,12 +533,16 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     return angle;
   };
   // σ_max / σ_min of the map's Jacobian on face f (rows ∇u, ∇v in the face's frame); infinite when σ_min = 0.
-  auto distortion = [&](int f) {
+  auto jacobian = [&](int f) {  // rows ∇u, ∇v in the face's frame
     Eigen::Matrix2d J = Eigen::Matrix2d::Zero();
     for (int i = 0; i < 3; ++i) {
       J.row(0) += out.uv(3 * f + i, 0) * grad[f][i].transpose();
       J.row(1) += out.uv(3 * f + i, 1) * grad[f][i].transpose();
     }
+    return J;
+  };
+  auto distortion = [&](int f) {
+    const Eigen::Matrix2d J = jacobian(f);
     // Singular values of a 2 × 2 matrix in closed form.
     const double e = (J(0, 0) + J(1, 1)) / 2, ff = (J(0, 0) - J(1, 1)) / 2, gg = (J(1, 0) + J(0, 1)) / 2, h = (J(1, 0) - J(0, 1)) / 2;
     const double qq = std::hypot(e, h), rr = std::hypot(ff, gg);
@@ -614,11 +618,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     check_cancelled();
     std::vector<double> phi(nF);
     for (int f = 0; f < nF; ++f) {
-      Eigen::Matrix2d J = Eigen::Matrix2d::Zero();
-      for (int i = 0; i < 3; ++i) {
-        J.row(0) += out.uv(3 * f + i, 0) * grad[f][i].transpose();
-        J.row(1) += out.uv(3 * f + i, 1) * grad[f][i].transpose();
-      }
+      const Eigen::Matrix2d J = jacobian(f);
       const Eigen::Vector2d X(std::cos(theta[f]), std::sin(theta[f])), Y(-X.y(), X.x());
       const double a = J.row(0).dot(X), d = J.row(1).dot(Y);
       phi[f] = a > 0 && d > 0 ? std::log(std::sqrt(a * d) / s) : std::log(size[f]);  // a folded face keeps its size
