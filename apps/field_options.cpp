@@ -75,6 +75,17 @@ void FieldOptions::add_to(CLI::App* cmd, bool fixed_N) {
   cmd->add_option("--relax-max-moves", relax_max_moves, "With --relax: accepted moves at most (default 10000)")
       ->check(CLI::NonNegativeNumber)
       ->needs(relax_flag);
+  cmd->add_option("--relax-reach", relax_reach,
+                  "With --relax: a singularity may move to a free vertex at most K edges away in one move (default 1: one edge), "
+                  "which lets it pass a rise of the energy that single steps stop at")
+      ->check(CLI::PositiveNumber)
+      ->needs(relax_flag);
+  cmd->add_option("--relax-periods", relax_periods,
+                  "With --relax: lower the energy plus W times the squared periods of the conformal scale around the aligned "
+                  "boundary loops and feature lines, so that a map of the field stretches less (docs/solver.md, \"Periods\"; "
+                  "default 0: the energy alone)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(relax_flag);
   cmd->add_option("--root-face", root_faces, "Face where propagation starts (one per component at most; repeatable)");
   cmd->add_option("--root-angle", root_angles, "Angle (radians, in the root face's frame) of the field at the matching --root-face");
   cmd->add_flag("--split-large-turns", split_large_turns,
@@ -115,6 +126,8 @@ FieldRequest FieldOptions::request(const FieldDesigner& designer, const Repaired
   r.relax_options.pins = relax_pins;
   r.relax_options.cancel_distance = relax_cancel;
   r.relax_options.max_moves = relax_max_moves;
+  r.relax_options.period_weight = relax_periods;
+  r.relax_options.reach = relax_reach;
   r.split_large_turns = split_large_turns;
   if (repaired) move_request_to_repaired(r, designer.topology(), *repaired);
   if (!sing_from_field.empty()) {

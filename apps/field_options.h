@@ -31,6 +31,8 @@ struct FieldOptions {
   std::vector<int> relax_pins;     // --relax-pin
   int relax_cancel = 0;            // --relax-cancel, in edges
   int relax_max_moves = 10000;     // --relax-max-moves
+  double relax_periods = 0;        // --relax-periods
+  int relax_reach = 1;             // --relax-reach
   bool split_large_turns = false;  // --split-large-turns
   CLI::Option* auto_flag = nullptr;
   CLI::Option* from_field_option = nullptr;

@@ -99,13 +99,15 @@ nlohmann::ordered_json relax_summary_json(const RelaxResult& r) {
     moves.push_back({{"from", m.from}, {"to", m.to}, {"index", m.index}, {"energy", m.energy}, {"cancelled", m.cancelled}});
     cancelled += m.cancelled;
   }
-  return {{"energy_before", r.energy_before},
+  nlohmann::ordered_json out = {{"energy_before", r.energy_before},
           {"energy_after", r.energy_after},
           {"moves", moves},
           {"cancelled_pairs", cancelled},
           {"candidates_evaluated", r.candidates_evaluated},
           {"converged", r.converged},
           {"seconds", r.seconds}};
+  if (r.periods_used) out["periods_before"] = r.periods_before, out["periods_after"] = r.periods_after;
+  return out;
 }
 
 std::string relax_summary_line(const RelaxResult& r) {
@@ -116,6 +118,7 @@ std::string relax_summary_line(const RelaxResult& r) {
   if (r.energy_before > 0) s << std::setprecision(3) << " (" << 100 * (r.energy_after - r.energy_before) / r.energy_before << " %)";
   s << std::setprecision(3) << ", " << r.moves.size() << " moves";
   if (cancelled > 0) s << " (" << cancelled << " cancelling a pair)";
+  if (r.periods_used) s << ", periods " << r.periods_before << " -> " << r.periods_after;
   s << ", " << r.candidates_evaluated << " candidate solves, " << r.seconds << " s"
     << (r.converged ? "" : " (stopped at --relax-max-moves: a move may still lower the energy)");
   return s.str();

@@ -213,6 +213,48 @@ Mesh sheared_box(int n) {
   return m;
 }
 
+Mesh perforated_plate(int nx, int ny, int m, int layers, double r) {
+  std::map<std::pair<long long, long long>, int> id;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3i> faces;
+  auto vertex = [&](double x, double y) {
+    const auto key = std::make_pair(std::llround(x * 1e6), std::llround(y * 1e6));
+    const auto [it, added] = id.emplace(key, static_cast<int>(points.size()));
+    if (added) points.emplace_back(x, y, 0);
+    return it->second;
+  };
+  for (int cx = 0; cx < nx; ++cx)
+    for (int cy = 0; cy < ny; ++cy) {
+      std::vector<std::array<double, 2>> square;  // counter-clockwise
+      for (int side = 0; side < 4; ++side)
+        for (int k = 0; k < m; ++k) {
+          const double a = static_cast<double>(k) / m;
+          const double x[4] = {a, 1, 1 - a, 0}, y[4] = {0, a, 1, 1 - a};
+          square.push_back({cx + x[side], cy + y[side]});
+        }
+      const int n = 4 * m;
+      std::vector<std::vector<int>> ring(layers + 1, std::vector<int>(n));
+      for (int j = 0; j <= layers; ++j)
+        for (int k = 0; k < n; ++k) {
+          const double angle = std::atan2(square[k][1] - cy - 0.5, square[k][0] - cx - 0.5), w = static_cast<double>(j) / layers;
+          const double hx = cx + 0.5 + r * std::cos(angle), hy = cy + 0.5 + r * std::sin(angle);
+          ring[j][k] = vertex((1 - w) * hx + w * square[k][0], (1 - w) * hy + w * square[k][1]);
+        }
+      for (int j = 0; j < layers; ++j)
+        for (int k = 0; k < n; ++k) {
+          const int a = ring[j][k], b = ring[j][(k + 1) % n], c = ring[j + 1][(k + 1) % n], d = ring[j + 1][k];
+          if ((j + k) % 2) faces.emplace_back(a, b, c), faces.emplace_back(a, c, d);
+          else faces.emplace_back(a, b, d), faces.emplace_back(b, c, d);
+        }
+    }
+  Mesh out;
+  out.V.resize(static_cast<int>(points.size()), 3);
+  for (size_t i = 0; i < points.size(); ++i) out.V.row(static_cast<int>(i)) = points[i].transpose();
+  out.F.resize(static_cast<int>(faces.size()), 3);
+  for (size_t i = 0; i < faces.size(); ++i) out.F.row(static_cast<int>(i)) = faces[i].transpose();
+  return out;
+}
+
 Mesh jittered_disk(int rings, int segments, double amount) {
   Mesh m = make_disk(rings, segments);
   const Topology t = topo(m);

@@ -64,6 +64,10 @@ Mesh jittered_disk(int rings, int segments, double amount);
 // 2.5 y: its sides z = ±1 are parallelograms with corners of atan(1 / 2.5) ≈ 21.8° and 158.2° where the
 // sharp edges meet (narrow corners, trivcon/features.h), each corner of a side shared by two triangles.
 Mesh sheared_box(int n);
+// A flat plate of nx × ny unit cells, each with a round hole of radius r at its centre: per cell, `layers` rings of
+// quads (each cut into two triangles) from the hole's circle, sampled at the angles of 4m points evenly spaced
+// along the cell's square, out to that square; the cells share their squares' points.
+Mesh perforated_plate(int nx, int ny, int m, int layers, double r);
 
 // Checks every structural invariant of a Topology against F (the input) alone. Cheap: O(F log F).
 void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const std::string& what);

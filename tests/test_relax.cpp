@@ -8,6 +8,7 @@
 #include <set>
 
 #include "support.h"
+#include "trivcon/auto.h"
 #include "trivcon/constraints.h"
 #include "trivcon/error.h"
 #include "trivcon/relax.h"
@@ -27,12 +28,25 @@ std::multiset<int> indices_of(const IndexPrescription& p) {
   return out;
 }
 
+// A cross field with the boundary aligned (every face with a boundary edge fixed to it), set on the designer.
+IndexPrescription aligned_cross_field(FieldDesigner& designer, const Mesh& m) {
+  IndexPrescription p;
+  p.N = 4;
+  p.fixed = boundary_alignment(m.V, designer.topology(), designer.geometry());
+  std::vector<int> fixed;
+  for (auto [f, angle] : p.fixed) fixed.push_back(f);
+  designer.set_fixed_faces(fixed);
+  return p;
+}
+
 // What every relaxation must satisfy: strictly decreasing energies ending at the real energy of the result,
 // a verified design, the same indices (less cancelled pairs), boundary vertices empty, pins unmoved.
 void expect_sound(const FieldDesigner& designer, const IndexPrescription& start, const RelaxResult& r, const RelaxOptions& options = {}) {
   ASSERT_EQ(r.energies.size(), r.moves.size() + 1);
-  EXPECT_EQ(r.energies.front(), r.energy_before);
-  EXPECT_EQ(r.energies.back(), r.energy_after);
+  // The objective: the energy, plus the periods' term when they were used.
+  const double w = r.periods_used ? options.period_weight : 0.0;
+  EXPECT_NEAR(r.energies.front(), r.energy_before + w * r.periods_before, 1e-12 * std::max(1.0, r.energies.front()));
+  EXPECT_NEAR(r.energies.back(), r.energy_after + w * r.periods_after, 1e-12 * std::max(1.0, r.energies.back()));
   for (size_t k = 0; k < r.moves.size(); ++k) {
     EXPECT_LT(r.energies[k + 1], r.energies[k]) << "move " << k;
     EXPECT_EQ(r.moves[k].energy, r.energies[k + 1]);
@@ -214,12 +228,7 @@ TEST(Relax, AlignedDiskKeepsItsBoundaryAndFixedFaces) {
   // neighbours. They spread out; no boundary vertex receives one; the fixed directions hold.
   const Mesh m = make_disk(8, 6);
   FieldDesigner designer(m.V, m.F);
-  IndexPrescription p;
-  p.N = 4;
-  p.fixed = boundary_alignment(m.V, designer.topology(), designer.geometry());
-  std::vector<int> fixed;
-  for (auto [f, angle] : p.fixed) fixed.push_back(f);
-  designer.set_fixed_faces(fixed);
+  IndexPrescription p = aligned_cross_field(designer, m);
   const std::vector<int> around = ring(designer.topology(), 0, 1);
   for (int k = 0; k < 4; ++k) p.vertex[around[k]] = 1;
   const RelaxResult r = relax(designer, p);
@@ -230,6 +239,147 @@ TEST(Relax, AlignedDiskKeepsItsBoundaryAndFixedFaces) {
     for (auto [b, k] : r.prescription.vertex)
       if (a < b) closest = std::min(closest, (m.V.row(a) - m.V.row(b)).norm());
   EXPECT_GT(closest, 0.4) << "energy " << r.energy_before << " -> " << r.energy_after;
+}
+
+// The periods of trivcon/relax.h on an annulus with both boundaries aligned (two components of fixed faces) and a
+// pair of opposite singularities placed off-centre: s = x / w sums to 0 around every face that is not fixed (the
+// minimum is stationary in each free face's direction), the two components' periods are opposite (all faces sum to
+// 0: s is 0 on the boundary edges) and not 0; each candidate's period change, predicted from the sensitivities,
+// is the real one wherever the solve kept the fixed paths' turns; relaxing with the periods ends with smaller ones.
+std::vector<double> fixed_periods(const FieldDesigner& designer, const Connection& c, const std::vector<std::vector<int>>& parts) {
+  const Topology& t = designer.topology();
+  const Eigen::VectorXd& w = designer.solver().weights();
+  std::vector<double> out;
+  for (const std::vector<int>& faces : parts) {
+    double sum = 0;
+    for (int f : faces)
+      for (int k = 0; k < 3; ++k) {
+        const int e = t.face_edges(f, k);
+        if (w(e) > 0) sum += (t.edge_faces(e, 0) == f ? 1 : -1) * c.x(e) / w(e);
+      }
+    out.push_back(sum);
+  }
+  return out;
+}
+
+TEST(Relax, PeriodsAroundAlignedLoopsArePredictedAndLowered) {
+  const Mesh m = make_annulus(10, 48);
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  IndexPrescription p = aligned_cross_field(designer, m);
+  std::vector<int> fixed;
+  for (auto [f, angle] : p.fixed) fixed.push_back(f);
+  // The two components: the faces touching each loop.
+  std::vector<std::vector<int>> parts(2);
+  for (int f : fixed) parts[t.vertex_boundary_loop[t.F(f, 0)] >= 0 ? t.vertex_boundary_loop[t.F(f, 0)]
+                           : t.vertex_boundary_loop[t.F(f, 1)] >= 0 ? t.vertex_boundary_loop[t.F(f, 1)]
+                                                                     : t.vertex_boundary_loop[t.F(f, 2)]].push_back(f);
+  ASSERT_FALSE(parts[0].empty());
+  ASSERT_FALSE(parts[1].empty());
+  // +1/4 and −1/4 a few rings apart on one side.
+  int plus = -1, minus = -1;
+  double best_plus = 1e300, best_minus = 1e300;
+  for (int v = 0; v < t.num_vertices; ++v) {
+    if (!t.is_interior_vertex(v)) continue;
+    const double dp = (m.V.row(v) - Eigen::RowVector3d(0.62, 0.25, 0)).norm(), dm = (m.V.row(v) - Eigen::RowVector3d(0.85, -0.2, 0)).norm();
+    if (dp < best_plus) best_plus = dp, plus = v;
+    if (dm < best_minus) best_minus = dm, minus = v;
+  }
+  p.vertex[plus] = 1, p.vertex[minus] = -1;
+  const ConnectionSolver& solver = designer.solver();
+  const Connection c0 = solver.solve(p);
+  const std::set<int> fixed_set(fixed.begin(), fixed.end());
+  double scale = 0;
+  for (int e = 0; e < t.num_edges; ++e)
+    if (solver.weights()(e) > 0) scale = std::max(scale, std::abs(c0.x(e) / solver.weights()(e)));
+  for (int f = 0; f < t.num_faces; ++f) {
+    if (fixed_set.count(f)) continue;
+    double sum = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int e = t.face_edges(f, k);
+      if (solver.weights()(e) > 0) sum += (t.edge_faces(e, 0) == f ? 1 : -1) * c0.x(e) / solver.weights()(e);
+    }
+    EXPECT_NEAR(sum, 0, 1e-9 * scale) << "face " << f;
+  }
+  const std::vector<double> T0 = fixed_periods(designer, c0, parts);
+  EXPECT_NEAR(T0[0] + T0[1], 0, 1e-9 * scale);
+  EXPECT_GT(std::abs(T0[0]), 1e-3);
+  // Predicted against real period changes.
+  RelaxOptions with;
+  with.period_weight = 1;
+  const std::vector<RelaxCandidate> plain = relax_candidates(designer, p, c0), weighted = relax_candidates(designer, p, c0, with);
+  ASSERT_EQ(plain.size(), weighted.size());
+  std::map<std::pair<int, int>, double> first;
+  for (const RelaxCandidate& a : plain) first[{a.from, a.to}] = a.first_order;
+  int compared = 0;
+  for (const RelaxCandidate& a : weighted) {
+    IndexPrescription q = p;
+    q.vertex.erase(a.from);
+    q.vertex[a.to] = a.index;
+    const Connection c = solver.solve(q);
+    if (c.path_turn != c0.path_turn) continue;
+    const std::vector<double> T = fixed_periods(designer, c, parts);
+    const double real = T[0] * T[0] + T[1] * T[1] - T0[0] * T0[0] - T0[1] * T0[1];
+    EXPECT_NEAR(a.first_order - first.at({a.from, a.to}), real, 1e-8 * std::max(1.0, std::abs(real))) << a.from << " -> " << a.to;
+    ++compared;
+  }
+  EXPECT_GT(compared, 8);
+  const RelaxResult r = relax(designer, p, with);
+  expect_sound(designer, p, r, with);
+  EXPECT_TRUE(r.periods_used);
+  EXPECT_NEAR(r.periods_before, T0[0] * T0[0] + T0[1] * T0[1], 1e-9 * std::max(1.0, r.periods_before));
+  EXPECT_LT(r.periods_after, r.periods_before);
+  // Without the weight the periods are not looked at.
+  EXPECT_FALSE(relax(designer, p).periods_used);
+}
+
+// A plate of 3 × 2 cells with round holes, its boundary aligned: the smoothest field's −1/4 (four per hole) relaxed by
+// single steps stop in a crowd along the holes; allowed to jump three edges they pass the rises between and end
+// far lower. Every move of the reach-3 run goes at most three edges; each run is sound; the jumps' run is a
+// minimum for its own candidates too.
+TEST(Relax, AReachOfThreeEdgesPassesRisesThatStepsStopAt) {
+  const Mesh m = test::perforated_plate(3, 2, 8, 6, 0.15);
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  IndexPrescription p = aligned_cross_field(designer, m);
+  AutoOptions automatic;
+  automatic.fixed = p.fixed;
+  p.vertex = auto_singularities(designer, automatic).vertex;
+  ASSERT_EQ(p.vertex.size(), 24u);
+  const RelaxResult steps = relax(designer, p);
+  RelaxOptions far;
+  far.reach = 3;
+  const RelaxResult jumps = relax(designer, p, far);
+  expect_sound(designer, p, steps);
+  expect_sound(designer, p, jumps, far);
+  EXPECT_TRUE(jumps.converged);
+  EXPECT_LT(jumps.energy_after, 0.8 * steps.energy_after) << steps.energy_after << " by steps";
+  int longest = 0;
+  for (const RelaxMove& move : jumps.moves) {
+    int distance = 0;
+    for (int d = 1; d <= 3 && distance == 0; ++d) {
+      const std::vector<int> ring = test::vertex_ring(t, move.from, d);
+      if (std::find(ring.begin(), ring.end(), move.to) != ring.end()) distance = d;
+    }
+    EXPECT_GE(distance, 1) << move.from << " -> " << move.to;
+    longest = std::max(longest, distance);
+  }
+  EXPECT_GE(longest, 2);
+  const Connection c = designer.solver().solve(jumps.prescription);
+  for (const RelaxCandidate& move : relax_candidates(designer, jumps.prescription, c, far)) {
+    if (move.cancels) continue;
+    IndexPrescription q = jumps.prescription;
+    q.vertex.erase(move.from);
+    q.vertex[move.to] = move.index;
+    if (!(move.first_order < 0)) continue;
+    EXPECT_GE(designer.solver().solve(q).energy, c.energy * (1 - 1e-12)) << move.from << " -> " << move.to;
+  }
+  EXPECT_EQ(error_of([&] {
+              RelaxOptions bad;
+              bad.reach = 0;
+              relax(designer, p, bad);
+            }),
+            "relax: reach must be at least 1, not 0");
 }
 
 // For every candidate v → u moving n: E(n) and E(−n) (the opposite move, also a valid prescription) by real

@@ -6,14 +6,24 @@
 //   designer.design(r.prescription) ...                        // the relaxed field
 //
 // A move takes a singular vertex v's whole index n/N to an interior neighbour u (one edge away) that is
-// not singular; with cancel_distance > 0 it may also take it onto a vertex holding −n/N at most that many
-// edges away, where both vanish. Boundary vertices never receive a singularity, pinned vertices neither
+// not singular, or with reach k > 1 to such a vertex up to k edges away; with cancel_distance > 0 it may
+// also take it onto a vertex holding −n/N at most that many edges away, where both vanish. Boundary vertices never receive a singularity, pinned vertices neither
 // move nor receive one, avoided vertices receive none, a step within `separation` of another singularity
 // is not taken (see RelaxOptions), nothing moves between components, so each component keeps its multiset
 // of indices (less the cancelled pairs). Generator and loop indices, and the fixed directions, stay as the
 // prescription gives them (free ones are chosen smoothest by every solve, as in any design). A move is
 // accepted only when a real solve (designer.solver().solve) lowers the energy by more than 1e-12 of it;
 // relax stops when no candidate does, or after max_moves moves.
+//
+// Periods (docs/solver.md, "Periods"). Let s_e = x_e / w_e on the primal edges. At every face f that is not
+// fixed, Σ_{e∈f} g_fe s_e = 0 (g_fe = +1 where f = edge_faces(e, 0), −1 where f = edge_faces(e, 1)): rotating
+// f's direction changes no constraint, so the minimum is stationary in it. So s = dφ locally: e^φ is the scale
+// that makes the field's frame integrable, a conformal map's. Around a component C of fixed faces (connected
+// through shared vertices: a boundary loop's aligned strip, a feature network, fixed faces) φ changes by the
+// period T_C = Σ_{f∈C} Σ_{e∈f} g_fe s_e, which no scale can absorb: a map of this field must stretch by e^{|T_C|}
+// somewhere around C. T_C is linear in the right-hand sides: ∂T_C/∂b = (A W Aᵀ)⁻¹ A σ_C with σ_C(e) = Σ_{f∈C∋e}
+// g_fe (ConnectionSolver::vertex_duals of σ_C), so a move changes it by exactly c (∂T_C/∂b_v − ∂T_C/∂b_u) with
+// the cycle indices held; with period_weight > 0 that change enters the ranking below.
 //
 // Ranking (docs/solver.md, "Singularity relaxation"). The energy is E = bᵀ M⁻¹ b with M = A W Aᵀ and b the
 // right-hand sides (trivcon/solver.h; vertex rows b_v = K_v − 2π n_v/N). Moving n from v to u is
@@ -51,21 +61,31 @@ struct RelaxOptions {
                             // another one, unless they were closer already and it brings them no closer
   int max_moves = 10000;    // accepted moves at most (≥ 0)
   int cancel_distance = 0;  // > 0: an index n may meet a −n at most this many edges away, both vanishing; 0: never
+  int reach = 1;            // ≥ 1: a singularity may move to a free vertex at most this many edges away in one move
   double max_seconds = 0;   // > 0: stop after about this long (checked between solves), with the moves made so far
+  // > 0: the objective is E + period_weight · P, P = Σ_C T_C² the squared periods of the conformal scale around
+  // the components C of fixed faces (see "Periods" above); 0: E alone. Ignored (RelaxResult::periods_used false)
+  // with fewer than two components, or when their sensitivities would take more than kMaxPeriodValues numbers.
+  double period_weight = 0;
 };
+
+// The most numbers (components × vertices) the period sensitivities may take (about 160 MB).
+constexpr double kMaxPeriodValues = 2e7;
 
 struct RelaxMove {
   int from = 0, to = 0;
   int index = 0;           // n (index n/N) that moved from `from` to `to`
-  double energy = 0;       // the energy after the move
+  double energy = 0;       // the objective after the move (E, plus period_weight · P when the periods are used)
   bool cancelled = false;  // `to` held −n: both vanished
 };
 
 struct RelaxResult {
   IndexPrescription prescription;  // the relaxed one (only its vertex indices differ from the start)
-  double energy_before = 0, energy_after = 0;
+  double energy_before = 0, energy_after = 0;  // the field's energy E (Connection::energy)
   std::vector<RelaxMove> moves;
-  std::vector<double> energies;  // energy_before, then after each move: strictly decreasing
+  std::vector<double> energies;  // the objective before, then after each move: strictly decreasing
+  bool periods_used = false;     // the objective had the period term (RelaxOptions::period_weight)
+  double periods_before = 0, periods_after = 0;  // P = Σ_C T_C² (0 when not used)
   int candidates_evaluated = 0;  // real solves of candidate moves
   bool converged = false;        // stopped because no candidate lowers the energy (not at max_moves or max_seconds)
   bool out_of_time = false;      // stopped at max_seconds
@@ -95,7 +115,8 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
                                              const Connection& connection, const RelaxOptions& options = {});
 
 // Relaxes `start` as above; throws trivcon::Error for an invalid prescription (as a design would), a pin out
-// of range, or a negative max_moves, cancel_distance or max_seconds. Polls trivcon/cancel.h once per candidate solve.
+// of range, a negative max_moves, cancel_distance, max_seconds or period_weight, or a reach below 1. Polls
+// trivcon/cancel.h once per candidate solve.
 RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start, const RelaxOptions& options = {});
 
 }  // namespace trivcon

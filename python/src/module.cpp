@@ -987,7 +987,7 @@ PYBIND11_MODULE(_core, m) {
              std::map<int, double> fixed, bool align_boundary, std::optional<double> feature_degrees,
              std::vector<std::pair<int, int>> feature_edges, std::vector<std::pair<int, double>> roots, double auto_cancel, bool auto_cancel_absolute, int auto_iterations,
              std::optional<double> curvature_t, bool split, int max_rounds, bool relax, std::vector<int> relax_pins, int relax_cancel,
-             int relax_max_moves, double map_edge_length, double map_target_faces) {
+             int relax_max_moves, int relax_reach, double relax_periods, double map_edge_length, double map_target_faces) {
             // The library's request layer (trivcon/request.h) does the work; here only the conversion.
             FieldRequest q;
             q.prescription.N = N;
@@ -1017,6 +1017,8 @@ PYBIND11_MODULE(_core, m) {
             q.relax_options.pins = std::move(relax_pins);
             q.relax_options.cancel_distance = relax_cancel;
             q.relax_options.max_moves = relax_max_moves;
+            q.relax_options.reach = relax_reach;
+            q.relax_options.period_weight = relax_periods;
             struct Out {
               DesignerPtr designer;
               DesignResultPtr result;
@@ -1086,6 +1088,8 @@ PYBIND11_MODULE(_core, m) {
               py::dict d;
               d["vertex"] = x.prescription.vertex;
               d["energy_before"] = x.energy_before, d["energy_after"] = x.energy_after;
+              d["periods_before"] = x.periods_used ? py::object(py::float_(x.periods_before)) : py::object(py::none());
+              d["periods_after"] = x.periods_used ? py::object(py::float_(x.periods_after)) : py::object(py::none());
               d["energies"] = py::array_t<double>(static_cast<py::ssize_t>(x.energies.size()), x.energies.data());
               d["from"] = int64_vector(from), d["to"] = int64_vector(to), d["index"] = int64_vector(n);
               d["cancelled"] = py::array_t<bool>(py::cast(cancelled));
@@ -1098,7 +1102,7 @@ PYBIND11_MODULE(_core, m) {
           py::arg("feature_degrees"), py::arg("feature_edges"), py::arg("roots"), py::arg("auto_cancel"), py::arg("auto_cancel_absolute"),
           py::arg("auto_iterations"), py::arg("curvature_t"), py::arg("split"), py::arg("max_rounds"), py::arg("relax") = false,
           py::arg("relax_pins") = std::vector<int>{}, py::arg("relax_cancel") = 0, py::arg("relax_max_moves") = 10000,
-          py::arg("map_edge_length") = 0.0, py::arg("map_target_faces") = 0.0,
+          py::arg("relax_reach") = 1, py::arg("relax_periods") = 0.0, py::arg("map_edge_length") = 0.0, py::arg("map_target_faces") = 0.0,
           "One field request (trivcon/request.h; vertex None: the smoothest field's singularities, chosen for a map at the given "
           "scale as the map commands do when one is > 0, cancel_for_map): (designer of the final mesh, "
           "DesignResult, AutoResult or None, parent face of each face (with split), rounds, converged, sharp edges, relaxation "

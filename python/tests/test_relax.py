@@ -107,3 +107,57 @@ def test_same_as_the_program(cli, tmp_path):
     assert [m["from"] for m in j["moves"]] == r.moves["from"].tolist()
     assert [m["to"] for m in j["moves"]] == r.moves["to"].tolist()
     assert j["energy_after"] == pytest.approx(r.energy_after, rel=1e-12, abs=1e-15)
+
+
+def annulus_with_a_pair():
+    """An annulus with both boundaries aligned (two loops, so two components of fixed faces) and a +1/4, -1/4
+    pair off-centre: the periods of the conformal scale around the loops are not 0."""
+    V, F = trivcon.make_annulus(10, 48)
+    interior = np.ones(len(V), bool)
+    edges = {}
+    for a, b, c in F:
+        for x, y in ((a, b), (b, c), (c, a)):
+            key = (min(x, y), max(x, y))
+            edges[key] = edges.get(key, 0) + 1
+    for (x, y), n in edges.items():
+        if n == 1:
+            interior[x] = interior[y] = False
+    ids = np.flatnonzero(interior)
+    plus = int(ids[np.argmin(np.linalg.norm(V[ids] - [0.62, 0.25, 0], axis=1))])
+    minus = int(ids[np.argmin(np.linalg.norm(V[ids] - [0.85, -0.2, 0], axis=1))])
+    return V, F, {plus: "1/4", minus: "-1/4"}
+
+
+def test_periods_and_reach(cli, tmp_path):
+    V, F, sings = annulus_with_a_pair()
+    d = trivcon.FieldDesigner(V, F)
+    plain = d.relax(sings, N=4, align_boundary=True)
+    assert plain.periods_before is None and plain.periods_after is None
+    r = d.relax(sings, N=4, align_boundary=True, reach=3, period_weight=1.0)
+    assert r.periods_before > 1e-6 and r.periods_after < r.periods_before
+    assert r.energies[0] == pytest.approx(r.energy_before + r.periods_before, rel=1e-12)
+    assert r.energies[-1] == pytest.approx(r.energy_after + r.periods_after, rel=1e-12)
+    assert np.all(np.diff(r.energies) < 0)
+    # The program relaxes the same way and reports the periods.
+    mesh = tmp_path / "annulus.obj"
+    trivcon.write_mesh(str(mesh), V, F)
+    report = tmp_path / "r.json"
+    args = ["solve", mesh, "-N", "4", "--align-boundary", "--relax", "--relax-reach", "3", "--relax-periods", "1", "--report", report]
+    for v, k in sings.items():
+        args += ["--sing", f"{v}:{k}"]
+    out = cli(*args)
+    j = json.loads(report.read_text())["relax"]
+    assert [m["to"] for m in j["moves"]] == r.moves["to"].tolist()
+    assert j["periods_after"] == pytest.approx(r.periods_after, rel=1e-9, abs=1e-12)
+    assert "periods " in out.stdout
+
+
+def test_reach_and_periods_errors_are_named():
+    V, F, sings = annulus_with_a_pair()
+    d = trivcon.FieldDesigner(V, F)
+    with pytest.raises(trivcon.Error, match="relax_reach must be a whole number >= 1, not 0"):
+        d.relax(sings, N=4, align_boundary=True, reach=0)
+    with pytest.raises(trivcon.Error, match="relax_periods must be a number >= 0, not -1"):
+        d.relax(sings, N=4, align_boundary=True, period_weight=-1)
+    with pytest.raises(trivcon.Error, match="need relax=True"):
+        d.solve(4, sings, align_boundary=True, relax_reach=2)

@@ -826,7 +826,7 @@ class FieldDesigner(_Cached):
     def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False,
               align_features=None, feature_edges=None, roots=None, auto_cancel=0.0, align_curvature=None,
               split_large_turns=False, max_rounds=8, relax=False, relax_pins=None, relax_cancel=0, relax_max_moves=10000,
-              map_target_faces=None, map_edge_length=None):
+              relax_reach=1, relax_periods=0.0, map_target_faces=None, map_edge_length=None):
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
@@ -855,7 +855,11 @@ class FieldDesigner(_Cached):
           trivcon/relax.h): indices per component kept, boundary vertices never singular; relax_pins: vertices
           that keep their index (none moves away or onto them); relax_cancel: an index may also move onto an
           opposite one at most this many edges away, both vanishing (0: never); relax_max_moves: accepted
-          moves at most. Result.relax is then a RelaxResult (energies, moves); the field is the relaxed one.
+          moves at most; relax_reach: a singularity may move to a free vertex at most this many edges away in
+          one move (1: steps; more passes rises that steps stop at, as --relax-reach); relax_periods: W > 0 lowers
+          the energy plus W times the squared periods of the conformal scale around the fixed faces' components
+          instead (as --relax-periods; docs/solver.md, "Periods"). Result.relax is then a RelaxResult (energies,
+          moves); the field is the relaxed one.
 
         split_large_turns: refine the mesh where the connection turns by pi/N or more and solve again
           with the same vertex singularities, at most max_rounds times, until no edge does (trivcon
@@ -929,8 +933,13 @@ class FieldDesigner(_Cached):
         for name, value in (("relax_cancel", relax_cancel), ("relax_max_moves", relax_max_moves)):
             if isinstance(value, bool) or not isinstance(value, _numbers.Integral) or value < 0:
                 raise Error(f"{name} must be a whole number >= 0, not {value!r}")
-        if not relax and (pins or relax_cancel or relax_max_moves != 10000):
-            raise Error("relax_pins, relax_cancel and relax_max_moves need relax=True")
+        if isinstance(relax_reach, bool) or not isinstance(relax_reach, _numbers.Integral) or relax_reach < 1:
+            raise Error(f"relax_reach must be a whole number >= 1, not {relax_reach!r}")
+        if (isinstance(relax_periods, bool) or not isinstance(relax_periods, _numbers.Real) or not _math.isfinite(relax_periods)
+                or relax_periods < 0):
+            raise Error(f"relax_periods must be a number >= 0, not {relax_periods!r}")
+        if not relax and (pins or relax_cancel or relax_max_moves != 10000 or relax_reach != 1 or relax_periods):
+            raise Error("relax_pins, relax_cancel, relax_max_moves, relax_reach and relax_periods need relax=True")
         map_scale = [0.0, 0.0]  # edge length, target faces
         for k, (name, value) in enumerate((("map_edge_length", map_edge_length), ("map_target_faces", map_target_faces))):
             if value is None:
@@ -945,7 +954,8 @@ class FieldDesigner(_Cached):
         core, r, a, parent, rounds, converged, sharp, relaxed = self._d.solve_request(
             N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), explicit, bool(align_boundary),
             degrees, edge_pairs, root_list, cancel, False, 8, curvature_t, bool(split_large_turns), int(max_rounds),
-            bool(relax), pins, int(relax_cancel), int(relax_max_moves), map_scale[0], map_scale[1])
+            bool(relax), pins, int(relax_cancel), int(relax_max_moves), int(relax_reach), float(relax_periods), map_scale[0],
+            map_scale[1])
         auto = AutoResult(a, self) if a is not None else None
         designer = self if core is self._d else FieldDesigner._of_core(core, self)
         result = Result(designer, r, auto)
@@ -979,17 +989,18 @@ class FieldDesigner(_Cached):
                                                      curvature_t is not None, curvature_t or 0.0), self)
 
     def relax(self, singularities, N=1, pins=None, max_moves=10000, cancel_distance=0, generators=None, boundary=None, fixed=None,
-              align_boundary=False, align_features=None, feature_edges=None, auto_cancel=0.0):
+              align_boundary=False, align_features=None, feature_edges=None, auto_cancel=0.0, reach=1, period_weight=0.0):
         """Singularities moved downhill in the field's own energy (trivcon/relax.h): a RelaxResult.
 
-        singularities: as in solve (or "auto", with auto_cancel); pins, max_moves, cancel_distance: see solve's
-        relax_pins, relax_max_moves, relax_cancel; generators, boundary, fixed, align_boundary, align_features,
+        singularities: as in solve (or "auto", with auto_cancel); pins, max_moves, cancel_distance, reach,
+        period_weight: see solve's relax_pins, relax_max_moves, relax_cancel, relax_reach, relax_periods; generators, boundary, fixed, align_boundary, align_features,
         feature_edges as in solve. RelaxResult.singularities go straight into solve; RelaxResult.result is the
         field of the relaxed placement, already solved.
         """
         result = self.solve(N, singularities, generators=generators, boundary=boundary, fixed=fixed, align_boundary=align_boundary,
                             align_features=align_features, feature_edges=feature_edges, auto_cancel=auto_cancel, relax=True,
-                            relax_pins=pins, relax_cancel=cancel_distance, relax_max_moves=max_moves)
+                            relax_pins=pins, relax_cancel=cancel_distance, relax_max_moves=max_moves, relax_reach=reach,
+                            relax_periods=period_weight)
         result.relax.result = result
         return result.relax
 
@@ -1366,7 +1377,10 @@ class RelaxResult:
       singularities  {vertex: Fraction}: the relaxed placement (goes straight into solve(singularities=...));
                      singularity_arrays the same as (vertices, numerators) int64 arrays
       energy_before, energy_after   the field's energy (sum of x^2 / w) at the start and at the end
-      energies       float64 (k + 1,): energy_before, then after each move, strictly decreasing
+      periods_before, periods_after  with relax_periods / period_weight W > 0: the sum of the squared periods
+                     P at the start and at the end (None without)
+      energies       float64 (k + 1,): the objective (the energy, plus W P with the periods) before, then
+                     after each move, strictly decreasing
       moves          dict of arrays, one entry per accepted move in order: "from", "to" (int64 vertices),
                      "index" (int64 n of the index n / N moved), "energy" (float64, after it), "cancelled"
                      (bool: "to" held the opposite index and both vanished)
@@ -1379,6 +1393,7 @@ class RelaxResult:
         self.N = N
         self._vertex = {int(k): int(v) for k, v in d["vertex"].items()}
         self.energy_before, self.energy_after = d["energy_before"], d["energy_after"]
+        self.periods_before, self.periods_after = d.get("periods_before"), d.get("periods_after")
         self.energies = _frozen(_np.asarray(d["energies"], dtype=_np.float64))
         self.moves = {"from": _frozen(d["from"]), "to": _frozen(d["to"]), "index": _frozen(d["index"]),
                       "energy": _frozen(_np.asarray(d["energies"], dtype=_np.float64)[1:].copy()),

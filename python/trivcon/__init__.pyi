@@ -155,6 +155,8 @@ class FieldDesigner:
         relax_pins: Optional[npt.ArrayLike] = ...,
         relax_cancel: int = ...,
         relax_max_moves: int = ...,
+        relax_reach: int = ...,
+        relax_periods: float = ...,
         map_target_faces: Optional[float] = ...,
         map_edge_length: Optional[float] = ...,
     ) -> Result: ...
@@ -172,6 +174,8 @@ class FieldDesigner:
         align_features: Optional[float] = ...,
         feature_edges: Optional[npt.ArrayLike] = ...,
         auto_cancel: float = ...,
+        reach: int = ...,
+        period_weight: float = ...,
     ) -> RelaxResult: ...
     def auto_singularities(
         self,
@@ -342,6 +346,8 @@ class RelaxResult:
     N: int
     energy_before: float
     energy_after: float
+    periods_before: Optional[float]
+    periods_after: Optional[float]
     energies: _FloatArray
     moves: Dict[str, npt.NDArray[Any]]
     candidates_evaluated: int

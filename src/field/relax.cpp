@@ -27,6 +27,8 @@ constexpr double kBoundMargin = 1e-9;
 std::vector<char> pinned_vertices(const Topology& t, const RelaxOptions& options) {
   if (options.max_moves < 0) throw Error("relax: max_moves must be at least 0, not " + std::to_string(options.max_moves));
   if (options.cancel_distance < 0) throw Error("relax: cancel_distance must be at least 0, not " + std::to_string(options.cancel_distance));
+  if (options.reach < 1) throw Error("relax: reach must be at least 1, not " + std::to_string(options.reach));
+  if (!(options.period_weight >= 0) || !std::isfinite(options.period_weight)) throw Error("relax: period_weight must be a finite number of at least 0");
   if (!(options.max_seconds >= 0)) throw Error("relax: max_seconds must be at least 0");
   if (!(options.separation >= 0) || !std::isfinite(options.separation)) throw Error("relax: separation must be a finite distance of at least 0");
   std::vector<char> pinned(t.num_vertices, 0);
@@ -56,10 +58,104 @@ void apply(const RelaxCandidate& move, IndexPrescription& p) {
     p.vertex[move.to] = move.index;
 }
 
+// The period term of the objective (trivcon/relax.h, "Periods").
+struct Periods {
+  double weight = 0;
+  std::vector<std::vector<int>> components;  // fixed faces, connected through shared vertices
+  std::vector<Eigen::VectorXd> sensitivity;  // ∂T_C/∂b per vertex (0 where a vertex has no row)
+
+  bool used() const { return !components.empty(); }
+
+  // T_C of a connection.
+  std::vector<double> values(const FieldDesigner& designer, const Connection& connection) const {
+    const Topology& t = designer.topology();
+    const Eigen::VectorXd& w = designer.solver().weights();
+    std::vector<double> out;
+    for (const std::vector<int>& faces : components) {
+      double sum = 0;
+      for (int f : faces)
+        for (int k = 0; k < 3; ++k) {
+          const int e = t.face_edges(f, k);
+          if (w(e) > 0) sum += (t.edge_faces(e, 0) == f ? 1.0 : -1.0) * connection.x(e) / w(e);
+        }
+      out.push_back(sum);
+    }
+    return out;
+  }
+  double penalty(const std::vector<double>& T) const {
+    double p = 0;
+    for (double x : T) p += x * x;
+    return p;
+  }
+  // The change of P when c moves from v to u, with the cycle indices held (exact then).
+  double change(const std::vector<double>& T, int v, int u, double c) const {
+    double d = 0;
+    for (size_t k = 0; k < T.size(); ++k) {
+      const double dT = c * (sensitivity[k](v) - sensitivity[k](u));
+      d += 2 * T[k] * dT + dT * dT;
+    }
+    return d;
+  }
+};
+
+Periods make_periods(const FieldDesigner& designer, double weight) {
+  Periods p;
+  if (!(weight > 0)) return p;
+  const Topology& t = designer.topology();
+  const ConnectionSolver& solver = designer.solver();
+  const std::vector<int>& fixed = solver.fixed_faces();
+  // Components through shared vertices (union-find over the vertices of fixed faces).
+  std::vector<int> parent(t.num_vertices, -1);
+  auto find = [&](int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (int f : fixed)
+    for (int k = 0; k < 3; ++k)
+      if (parent[t.F(f, k)] < 0) parent[t.F(f, k)] = t.F(f, k);
+  for (int f : fixed)
+    for (int k = 1; k < 3; ++k) parent[find(t.F(f, k))] = find(t.F(f, 0));
+  std::map<int, int> component_of_root;
+  for (int f : fixed) {
+    const auto [it, added] = component_of_root.emplace(find(t.F(f, 0)), static_cast<int>(p.components.size()));
+    if (added) p.components.emplace_back();
+    p.components[it->second].push_back(f);
+  }
+  if (p.components.size() < 2 ||
+      static_cast<double>(p.components.size()) * t.num_vertices > kMaxPeriodValues) {
+    p.components.clear();
+    return p;
+  }
+  p.weight = weight;
+  const Eigen::VectorXd& w = solver.weights();
+  Connection sigma;
+  sigma.N = 1;
+  for (const std::vector<int>& faces : p.components) {
+    sigma.x = Eigen::VectorXd::Zero(t.num_edges);
+    for (int f : faces)
+      for (int k = 0; k < 3; ++k) {
+        const int e = t.face_edges(f, k);
+        if (w(e) > 0) sigma.x(e) += t.edge_faces(e, 0) == f ? 1.0 : -1.0;
+      }
+    p.sensitivity.push_back(solver.vertex_duals(sigma));
+  }
+  return p;
+}
+
+std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const IndexPrescription& prescription,
+                                          const Connection& connection, const RelaxOptions& options, const Periods& periods);
+
 }  // namespace
 
 std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, const IndexPrescription& prescription,
                                              const Connection& connection, const RelaxOptions& options) {
+  return candidates_of(designer, prescription, connection, options, make_periods(designer, options.period_weight));
+}
+
+namespace {
+
+std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const IndexPrescription& prescription,
+                                          const Connection& connection, const RelaxOptions& options, const Periods& periods) {
   const Topology& t = designer.topology();
   const std::vector<char> pinned = pinned_vertices(t, options);
   const ConnectionSolver& solver = designer.solver();
@@ -79,6 +175,7 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
   for (const FixedPath& path : solver.fixed_paths())
     for (int e : path.path.edges) free_cycle_edge[e] = 1;
   const double step = 2 * kPi / prescription.N;
+  const std::vector<double> T = periods.used() ? periods.values(designer, connection) : std::vector<double>{};
   std::vector<RelaxCandidate> out;
   auto add = [&](int v, int u, int n, int distance, bool cancels, int edge) {
     const double c = step * n;
@@ -99,6 +196,10 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
       const double conductance = direct + (rest_v > 0 && rest_u > 0 ? 1 / (1 / rest_v + 1 / rest_u) : 0.0);
       if (conductance > 0) m.lower_bound += c * c / conductance;
     }
+    if (periods.used()) {  // the period term's change, exact with the cycle indices held
+      const double dP = periods.weight * periods.change(T, v, u, c);
+      m.first_order += dP, m.estimate += dP, m.lower_bound += dP;
+    }
     out.push_back(m);
   };
   auto other_end = [&](int e, int v) { return t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0); };
@@ -114,7 +215,7 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
     });
     return found;
   };
-  std::vector<int> seen(t.num_vertices, -1), frontier, next;
+  std::vector<int> seen(t.num_vertices, -1), reached(options.reach > 1 ? t.num_vertices : 0, -1), frontier, next;
   for (auto [v, n] : prescription.vertex) {
     if (n == 0 || pinned[v] == 1) continue;
     const double room = options.separation > 0 ? nearest_other(v, v) : 0.0;
@@ -124,6 +225,26 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
       // Not closer to another singularity than the separation, unless it was closer still.
       if (options.separation > 0 && nearest_other(u, v) < std::min(room, options.separation)) continue;
       add(v, u, n, 1, false, e);
+    }
+    // With a reach: the vertices 2 to `reach` edges away too (a jump over a rise of the objective that steps
+    // would not cross).
+    if (options.reach > 1) {
+      reached[v] = v;
+      frontier.assign(1, v);
+      for (int distance = 1; distance <= options.reach && !frontier.empty(); ++distance) {
+        next.clear();
+        for (int x : frontier)
+          for (int a = t.vertex_edge_offsets[x]; a < t.vertex_edge_offsets[x + 1]; ++a) {
+            const int u = other_end(t.vertex_edges[a], x);
+            if (reached[u] == v) continue;
+            reached[u] = v;
+            next.push_back(u);
+            if (distance < 2 || !t.is_interior_vertex(u) || pinned[u] || index_at(prescription, u) != 0) continue;
+            if (options.separation > 0 && nearest_other(u, v) < std::min(room, options.separation)) continue;
+            add(v, u, n, distance, false, -1);
+          }
+        frontier.swap(next);
+      }
     }
     if (options.cancel_distance == 0) continue;
     // Breadth-first to cancel_distance edges, for the vertices holding −n (each pair once, from its smaller vertex).
@@ -149,6 +270,8 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
   return out;
 }
 
+}  // namespace
+
 RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start, const RelaxOptions& options) {
   const auto t0 = linalg::Clock::now();
   pinned_vertices(designer.topology(), options);  // checks the options before the first solve
@@ -156,9 +279,19 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
   const double step = 2 * kPi / start.N;
   RelaxResult r;
   r.prescription = start;
+  const Periods periods = make_periods(designer, options.period_weight);
+  r.periods_used = periods.used();
+  // The objective: E, plus weight · P with the periods.
+  auto objective = [&](const Connection& c, double* P = nullptr) {
+    if (!periods.used()) return c.energy;
+    const double p = periods.penalty(periods.values(designer, c));
+    if (P) *P = p;
+    return c.energy + periods.weight * p;
+  };
   Connection current = solver.solve(start);
+  double current_objective = objective(current, &r.periods_before);
   r.energy_before = current.energy;
-  r.energies.push_back(current.energy);
+  r.energies.push_back(current_objective);
   // The second-order term of a move, measured by its real solve: (ΔE − first order) / c². With the cycle
   // indices held it is R_vu exactly, a property of the mesh and not of the placement, so a move solved once is
   // ranked exactly ever after (keyed by its unordered pair of vertices; a cancellation has its own entry).
@@ -177,7 +310,7 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
   bool held = solver.fixed_paths().empty();
   for (int g = 0; g < static_cast<int>(cycles.generators.size()); ++g) held = held && start.generator.count(g);
   while (static_cast<int>(r.moves.size()) < options.max_moves) {
-    std::vector<RelaxCandidate> candidates = relax_candidates(designer, r.prescription, current, options);
+    std::vector<RelaxCandidate> candidates = candidates_of(designer, r.prescription, current, options, periods);
     for (RelaxCandidate& m : candidates)
       if (const auto it = measured.find(key(m)); it != measured.end()) {
         const double c = step * m.index;
@@ -194,7 +327,7 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
         const double c = step * move.index;
         const auto it = measured.find(key(move));
         const double lowest = it != measured.end() ? move.first_order + c * c * it->second : move.lower_bound;
-        if (lowest > kBoundMargin * std::abs(current.energy)) continue;  // cannot lower E
+        if (lowest > kBoundMargin * std::abs(current_objective)) continue;  // cannot lower the objective
       } else if (!checking && !(move.estimate < 0) && measured.count(key(move))) {
         continue;
       }
@@ -206,9 +339,10 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
       IndexPrescription p = r.prescription;
       apply(move, p);
       Connection next = solver.solve(p);
+      const double next_objective = objective(next);
       ++r.candidates_evaluated;
       const double c = step * move.index;
-      const double second = std::max(0.0, (next.energy - current.energy - move.first_order) / (c * c));
+      const double second = std::max(0.0, (next_objective - current_objective - move.first_order) / (c * c));
       if (!measured.count(key(move)) && move.estimate > move.first_order) {  // R̃ (as scaled) against R
         ratios.push_back(scale * second * c * c / (move.estimate - move.first_order));
         if (ratios.size() >= 8) {
@@ -218,11 +352,12 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
         }
       }
       measured[key(move)] = second;
-      if (!(next.energy < current.energy - kRelativeDecrease * std::abs(current.energy))) continue;
+      if (!(next_objective < current_objective - kRelativeDecrease * std::abs(current_objective))) continue;
       r.prescription = std::move(p);
       current = std::move(next);
-      r.moves.push_back({move.from, move.to, move.index, current.energy, move.cancels});
-      r.energies.push_back(current.energy);
+      current_objective = next_objective;
+      r.moves.push_back({move.from, move.to, move.index, current_objective, move.cancels});
+      r.energies.push_back(current_objective);
       moved = true;
       break;
     }
@@ -237,6 +372,7 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
     }
   }
   r.energy_after = current.energy;
+  objective(current, &r.periods_after);
   r.seconds = linalg::seconds_since(t0);
   return r;
 }
