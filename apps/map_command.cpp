@@ -49,6 +49,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   run.param = std::move(made.param);
   run.placements = made.placements, run.cancel_units = made.cancel_units, run.first_problems = made.first_problems;
   run.first_distortion = made.first_distortion, run.relaxed = made.relaxed;
+  run.relaxed_periods = made.periods;
   run.quads = std::move(made.quads);
   return run;
 }
@@ -92,6 +93,7 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
     report["placement"] = {{"placements", run.placements},
                            {"cancel_units", run.cancel_units},
                            {"relaxed", run.relaxed},
+                           {"periods", run.relaxed_periods},
                            {"first_problems", run.first_problems},
                            {"first_distortion", run.first_distortion}};
   for (size_t i = 0; i < param.cones.size(); ++i)
@@ -108,7 +110,7 @@ std::string placement_line(const MapRun& run) {
        << " and a mean distortion of " << std::setprecision(3) << run.first_distortion << " (goal " << kMapDistortionGoal << "); placed again "
        << run.placements - 1 << " time(s), relaxed or with opposite pairs cancelled further apart; kept: ";
   if (run.cancel_units > 1) line << (run.relaxed ? "relaxed, " : "") << "pairs cancelled within " << static_cast<int>(run.cancel_units) << " units";
-  else line << (run.relaxed ? "the singularities found, relaxed" : "the first");
+  else line << (run.relaxed ? (run.relaxed_periods ? "the singularities found, relaxed with the periods" : "the singularities found, relaxed") : "the first");
   line << "\n";
   return line.str();
 }

@@ -44,13 +44,14 @@ struct MapRun {
   int first_problems = 0;
   double first_distortion = 0;
   bool relaxed = false;
+  bool relaxed_periods = false;  // relaxed with the periods (MapOutcome::periods)
   std::optional<QuadMesh> quads;  // run_map(…, true): the kept map's quad mesh
   const RepairedMesh* repaired() const { return loaded.repaired(); }
 };
 
 // Reads the mesh (repaired unless --no-repair), solves the request and makes the map (map_request: with --auto,
 // ± pairs within one unit of the map cancel unless --auto-cancel says otherwise; a map that folds or stretches
-// beyond the goal is made again, relaxed, then with pairs cancelled within 2 or 4). Throws trivcon::Error, also
+// beyond the goal is made again, relaxed, relaxed with the periods, then with pairs cancelled within 2 or 4). Throws trivcon::Error, also
 // when the field does not pass verification.
 // With `quads`, the quad mesh too, and a map whose quad mesh fails a check counts as one that folds.
 MapRun run_map(const MapCommand& command, bool quads = false);

@@ -133,19 +133,25 @@ struct MapOutcome {
   int first_problems = 0;  // the first attempt's problems (below), when it was placed again
   double first_distortion = 0;  // the first attempt's mean singular-value ratio, when it was placed again
   bool relaxed = false;    // the kept placement was relaxed by map_request (not by the request's own relax)
+  bool periods = false;    // and with the periods in the objective (kMapPeriodWeight)
   std::optional<QuadMesh> quads;  // with quads = true: the kept map's quad mesh (extract_quads)
 };
 // The mean singular-value ratio of a map (ParamQuality::mean_distortion) above which map_request places again.
 inline constexpr double kMapDistortionGoal = 1.5;
+// The weight of the periods (RelaxOptions::period_weight) in map_request's second relaxed attempt.
+inline constexpr double kMapPeriodWeight = 3;
+// The reach (RelaxOptions::reach) of map_request's relaxed attempts.
+inline constexpr int kMapRelaxReach = 3;
 // cancel_for_map, solve_request, and the map with request_param_options (and its quad mesh with `quads`). With
 // automatic placement and no cancel distance in the request, a map left with folded or degenerate faces or wrong
 // windings (or, with `quads`, whose quad mesh fails a check of check_quads), or stretched beyond
 // kMapDistortionGoal, is made again: from the same singularities relaxed (trivcon/relax.h; kept a unit from the
-// aligned edges and from each other), then from singularities whose ± pairs were cancelled within 2, then 4
+// aligned edges and from each other, with a reach of kMapRelaxReach edges), then relaxed with the periods (RelaxOptions::period_weight =
+// kMapPeriodWeight), then from singularities whose ± pairs were cancelled within 2, then 4
 // units (at a scale too coarse for the singularities found, a detailed scan at a thousand quads, fewer of them
 // give a map without folds), then those relaxed; with the request's own relax, every placement is relaxed. A
 // placement equal to an earlier one is not mapped again. The search ends at the first map without problems
-// within the goal, or without problems after the first relaxed one; the kept map is the one with the fewest
+// within the goal, or without problems once the placement found was mapped as found and relaxed both ways; the kept map is the one with the fewest
 // problems, then the least stretch beyond the goal (the earliest of equals). `request` is left as the kept one
 // was made.
 // Throws what solve_request and parametrize throw.

@@ -289,22 +289,24 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   };
   // The attempts: the placement found; the same relaxed (trivcon/relax.h: the field's energy is lower where
   // the singularities sit as the surface's curvature and the aligned lines ask, and a map of a field with less
-  // rotation stretches less); then with pairs cancelled within 2 and 4 units, then those relaxed. Neither kind
-  // wins everywhere: relaxed, a plate's −1/4 around round holes stop twisting the map, while a coarse scan's
-  // fold more (docs/param.md; BENCHMARKS.md).
+  // rotation stretches less); the same relaxed with the periods of the conformal scale around the aligned lines
+  // in the objective (a map must stretch by e^|T| around a loop of period T; with aligned lines only); then with
+  // pairs cancelled within 2 and 4 units, then those relaxed. Neither kind wins everywhere: relaxed, a plate's
+  // −1/4 around round holes stop twisting the map, while a coarse scan's fold more (docs/param.md; BENCHMARKS.md).
   struct Attempt {
     double units;
     bool relax;
+    bool periods;
   };
-  std::vector<Attempt> attempts{{1.0, request.relax}};
+  std::vector<Attempt> attempts{{1.0, request.relax, false}};
   if (escalate) {
-    for (bool relax : {false, true})
-      for (double units : {1.0, 2.0, 4.0})
-        if ((units > 1 || relax) && !(relax && request.relax)) attempts.push_back({units, relax || request.relax});
-    std::stable_sort(attempts.begin() + 1, attempts.end(), [](const Attempt& a, const Attempt& b) {
-      return (a.units == 1) > (b.units == 1);  // the same singularities relaxed first
-    });
+    if (!request.relax) attempts.push_back({1.0, true, false}), attempts.push_back({1.0, true, true});
+    for (double units : {2.0, 4.0}) attempts.push_back({units, request.relax, false});
+    if (!request.relax)
+      for (double units : {2.0, 4.0}) attempts.push_back({units, true, false});
   }
+  // The attempts from the placement found (the first ones).
+  const int same_placement = static_cast<int>(std::count_if(attempts.begin(), attempts.end(), [](const Attempt& a) { return a.units == 1; }));
   MapOutcome best;
   FieldRequest kept = request;
   int tried = 0, kept_at = 0, maps = 0;
@@ -320,6 +322,9 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
       r.relax_options.avoid = vertices_near_edges(designer, aligned, unit);
       // and a unit from each other: two closer than that can be rounded onto one integer point.
       r.relax_options.separation = unit;
+      if (attempt.periods) r.relax_options.period_weight = kMapPeriodWeight;
+      // and a singularity may jump up to kMapRelaxReach edges: steps alone stop in a crowd along the aligned lines.
+      r.relax_options.reach = std::max(r.relax_options.reach, kMapRelaxReach);
     }
     MapOutcome m;
     m.field = solve_request(designer, F, r);
@@ -340,6 +345,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     if (quads) m.quads = extract_quads(m.field.designer(designer), m.param);
     m.cancel_units = escalate ? attempt.units : 0.0;
     m.relaxed = attempt.relax && !request.relax;
+    m.periods = attempt.periods;
     if (tried == 1 || better(m, best)) {
       const int first = tried == 1 ? problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
@@ -347,8 +353,9 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
       best.first_problems = first, best.first_distortion = first_distortion;
       kept = r, kept_at = tried;
     }
-    // Past the goal only the first placement is relaxed: after that a map without problems ends the search.
-    if (problems(best) == 0 && (stretch(best) == 0 || maps > 1)) break;
+    // Past the goal only the first placement is relaxed: once its attempts are made, a map without problems ends
+    // the search.
+    if (problems(best) == 0 && (stretch(best) == 0 || tried >= same_placement)) break;
   }
   // The designer holds the last attempt's set-up (fixed faces turned for singularities moved onto features): the
   // kept one is solved again, which gives the same design, so that the designer is the kept field's.
