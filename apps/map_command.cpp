@@ -42,6 +42,13 @@ MapRun run_map(const MapCommand& o, bool quads) {
   run.designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F, o.field.solver_options());
   run.request = o.field.request(*run.designer, run.repaired());
   run.request.uniform_size = o.uniform_size;
+  // Quads end on a boundary only where it lies on integer iso-lines (docs/quad.md, "Boundaries"): with --auto
+  // (the placement is trivcon's, so it can count the boundary's turning) `quad` aligns the boundary unasked.
+  if (quads && run.request.auto_place && !run.request.align_boundary && !run.designer->topology().boundary_loops.empty()) {
+    run.request.align_boundary = true;
+    run.boundary_aligned_unasked = true;
+    if (!o.quiet) std::cout << "boundary: aligned (quads end on it; --auto aligns every boundary loop for quad)\n";
+  }
   MapOutcome made = map_request(*run.designer, mesh.F, run.request, o.edge_length, o.target_faces, quads);
   run.out = std::move(made.field);
   if (!run.out.verified)
@@ -76,6 +83,7 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                                    {"components", t.components.size()},
                                    {"euler_characteristic", t.euler_characteristic()},
                                    {"boundary_loops", t.boundary_loops.size()},
+                                   {"align_boundary", run.request.align_boundary},
                                    {"N", 4},
                                    {"singularities", nlohmann::ordered_json::array()},
                                    {"field", {{"verified", run.out.verified}, {"energy", run.out.design.connection.energy}}},

@@ -45,6 +45,7 @@ struct MapRun {
   double first_distortion = 0;
   bool relaxed = false;
   bool relaxed_periods = false;  // relaxed with the periods (MapOutcome::periods)
+  bool boundary_aligned_unasked = false;  // quad --auto aligned the boundary without --align-boundary
   std::optional<QuadMesh> quads;  // run_map(…, true): the kept map's quad mesh
   const RepairedMesh* repaired() const { return loaded.repaired(); }
 };
@@ -53,7 +54,8 @@ struct MapRun {
 // ± pairs within one unit of the map cancel unless --auto-cancel says otherwise; a map that folds or stretches
 // beyond the goal is made again, relaxed, relaxed with the periods, then with pairs cancelled within 2 or 4). Throws trivcon::Error, also
 // when the field does not pass verification.
-// With `quads`, the quad mesh too, and a map whose quad mesh fails a check counts as one that folds.
+// With `quads`, the quad mesh too, and a map whose quad mesh fails a check counts as one that folds; with --auto
+// the boundary is then aligned even without --align-boundary (quads end on it only so).
 MapRun run_map(const MapCommand& command, bool quads = false);
 
 // The map as `param -o` writes it: the input file's mesh (repaired or not) with one vt per corner.

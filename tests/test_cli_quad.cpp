@@ -204,14 +204,17 @@ TEST(CliQuad, BunnyAt1000QuadsIsPlacedAgainWhenAQuadTurnsOver) {
 // around a hole): the smoothest field's −1/4 (four on each hole's axes) twist the map (dozens of folds, mean
 // singular-value ratio 2.7); `quad` relaxes them, a unit away from the holes and from each other, up to three edges a
 // move, to the holes' diagonals, and the map is clean and within the goal (by single steps they crowded along the
-// holes and the map folded).
+// holes and the map folded). The boundary is aligned without being asked.
 TEST(CliQuad, PlateWith27HolesIsRelaxedUntilTheMapIsClean) {
   const Mesh plate = perforated_plate(9, 3, 8, 6, 0.15);
   const std::string mesh = mesh_file(plate, "plate27.obj"), out = temp_file("q.obj"), report = temp_file("r.json");
-  const auto r = run_cli("quad " + mesh + " --auto --align-boundary --target-faces 1000 -o " + out + " --report " + report);
+  // No --align-boundary: with --auto, quad aligns the boundary unasked (quads end on it only so).
+  const auto r = run_cli("quad " + mesh + " --auto --target-faces 1000 -o " + out + " --report " + report);
   ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("boundary: aligned"), std::string::npos) << r.out;
   const nlohmann::json j = nlohmann::json::parse(slurp(report));
   EXPECT_EQ(j["boundary_loops"], 28);
+  EXPECT_EQ(j["align_boundary"], true);
   EXPECT_NEAR(j["quad"]["quads"].get<double>(), 1000, 300);
   EXPECT_EQ(j["placement"]["relaxed"], true);
   EXPECT_GT(j["placement"]["first_problems"].get<int>(), 10);
