@@ -142,6 +142,9 @@ inline constexpr double kMapDistortionGoal = 1.5;
 inline constexpr double kMapPeriodWeight = 3;
 // The reach (RelaxOptions::reach) of map_request's relaxed attempts.
 inline constexpr int kMapRelaxReach = 3;
+// map_request does not relax a placement whose first attempt has more singularities than this (each move ranks
+// every singularity's candidates again).
+inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // cancel_for_map, solve_request, and the map with request_param_options (and its quad mesh with `quads`). With
 // automatic placement and no cancel distance in the request, a map left with folded or degenerate faces or wrong
 // windings (or, with `quads`, whose quad mesh fails a check of check_quads), or stretched beyond
@@ -150,7 +153,8 @@ inline constexpr int kMapRelaxReach = 3;
 // kMapPeriodWeight), then from singularities whose ± pairs were cancelled within 2, then 4
 // units (at a scale too coarse for the singularities found, a detailed scan at a thousand quads, fewer of them
 // give a map without folds), then those relaxed; with the request's own relax, every placement is relaxed. A
-// placement equal to an earlier one is not mapped again. The search ends at the first map without problems
+// placement equal to an earlier one is not mapped again, and none is relaxed when the first has more than
+// kMapRelaxMaxSingularities singularities. The search ends at the first map without problems
 // within the goal, or without problems once the placement found was mapped as found and relaxed both ways; the kept map is the one with the fewest
 // problems, then the least stretch beyond the goal (the earliest of equals). `request` is left as the kept one
 // was made.

@@ -310,8 +310,15 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   MapOutcome best;
   FieldRequest kept = request;
   int tried = 0, kept_at = 0, maps = 0;
+  size_t first_singularities = 0;  // the first placement's
   std::vector<std::map<int, int>> placed;  // each map's singularities
   for (const Attempt& attempt : attempts) {
+    // Each accepted move ranks every singularity's candidates again: past kMapRelaxMaxSingularities (cheese,
+    // genus 133: 1,412 −1/4) a relaxation takes minutes, so those placements are not relaxed here.
+    if (attempt.relax && !request.relax && first_singularities > kMapRelaxMaxSingularities) {
+      ++tried;
+      continue;
+    }
     FieldRequest r = request;
     if (escalate) r.auto_options.cancel_distance = attempt.units * unit;
     r.relax = attempt.relax;
@@ -336,6 +343,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
       }
       continue;
     }
+    if (tried == 1) first_singularities = m.field.prescription.vertex.size();
     // The same singularities as an earlier attempt (nothing closer than the new distance to cancel): the same map.
     if (std::find(placed.begin(), placed.end(), m.field.prescription.vertex) != placed.end()) continue;
     placed.push_back(m.field.prescription.vertex);
