@@ -1359,7 +1359,9 @@ class Result(_Cached):
         The map is made as by parametrize (same arguments), then its integer grid is extracted (trivcon/quad.h,
         docs/quad.md): the quads' irregular vertices are this field's singularities, valence 4 - n at index n/4.
         QuadMesh.quality has every guarantee checked on the result and QuadMesh.warning says what failed ("" when
-        nothing did); nothing is raised for a failed guarantee, so that the mesh can be looked at.
+        nothing did); nothing is raised for a failed guarantee, so that the mesh can be looked at. Quads end on a
+        boundary only where it is aligned: on a mesh with boundary, solve with align_boundary=True (as
+        `trivcon quad --auto` does unasked), or the quads along it are missing (reported).
         """
         return self.parametrize(target_faces, edge_length, align_boundary, aligned_edges, uniform_size).quads()
 
