@@ -365,9 +365,11 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     // the search.
     if (problems(best) == 0 && (stretch(best) == 0 || tried >= same_placement)) break;
   }
-  // The designer holds the last attempt's set-up (fixed faces turned for singularities moved onto features): the
-  // kept one is solved again, which gives the same design, so that the designer is the kept field's.
-  if (kept_at != tried) best.field = solve_request(designer, F, kept);
+  // The designer holds the last attempt's set-up (fixed faces turned for singularities moved onto features): it
+  // takes the kept field's fixed faces back, so that the designer is the kept field's (its design is kept as it
+  // was made; solving the kept request again would place and relax again for the same result).
+  if (kept_at != tried && designer.fixed_faces() != best.field.constraints.fixed_faces)
+    designer.set_fixed_faces(best.field.constraints.fixed_faces);
   best.placements = maps;
   if (maps == 1) best.first_problems = 0, best.first_distortion = 0;
   request = kept;
