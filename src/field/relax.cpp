@@ -215,7 +215,7 @@ std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const I
     });
     return found;
   };
-  std::vector<int> seen(t.num_vertices, -1), reached(options.reach > 1 ? t.num_vertices : 0, -1), frontier, next;
+  std::vector<int> seen(t.num_vertices, -1), frontier, next;
   for (auto [v, n] : prescription.vertex) {
     if (n == 0 || pinned[v] == 1) continue;
     const double room = options.separation > 0 ? nearest_other(v, v) : 0.0;
@@ -226,31 +226,14 @@ std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const I
       if (options.separation > 0 && nearest_other(u, v) < std::min(room, options.separation)) continue;
       add(v, u, n, 1, false, e);
     }
-    // With a reach: the vertices 2 to `reach` edges away too (a jump over a rise of the objective that steps
-    // would not cross).
-    if (options.reach > 1) {
-      reached[v] = v;
-      frontier.assign(1, v);
-      for (int distance = 1; distance <= options.reach && !frontier.empty(); ++distance) {
-        next.clear();
-        for (int x : frontier)
-          for (int a = t.vertex_edge_offsets[x]; a < t.vertex_edge_offsets[x + 1]; ++a) {
-            const int u = other_end(t.vertex_edges[a], x);
-            if (reached[u] == v) continue;
-            reached[u] = v;
-            next.push_back(u);
-            if (distance < 2 || !t.is_interior_vertex(u) || pinned[u] || index_at(prescription, u) != 0) continue;
-            if (options.separation > 0 && nearest_other(u, v) < std::min(room, options.separation)) continue;
-            add(v, u, n, distance, false, -1);
-          }
-        frontier.swap(next);
-      }
-    }
-    if (options.cancel_distance == 0) continue;
-    // Breadth-first to cancel_distance edges, for the vertices holding −n (each pair once, from its smaller vertex).
+    // Breadth-first to the farther of `reach` and cancel_distance edges: with a reach, the free vertices 2 to
+    // `reach` edges away too (a jump over a rise of the objective that steps would not cross); with a cancel
+    // distance, the vertices holding −n (each pair once, from its smaller vertex).
+    const int depth = std::max(options.reach > 1 ? options.reach : 0, options.cancel_distance);
+    if (depth == 0) continue;
     seen[v] = v;
     frontier.assign(1, v);
-    for (int distance = 1; distance <= options.cancel_distance && !frontier.empty(); ++distance) {
+    for (int distance = 1; distance <= depth && !frontier.empty(); ++distance) {
       next.clear();
       for (int x : frontier)
         for (int a = t.vertex_edge_offsets[x]; a < t.vertex_edge_offsets[x + 1]; ++a) {
@@ -258,7 +241,12 @@ std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const I
           if (seen[u] == v) continue;
           seen[u] = v;
           next.push_back(u);
-          if (u > v && !pinned[u] && index_at(prescription, u) == -n) add(v, u, n, distance, true, -1);
+          if (pinned[u]) continue;
+          const int held = index_at(prescription, u);
+          if (distance <= options.cancel_distance && u > v && held == -n) add(v, u, n, distance, true, -1);
+          if (distance >= 2 && distance <= options.reach && held == 0 && t.is_interior_vertex(u) &&
+              !(options.separation > 0 && nearest_other(u, v) < std::min(room, options.separation)))
+            add(v, u, n, distance, false, -1);
         }
       frontier.swap(next);
     }
