@@ -259,6 +259,76 @@ TEST(FeatureAlignment, NarrowCornersTurnByOneStep) {
   EXPECT_TRUE(lines.narrow.empty());
 }
 
+TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
+  // A flat 12×12 grid with a feature line across it at y = 1/2 and another from its middle up to y = 11/12:
+  // a T-junction of three sharp edges at (1/2, 1/2). A +1/4 one edge below the junction is moved onto it
+  // (move_singularities_onto_features): the half-plane below the line turns one step fewer, and the junction
+  // reads +1/4 in the exact field while every face beside the lines still follows them.
+  const int n = 12;
+  const Mesh m = make_holed_grid(n, 0);
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  auto at = [&](int x, int y) {
+    for (int v = 0; v < m.V.rows(); ++v)
+      if (std::abs(m.V(v, 0) * n - x) < 1e-9 && std::abs(m.V(v, 1) * n - y) < 1e-9) return v;
+    ADD_FAILURE() << "no vertex at " << x << ", " << y;
+    return -1;
+  };
+  auto edge_between = [&](int a, int b) {
+    for (int e = 0; e < t.num_edges; ++e)
+      if ((t.edge_vertices(e, 0) == a && t.edge_vertices(e, 1) == b) || (t.edge_vertices(e, 0) == b && t.edge_vertices(e, 1) == a)) return e;
+    ADD_FAILURE() << "no edge " << a << "-" << b;
+    return -1;
+  };
+  Solved s;
+  for (int x = 1; x + 2 < n; ++x) s.edges.push_back(edge_between(at(x, n / 2), at(x + 1, n / 2)));
+  for (int y = n / 2; y + 2 < n; ++y) s.edges.push_back(edge_between(at(n / 2, y), at(n / 2, y + 1)));
+  const int junction = at(n / 2, n / 2), below = at(n / 2, n / 2 - 1);
+  s.alignment = feature_alignment(m.V, t, designer.geometry(), s.edges, 4);
+  EXPECT_TRUE(s.alignment.narrow.empty());
+  std::map<int, int> vertex{{below, 1}};
+  move_singularities_onto_features(m.V, t, designer.geometry(), s.edges, 4, 1.5 / n, vertex, s.alignment);
+  EXPECT_EQ(vertex, (std::map<int, int>{{junction, 1}}));
+  ASSERT_EQ(s.alignment.snapped.size(), 1u);
+  const FeatureSnap& snap = s.alignment.snapped[0];
+  EXPECT_EQ(snap.from, below);
+  EXPECT_EQ(snap.to, junction);
+  EXPECT_NEAR(snap.distance, 1.0 / n, 1e-12);
+  // The sector turned is the half-plane below the line: every face of the junction's star there.
+  int star_below = 0;
+  for (int f = 0; f < t.num_faces; ++f) {
+    bool touches = false;
+    double cy = 0;
+    for (int k = 0; k < 3; ++k) touches = touches || t.F(f, k) == junction, cy += m.V(t.F(f, k), 1) / 3;
+    if (touches && cy < 0.5) ++star_below;
+  }
+  ASSERT_EQ(static_cast<int>(snap.faces.size()), star_below);
+  for (int f : snap.faces) {
+    double cy = 0;
+    for (int k = 0; k < 3; ++k) cy += m.V(t.F(f, k), 1) / 3;
+    EXPECT_LT(cy, 0.5) << "face " << f;
+  }
+  std::vector<int> faces;
+  for (auto [f, a] : s.alignment.fixed) faces.push_back(f);
+  designer.set_fixed_faces(faces);
+  IndexPrescription p;
+  p.N = 4;
+  p.fixed = s.alignment.fixed;
+  p.vertex = vertex;
+  s.singularities = vertex;
+  s.design = designer.design(p);
+  // The turned sector's inner faces follow neither line by design, like a narrow corner's.
+  s.alignment.narrow.push_back({junction, -1, -1, kPi, snap.faces});
+  expect_exact_and_aligned(designer, s);
+  // Beside a degree-2 vertex of the line only (the vertical line removed), the move is the same.
+  Solved line;
+  for (int x = 1; x + 2 < n; ++x) line.edges.push_back(edge_between(at(x, n / 2), at(x + 1, n / 2)));
+  line.alignment = feature_alignment(m.V, t, designer.geometry(), line.edges, 4);
+  std::map<int, int> alone{{below, -1}};
+  move_singularities_onto_features(m.V, t, designer.geometry(), line.edges, 4, 1.5 / n, alone, line.alignment);
+  EXPECT_EQ(alone, (std::map<int, int>{{junction, -1}}));
+}
+
 TEST(FeatureAlignment, CubeWithSingularitiesByHand) {
   // The corners, and also a +1/4 −1/4 pair inside a cube face: exact and aligned all the same.
   const Mesh m = make_cube_sphere(8, false);

@@ -216,7 +216,8 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
     });
     std::sort(candidates.begin(), candidates.end());
     for (auto [d, w] : candidates) {
-      if (degree[w] != 2 || vertex.count(w)) continue;
+      // A line vertex (two sharp edges) or a junction (more): either way its sector facing s lies between two.
+      if (degree[w] < 2 || vertex.count(w)) continue;
       // The sector of w facing s: the one holding the reached neighbour of w nearest s.
       int x = -1;
       double best = std::numeric_limits<double>::infinity();
