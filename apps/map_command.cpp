@@ -57,6 +57,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   run.placements = made.placements, run.cancel_units = made.cancel_units, run.first_problems = made.first_problems;
   run.first_distortion = made.first_distortion, run.relaxed = made.relaxed;
   run.relaxed_periods = made.periods;
+  run.onto_units = made.onto_units;
   run.quads = std::move(made.quads);
   return run;
 }
@@ -102,6 +103,7 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                            {"cancel_units", run.cancel_units},
                            {"relaxed", run.relaxed},
                            {"periods", run.relaxed_periods},
+                           {"onto_features_units", run.onto_units},
                            {"first_problems", run.first_problems},
                            {"first_distortion", run.first_distortion}};
   for (size_t i = 0; i < param.cones.size(); ++i)
@@ -116,8 +118,9 @@ std::string placement_line(const MapRun& run) {
   line << "placement: the singularities found gave " << run.first_problems
        << (run.quads ? " problems (map folds, wrong windings, failed quad checks)" : " problems (map folds, wrong windings)")
        << " and a mean distortion of " << std::setprecision(3) << run.first_distortion << " (goal " << kMapDistortionGoal << "); placed again "
-       << run.placements - 1 << " time(s), relaxed or with opposite pairs cancelled further apart; kept: ";
+       << run.placements - 1 << " time(s), relaxed, moved onto feature lines from further or with opposite pairs cancelled further apart; kept: ";
   if (run.cancel_units > 1) line << (run.relaxed ? "relaxed, " : "") << "pairs cancelled within " << static_cast<int>(run.cancel_units) << " units";
+  else if (run.onto_units > kMapOntoFeatures) line << "the singularities found, moved onto the feature lines from " << run.onto_units << " units";
   else line << (run.relaxed ? (run.relaxed_periods ? "the singularities found, relaxed with the periods" : "the singularities found, relaxed") : "the first");
   line << "\n";
   return line.str();

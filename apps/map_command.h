@@ -45,6 +45,7 @@ struct MapRun {
   double first_distortion = 0;
   bool relaxed = false;
   bool relaxed_periods = false;  // relaxed with the periods (MapOutcome::periods)
+  double onto_units = 0;         // MapOutcome::onto_units
   bool boundary_aligned_unasked = false;  // quad --auto aligned the boundary without --align-boundary
   std::optional<QuadMesh> quads;  // run_map(…, true): the kept map's quad mesh
   const RepairedMesh* repaired() const { return loaded.repaired(); }

@@ -9,6 +9,7 @@
 #include "support.h"
 #include "trivcon/generate.h"
 #include "trivcon/io.h"
+#include "trivcon/request.h"
 
 namespace trivcon {
 namespace {
@@ -245,12 +246,16 @@ TEST(CliQuad, PlacedAgainOnlyWhenTheCancelDistanceIsTheProgramsOwn) {
     const nlohmann::json j = nlohmann::json::parse(slurp(report));
     const int placements = j["placement"]["placements"].get<int>();
     if (extra.empty()) {
-      EXPECT_EQ(placements, 6);  // the first, relaxed, cancelled within 2 and 4 units, and those relaxed
+      // The first, relaxed, cancelled within 2 and 4 units, and those relaxed; none moved onto feature lines from
+      // further (no sharp edges).
+      EXPECT_EQ(placements, 6);
+      EXPECT_EQ(j["placement"]["onto_features_units"].get<double>(), kMapOntoFeatures);
       EXPECT_GT(j["placement"]["first_problems"].get<int>(), j["param"]["flipped_faces"].get<int>() + j["param"]["degenerate_faces"].get<int>());
       EXPECT_NE(r.out.find("placement: the singularities found gave"), std::string::npos) << r.out;
     } else {
       EXPECT_EQ(placements, 1);
       EXPECT_EQ(j["placement"]["cancel_units"].get<double>(), 0.0);
+      EXPECT_EQ(j["placement"]["onto_features_units"].get<double>(), 0.0);
       EXPECT_EQ(r.out.find("placement:"), std::string::npos) << r.out;
     }
   }

@@ -121,7 +121,7 @@ double map_unit(const FieldDesigner& designer, double edge_length, double target
 // distance was given, and to split every singularity of |index| ≥ 1 into ones of ±1/4 about one unit around it
 // (AutoOptions::split_above = 3) when no split was asked for: a quad vertex has valence 4 − 4k, so k ≥ 1
 // cannot be made (the smoothest field of a round disk with its boundary aligned puts +1 at the centre); and to
-// move ±1/4 singularities closer than 1.5 units to a feature line onto it (AutoOptions::onto_features).
+// move ±1/4 singularities closer than kMapOntoFeatures units to a feature line onto it (AutoOptions::onto_features).
 void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double edge_length, double target_faces);
 
 // A field and its map, as `param`, `quad` and Python's solve with a map scale make them.
@@ -134,8 +134,14 @@ struct MapOutcome {
   double first_distortion = 0;  // the first attempt's mean singular-value ratio, when it was placed again
   bool relaxed = false;    // the kept placement was relaxed by map_request (not by the request's own relax)
   bool periods = false;    // and with the periods in the objective (kMapPeriodWeight)
+  double onto_units = 0;   // with automatic placement and sharp edges: the distance singularities were moved onto them from, in units
   std::optional<QuadMesh> quads;  // with quads = true: the kept map's quad mesh (extract_quads)
 };
+// The distance, in units of the map, within which cancel_for_map moves ±1/4 singularities onto a feature line, and
+// the farther one of map_request's attempt after the relaxed ones (a singularity in a strip or wedge between
+// two feature lines, where the map has one unit across it, has no integer point off both lines).
+inline constexpr double kMapOntoFeatures = 1.5;
+inline constexpr double kMapOntoFeaturesFar = 2;
 // The mean singular-value ratio of a map (ParamQuality::mean_distortion) above which map_request places again.
 inline constexpr double kMapDistortionGoal = 1.5;
 // The weight of the periods (RelaxOptions::period_weight) in map_request's second relaxed attempt.
@@ -150,7 +156,8 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // windings (or, with `quads`, whose quad mesh fails a check of check_quads), or stretched beyond
 // kMapDistortionGoal, is made again: from the same singularities relaxed (trivcon/relax.h; kept a unit from the
 // aligned edges and from each other, with a reach of kMapRelaxReach edges), then relaxed with the periods (RelaxOptions::period_weight =
-// kMapPeriodWeight), then from singularities whose ± pairs were cancelled within 2, then 4
+// kMapPeriodWeight), then (with sharp edges) with singularities moved onto the feature lines from
+// kMapOntoFeaturesFar units, then from singularities whose ± pairs were cancelled within 2, then 4
 // units (at a scale too coarse for the singularities found, a detailed scan at a thousand quads, fewer of them
 // give a map without folds), then those relaxed; with the request's own relax, every placement is relaxed. A
 // placement equal to an earlier one is not mapped again, and none is relaxed when the first has more than

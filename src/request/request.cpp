@@ -234,7 +234,7 @@ void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double
   if (!request.auto_place) return;
   const double unit = map_unit(designer, edge_length, target_faces);
   if (request.auto_options.split_above == 0) request.auto_options.split_above = 3, request.auto_options.split_distance = unit;
-  if (request.auto_options.onto_features == 0) request.auto_options.onto_features = 1.5 * unit;
+  if (request.auto_options.onto_features == 0) request.auto_options.onto_features = kMapOntoFeatures * unit;
   if (request.auto_options.cancel_distance != 0) return;
   request.auto_options.cancel_distance = unit;
   request.auto_options.cancel_absolute = true;
@@ -275,6 +275,7 @@ std::vector<int> vertices_near_edges(const FieldDesigner& designer, const std::v
 MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
                        bool quads) {
   const bool escalate = request.auto_place && request.auto_options.cancel_distance == 0;
+  const bool onto_given = request.auto_options.onto_features != 0;
   cancel_for_map(request, designer, edge_length, target_faces);
   const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
   // The map's folded and degenerate faces and wrong windings, and with quads the quad mesh's failed checks.
@@ -297,16 +298,20 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     double units;
     bool relax;
     bool periods;
+    double onto = kMapOntoFeatures;  // singularities moved onto feature lines from this many units
   };
   std::vector<Attempt> attempts{{1.0, request.relax, false}};
   if (escalate) {
     if (!request.relax) attempts.push_back({1.0, true, false}), attempts.push_back({1.0, true, true});
+    if (!onto_given && !request.split_large_turns && !request_sharp_edges(designer, request).empty())
+      attempts.push_back({1.0, request.relax, false, kMapOntoFeaturesFar});
     for (double units : {2.0, 4.0}) attempts.push_back({units, request.relax, false});
     if (!request.relax)
       for (double units : {2.0, 4.0}) attempts.push_back({units, true, false});
   }
   // The attempts from the placement found (the first ones).
-  const int same_placement = static_cast<int>(std::count_if(attempts.begin(), attempts.end(), [](const Attempt& a) { return a.units == 1; }));
+  const int same_placement =
+      static_cast<int>(std::count_if(attempts.begin(), attempts.end(), [](const Attempt& a) { return a.units == 1 && a.onto == kMapOntoFeatures; }));
   MapOutcome best;
   FieldRequest kept = request;
   int tried = 0, kept_at = 0, maps = 0;
@@ -321,6 +326,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     }
     FieldRequest r = request;
     if (escalate) r.auto_options.cancel_distance = attempt.units * unit;
+    if (escalate && !onto_given) r.auto_options.onto_features = attempt.onto * unit;
     r.relax = attempt.relax;
     if (attempt.relax) {
       // The relaxation keeps singularities a unit away from the aligned lines: the energy draws a −1/4 toward a
@@ -354,6 +360,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     m.cancel_units = escalate ? attempt.units : 0.0;
     m.relaxed = attempt.relax && !request.relax;
     m.periods = attempt.periods;
+    m.onto_units = escalate && !onto_given ? attempt.onto : 0.0;
     if (tried == 1 || better(m, best)) {
       const int first = tried == 1 ? problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
