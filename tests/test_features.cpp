@@ -62,28 +62,33 @@ struct Solved {
   Design design;
 };
 
-// The CLI's route: sharp edges at `degrees`, faces fixed to them, then --auto's placement (honouring the
-// same fixed faces) or the given singularities, then the exact solve.
-Solved solve_with_features(FieldDesigner& designer, double degrees, const std::map<int, int>* given = nullptr) {
-  Solved s;
-  s.edges = sharp_edges(designer.V(), designer.topology(), designer.geometry(), degrees);
-  s.alignment = feature_alignment(designer.V(), designer.topology(), designer.geometry(), s.edges, 4);
+// The exact solve of s.singularities with s.alignment's faces fixed, into s.design.
+void design_aligned(FieldDesigner& designer, Solved& s) {
   std::vector<int> faces;
   for (auto [f, a] : s.alignment.fixed) faces.push_back(f);
   designer.set_fixed_faces(faces);
   IndexPrescription p;
   p.N = 4;
   p.fixed = s.alignment.fixed;
+  p.vertex = s.singularities;
+  s.design = designer.design(p);
+}
+
+// The CLI's route: sharp edges at `degrees`, faces fixed to them, then --auto's placement (honouring the
+// same fixed faces) or the given singularities, then the exact solve.
+Solved solve_with_features(FieldDesigner& designer, double degrees, const std::map<int, int>* given = nullptr) {
+  Solved s;
+  s.edges = sharp_edges(designer.V(), designer.topology(), designer.geometry(), degrees);
+  s.alignment = feature_alignment(designer.V(), designer.topology(), designer.geometry(), s.edges, 4);
   if (given) {
-    p.vertex = *given;
+    s.singularities = *given;
   } else {
     AutoOptions ao;
     ao.N = 4;
-    ao.fixed = p.fixed;
-    p.vertex = auto_singularities(designer, ao).vertex;
+    ao.fixed = s.alignment.fixed;
+    s.singularities = auto_singularities(designer, ao).vertex;
   }
-  s.singularities = p.vertex;
-  s.design = designer.design(p);
+  design_aligned(designer, s);
   return s;
 }
 
@@ -308,15 +313,8 @@ TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
     for (int k = 0; k < 3; ++k) cy += m.V(t.F(f, k), 1) / 3;
     EXPECT_LT(cy, 0.5) << "face " << f;
   }
-  std::vector<int> faces;
-  for (auto [f, a] : s.alignment.fixed) faces.push_back(f);
-  designer.set_fixed_faces(faces);
-  IndexPrescription p;
-  p.N = 4;
-  p.fixed = s.alignment.fixed;
-  p.vertex = vertex;
   s.singularities = vertex;
-  s.design = designer.design(p);
+  design_aligned(designer, s);
   // The turned sector's inner faces follow neither line by design, like a narrow corner's.
   s.alignment.narrow.push_back({junction, -1, -1, kPi, snap.faces});
   expect_exact_and_aligned(designer, s);
