@@ -92,10 +92,10 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& topology,
                                    int N);
 
 // For a map (N even, N ≥ 4): each singularity of index ±1/N in `vertex` (vertex → n) closer than `distance`
-// along edges to a feature line is moved onto the nearest vertex w of the line, if w has two or more sharp edges
-// (a line vertex or a junction) and no singularity: the sector of w facing it (its faces beside no other sharp edge) is turned through with one
-// step more (−1/N) or fewer (+1/N) than the nearest to its angle, as a narrow corner's, so that w gets the
-// index. A singularity a unit or so from a feature line would otherwise often be rounded onto the line's
+// along edges to a feature line is moved onto the nearest vertex w of the line, if w has two or more sharp
+// edges (a line vertex or a junction) and no singularity: the sector of w facing it (its faces beside no other
+// sharp edge) is turned through with one step more (−1/N) or fewer (+1/N) than the nearest to its angle, as a
+// narrow corner's, so that w gets the index. A singularity a unit or so from a feature line would otherwise often be rounded onto the line's
 // iso-line beside it (or one unit from it, where a strip between lines is squeezed to one unit), flattening the
 // faces between them. The map requests use 1.5 units (trivcon/request.h, cancel_for_map). Updates `vertex` and `alignment.fixed` (new
 // faces among them: the sector's middle ones), lists the moves in `alignment.snapped`.

@@ -275,7 +275,8 @@ std::vector<int> vertices_near_edges(const FieldDesigner& designer, const std::v
 MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
                        bool quads) {
   const bool escalate = request.auto_place && request.auto_options.cancel_distance == 0;
-  const bool onto_given = request.auto_options.onto_features != 0;
+  // The distance onto feature lines is map_request's own (per attempt) unless the request gave one.
+  const bool own_onto = escalate && request.auto_options.onto_features == 0;
   cancel_for_map(request, designer, edge_length, target_faces);
   const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
   // The map's folded and degenerate faces and wrong windings, and with quads the quad mesh's failed checks.
@@ -303,7 +304,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   std::vector<Attempt> attempts{{1.0, request.relax, false}};
   if (escalate) {
     if (!request.relax) attempts.push_back({1.0, true, false}), attempts.push_back({1.0, true, true});
-    if (!onto_given && !request.split_large_turns && !request_sharp_edges(designer, request).empty())
+    if (own_onto && !request.split_large_turns && !request_sharp_edges(designer, request).empty())
       attempts.push_back({1.0, request.relax, false, kMapOntoFeaturesFar});
     for (double units : {2.0, 4.0}) attempts.push_back({units, request.relax, false});
     if (!request.relax)
@@ -326,7 +327,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     }
     FieldRequest r = request;
     if (escalate) r.auto_options.cancel_distance = attempt.units * unit;
-    if (escalate && !onto_given) r.auto_options.onto_features = attempt.onto * unit;
+    if (own_onto) r.auto_options.onto_features = attempt.onto * unit;
     r.relax = attempt.relax;
     if (attempt.relax) {
       // The relaxation keeps singularities a unit away from the aligned lines: the energy draws a −1/4 toward a
@@ -360,7 +361,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     m.cancel_units = escalate ? attempt.units : 0.0;
     m.relaxed = attempt.relax && !request.relax;
     m.periods = attempt.periods;
-    m.onto_units = escalate && !onto_given ? attempt.onto : 0.0;
+    m.onto_units = own_onto ? attempt.onto : 0.0;
     if (tried == 1 || better(m, best)) {
       const int first = tried == 1 ? problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
