@@ -68,7 +68,7 @@ void run_quad(const QuadCommand& o) {
               << "irregular vertices: " << q.irregular_vertices << " (singularities: " << (irregular.tellp() > 0 ? irregular.str() : "none")
               << "), " << (q.singular_mismatches == 0 ? "exactly at the singularities" : std::to_string(q.singular_mismatches) + " NOT at a singularity of their valence") << "\n"
               << "scaled Jacobian: min " << fmt(q.min_scaled_jacobian) << ", mean " << fmt(q.mean_scaled_jacobian) << "; inverted quads "
-              << q.inverted_quads << "; distance to the input " << fmt(100 * q.hausdorff_relative) << " % of the bounding box diagonal\n"
+              << q.inverted_quads << ", with a flat or reflex corner " << q.nonconvex_quads << "; distance to the input " << fmt(100 * q.hausdorff_relative) << " % of the bounding box diagonal\n"
               << "time: read " << fmt(run.read_seconds) << " s, field " << fmt(run.out.design.solve_seconds + run.out.design.field_seconds)
               << " s, map " << fmt(p.seconds_total())
               << " s, quads " << fmt(q.seconds_extract + q.seconds_check) << " s (extract " << fmt(q.seconds_extract) << ", check "

@@ -58,6 +58,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   run.first_distortion = made.first_distortion, run.relaxed = made.relaxed;
   run.relaxed_periods = made.periods;
   run.onto_units = made.onto_units;
+  run.onto_flat = made.onto_flat;
   run.quads = std::move(made.quads);
   return run;
 }
@@ -104,6 +105,7 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                            {"relaxed", run.relaxed},
                            {"periods", run.relaxed_periods},
                            {"onto_features_units", run.onto_units},
+                           {"onto_flat_sectors", run.onto_flat},
                            {"first_problems", run.first_problems},
                            {"first_distortion", run.first_distortion}};
   for (size_t i = 0; i < param.cones.size(); ++i)
@@ -120,6 +122,7 @@ std::string placement_line(const MapRun& run) {
        << " and a mean distortion of " << std::setprecision(3) << run.first_distortion << " (goal " << kMapDistortionGoal << "); placed again "
        << run.placements - 1 << " time(s), relaxed, moved onto feature lines from further or with opposite pairs cancelled further apart; kept: ";
   if (run.cancel_units > 1) line << (run.relaxed ? "relaxed, " : "") << "pairs cancelled within " << static_cast<int>(run.cancel_units) << " units";
+  else if (run.onto_flat) line << "the singularities found, moved onto the feature lines from " << run.onto_units << " units where a quad gets a flat corner";
   else if (run.onto_units > kMapOntoFeatures) line << "the singularities found, moved onto the feature lines from " << run.onto_units << " units";
   else line << (run.relaxed ? (run.relaxed_periods ? "the singularities found, relaxed with the periods" : "the singularities found, relaxed") : "the first");
   line << "\n";

@@ -167,6 +167,7 @@ nlohmann::ordered_json quad_report(const QuadMesh& quads) {
           {"irregular_vertices", q.irregular_vertices},
           {"singular_mismatches", q.singular_mismatches},
           {"inverted_quads", q.inverted_quads},
+          {"nonconvex_quads", q.nonconvex_quads},
           {"min_scaled_jacobian", q.min_scaled_jacobian},
           {"mean_scaled_jacobian", q.mean_scaled_jacobian},
           {"hausdorff_relative", q.hausdorff_relative},

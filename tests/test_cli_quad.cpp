@@ -247,9 +247,10 @@ TEST(CliQuad, PlacedAgainOnlyWhenTheCancelDistanceIsTheProgramsOwn) {
     const int placements = j["placement"]["placements"].get<int>();
     if (extra.empty()) {
       // The first, relaxed, cancelled within 2 and 4 units, and those relaxed; none moved onto feature lines from
-      // further (no sharp edges).
+      // further or onto flat sectors (no sharp edges).
       EXPECT_EQ(placements, 6);
       EXPECT_EQ(j["placement"]["onto_features_units"].get<double>(), kMapOntoFeatures);
+      EXPECT_FALSE(j["placement"]["onto_flat_sectors"].get<bool>());
       EXPECT_GT(j["placement"]["first_problems"].get<int>(), j["param"]["flipped_faces"].get<int>() + j["param"]["degenerate_faces"].get<int>());
       EXPECT_NE(r.out.find("placement: the singularities found gave"), std::string::npos) << r.out;
     } else {

@@ -267,8 +267,9 @@ TEST(FeatureAlignment, NarrowCornersTurnByOneStep) {
 TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
   // A flat 12×12 grid with a feature line across it at y = 1/2 and another from its middle up to y = 11/12:
   // a T-junction of three sharp edges at (1/2, 1/2). A +1/4 one edge below the junction is moved onto it
-  // (move_singularities_onto_features): the half-plane below the line turns one step fewer, and the junction
-  // reads +1/4 in the exact field while every face beside the lines still follows them.
+  // (move_singularities_onto_features) when flat sectors are allowed: the half-plane below the line turns one
+  // step fewer, and the junction reads +1/4 in the exact field while every face beside the lines still follows
+  // them. Without, it stays: the half-plane would be one quad's corner of π.
   const int n = 12;
   const Mesh m = make_holed_grid(n, 0);
   FieldDesigner designer(m.V, m.F);
@@ -292,7 +293,11 @@ TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
   s.alignment = feature_alignment(m.V, t, designer.geometry(), s.edges, 4);
   EXPECT_TRUE(s.alignment.narrow.empty());
   std::map<int, int> vertex{{below, 1}};
-  move_singularities_onto_features(m.V, t, designer.geometry(), s.edges, 4, 1.5 / n, vertex, s.alignment);
+  FeatureAlignment strict = s.alignment;
+  move_singularities_onto_features(m.V, t, designer.geometry(), s.edges, 4, 1.5 / n, false, vertex, strict);
+  EXPECT_EQ(vertex, (std::map<int, int>{{below, 1}}));
+  EXPECT_TRUE(strict.snapped.empty());
+  move_singularities_onto_features(m.V, t, designer.geometry(), s.edges, 4, 1.5 / n, true, vertex, s.alignment);
   EXPECT_EQ(vertex, (std::map<int, int>{{junction, 1}}));
   ASSERT_EQ(s.alignment.snapped.size(), 1u);
   const FeatureSnap& snap = s.alignment.snapped[0];
@@ -318,12 +323,13 @@ TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
   // The turned sector's inner faces follow neither line by design, like a narrow corner's.
   s.alignment.narrow.push_back({junction, -1, -1, kPi, snap.faces});
   expect_exact_and_aligned(designer, s);
-  // Beside a degree-2 vertex of the line only (the vertical line removed), the move is the same.
+  // Beside a degree-2 vertex of the line only (the vertical line removed), a −1/4 moves without flat sectors
+  // allowed: the half-plane gets three quad corners of π/3.
   Solved line;
   for (int x = 1; x + 2 < n; ++x) line.edges.push_back(edge_between(at(x, n / 2), at(x + 1, n / 2)));
   line.alignment = feature_alignment(m.V, t, designer.geometry(), line.edges, 4);
   std::map<int, int> alone{{below, -1}};
-  move_singularities_onto_features(m.V, t, designer.geometry(), line.edges, 4, 1.5 / n, alone, line.alignment);
+  move_singularities_onto_features(m.V, t, designer.geometry(), line.edges, 4, 1.5 / n, false, alone, line.alignment);
   EXPECT_EQ(alone, (std::map<int, int>{{junction, -1}}));
 }
 

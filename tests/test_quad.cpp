@@ -207,6 +207,18 @@ void expect_clean(const Pipeline& r, const std::string& what, bool brute_force =
   // Corners may be reflex where the map is strongly distorted (near close cones), so only the mean is bounded.
   EXPECT_GT(m.quality.mean_scaled_jacobian, 0.8) << what;
   EXPECT_LE(m.quality.min_scaled_jacobian, m.quality.mean_scaled_jacobian) << what;
+  // Quads with a flat or reflex corner: the sine of some corner's angle about the quad's normal is not positive.
+  int nonconvex = 0;
+  for (int i = 0; i < m.Q.rows(); ++i) {
+    Eigen::Vector3d p[4];
+    for (int k = 0; k < 4; ++k) p[k] = m.V.row(m.Q(i, k)).transpose();
+    const Eigen::Vector3d normal = (p[2] - p[0]).cross(p[3] - p[1]);
+    bool flat = false;
+    for (int k = 0; k < 4; ++k) flat = flat || !((p[(k + 1) % 4] - p[k]).cross(p[(k + 3) % 4] - p[k]).dot(normal) > 0);
+    nonconvex += flat;
+  }
+  EXPECT_EQ(m.quality.nonconvex_quads, nonconvex) << what;
+  EXPECT_EQ(m.quality.nonconvex_quads > 0, m.quality.min_scaled_jacobian <= 0) << what;
   // The vertices lie on the input surface.
   if (brute_force) {
     const Eigen::Vector3d extent = r.designer->V().colwise().maxCoeff() - r.designer->V().colwise().minCoeff();
@@ -291,18 +303,20 @@ TEST(Quad, DegenerateFacesStayOutOfTheMeanDistortion) {
 
 TEST(Quad, SingularitiesNearASharpEdgeMoveOntoIt) {
   // A capped cylinder of radius 1: --auto puts four +1/4 inside each cap. At 60 squares (a unit ≈ 0.6) they lie
-  // within 1.5 units of the rims and move onto them (trivcon/features.h): each rim vertex then turns its cap-side
-  // sector one step less (a quad corner of valence 3 on the rim). At 400 squares they stay inside the caps.
+  // within 1.5 units of the rims; with flat sectors allowed they move onto them (trivcon/features.h): each rim
+  // vertex then turns its cap-side sector (168.75°) one step less, one quad corner of valence 3 on the rim.
+  // Without, they stay inside the caps (that corner would be nearly flat), as at 400 squares.
   const Mesh m = make_capped_cylinder(6, 32, 12, 2.0);
-  for (int target : {60, 400}) {
+  for (auto [target, flat] : {std::pair{60, true}, {60, false}, {400, true}}) {
     FieldRequest req;
     req.feature_degrees = 30;
     req.auto_place = true;
+    req.auto_options.onto_flat_sectors = flat;
     cancel_for_map(req, FieldDesigner(m.V, m.F), 0, target);
     ParamOptions o;
     o.target_faces = target;
     const Pipeline r = run(m, req, o, true);
-    const std::string what = "target " + std::to_string(target);
+    const std::string what = "target " + std::to_string(target) + (flat ? ", flat sectors" : "");
     const std::vector<FeatureSnap>& moved = r.outcome.constraints.features.snapped;
     ASSERT_EQ(r.param.cones.size(), 8u) << what;
     int on_rim = 0;
@@ -311,7 +325,7 @@ TEST(Quad, SingularitiesNearASharpEdgeMoveOntoIt) {
       on_rim += std::abs(radius - 1) < 1e-9 && std::abs(std::abs(m.V(v, 2)) - 1) < 1e-9;
     }
     for (int n : r.param.cone_index) EXPECT_EQ(n, 1) << what;
-    EXPECT_EQ(moved.size(), target == 60 ? 8u : 0u) << what;
+    EXPECT_EQ(moved.size(), target == 60 && flat ? 8u : 0u) << what;
     EXPECT_EQ(on_rim, static_cast<int>(moved.size())) << what;
     const double unit = std::sqrt(r.designer->geometry().face_area.sum() / target);
     for (const FeatureSnap& k : moved) EXPECT_LT(k.distance, 1.5 * unit) << what;
@@ -568,6 +582,9 @@ TEST(Quad, RelaxationUndoesAnInvertedQuad) {
   q.vertex_cone[v] = -1;
   const int broken = inverted(r);
   ASSERT_GE(broken, 1);
+  check_quads(*r.designer, r.param, q);
+  EXPECT_GE(q.quality.nonconvex_quads, 1);
+  q.quality = {};
   EXPECT_GE(quad::relax_quads(*r.designer, r.param, q), 1);
   EXPECT_EQ(inverted(r), 0);
   EXPECT_TRUE(q.Q == Q);
@@ -584,6 +601,7 @@ TEST(Quad, RelaxationUndoesAnInvertedQuad) {
   check_quads(*r.designer, r.param, q);
   EXPECT_TRUE(q.quality.problems.empty()) << quad_warning(q);
   EXPECT_GT(q.quality.min_scaled_jacobian, 0.2);
+  EXPECT_EQ(q.quality.nonconvex_quads, 0);
 }
 
 TEST(Quad, RefusesAMapOfAnotherMesh) {

@@ -97,10 +97,13 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& topology,
 // sharp edge) is turned through with one step more (−1/N) or fewer (+1/N) than the nearest to its angle, as a
 // narrow corner's, so that w gets the index. A singularity a unit or so from a feature line would otherwise often be rounded onto the line's
 // iso-line beside it (or one unit from it, where a strip between lines is squeezed to one unit), flattening the
-// faces between them. The map requests use 1.5 units (trivcon/request.h, cancel_for_map). Updates `vertex` and `alignment.fixed` (new
-// faces among them: the sector's middle ones), lists the moves in `alignment.snapped`.
+// faces between them. The map requests use 1.5 units (trivcon/request.h, cancel_for_map). Without `flat_sectors`,
+// not onto a sector whose quad corners at w would open wider than 1.5 steps (3π/4 for N = 4) each: a +1/N on a
+// straight line or on a T-junction's straight side gives a quad one corner of about π (scaled Jacobian about 0).
+// Updates `vertex` and `alignment.fixed` (new faces among them: the sector's middle ones), lists the moves in
+// `alignment.snapped`.
 void move_singularities_onto_features(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
-                                      int N, double distance, std::map<int, int>& vertex, FeatureAlignment& alignment);
+                                      int N, double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment);
 
 // One line of a .sharp file.
 struct SharpFaceEdge {

@@ -135,6 +135,7 @@ struct MapOutcome {
   bool relaxed = false;    // the kept placement was relaxed by map_request (not by the request's own relax)
   bool periods = false;    // and with the periods in the objective (kMapPeriodWeight)
   double onto_units = 0;   // with automatic placement and sharp edges: the distance singularities were moved onto them from, in units
+  bool onto_flat = false;  // and onto sectors where a quad gets a flat corner (AutoOptions::onto_flat_sectors)
   std::optional<QuadMesh> quads;  // with quads = true: the kept map's quad mesh (extract_quads)
 };
 // The distance, in units of the map, within which cancel_for_map moves ±1/4 singularities onto a feature line, and
@@ -159,7 +160,9 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // kMapPeriodWeight), then (with sharp edges) with singularities moved onto the feature lines from
 // kMapOntoFeaturesFar units, then from singularities whose ± pairs were cancelled within 2, then 4
 // units (at a scale too coarse for the singularities found, a detailed scan at a thousand quads, fewer of them
-// give a map without folds), then those relaxed; with the request's own relax, every placement is relaxed. A
+// give a map without folds), then those relaxed, and last (with sharp edges) moved onto the lines from
+// kMapOntoFeatures and kMapOntoFeaturesFar units also onto sectors where a quad gets a flat corner
+// (AutoOptions::onto_flat_sectors); with the request's own relax, every placement is relaxed. A
 // placement equal to an earlier one is not mapped again, and none is relaxed when the first has more than
 // kMapRelaxMaxSingularities singularities. The search ends at the first map without problems
 // within the goal, or without problems once the placement found was mapped as found and relaxed both ways; the kept map is the one with the fewest

@@ -192,7 +192,7 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const 
 }
 
 void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, const Geometry& g, const std::vector<int>& edges, int N,
-                                      double distance, std::map<int, int>& vertex, FeatureAlignment& alignment) {
+                                      double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment) {
   if (N < 4 || N % 2 != 0 || edges.empty() || !(distance > 0)) return;
   const std::vector<char> sharp = sharp_flags(t, edges);
   const std::map<int, std::vector<int>> beside = sharp_faces(t, edges);
@@ -237,7 +237,11 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
         const double step = 2 * kPi / N;
         const int steps = static_cast<int>(std::lround(sector.theta / step)) - n;  // one more for −1/N, one fewer for +1/N
         const int m = static_cast<int>(sector.faces.size());
-        if (steps < 1 || !(std::abs(sector.theta - steps * step) / (m + 1) < 0.9 * kPi / N) || !sector_is_plain(sector, beside, claimed))
+        // The quad mesh gives the sector `steps` corners at w: wider than 1.5 steps each (a +1/N on a straight
+        // line or on a T-junction's straight side: one corner of about π), they would be flat or reflex.
+        const bool flat = sector.theta > 1.5 * steps * step;
+        if (steps < 1 || !(std::abs(sector.theta - steps * step) / (m + 1) < 0.9 * kPi / N) || (flat && !flat_sectors) ||
+            !sector_is_plain(sector, beside, claimed))
           break;
         turn_through(t, g, w, sector, steps, N, alignment.fixed, claimed);
         vertex.erase(s);

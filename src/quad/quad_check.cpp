@@ -174,7 +174,7 @@ void check_quads(const FieldDesigner& designer, const Parametrization& param, Qu
   const double diagonal = extent.norm();
   bool located = quads.vertex_face.size() == nV;
   for (int v = 0; v < nV && located; ++v) located = quads.vertex_face[v] >= 0 && quads.vertex_face[v] < t.num_faces;
-  int inverted = 0, unmeasured = 0;
+  int inverted = 0, unmeasured = 0, nonconvex = 0;
   double min_sj = nQ > 0 ? std::numeric_limits<double>::infinity() : 0, sum_sj = 0, farthest = 0;
   for (int i = 0; i < nQ; ++i) {
     std::array<Eigen::Vector3d, 4> p;
@@ -201,15 +201,19 @@ void check_quads(const FieldDesigner& designer, const Parametrization& param, Qu
     // The scaled Jacobian of each corner against the quad's own normal (the diagonals' cross product): the sine
     // of the corner's angle, negative at a reflex corner.
     const Eigen::Vector3d unit_own = own.norm() > 0 ? Eigen::Vector3d(own.normalized()) : own;
+    double worst = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector3d a = p[(k + 1) % 4] - p[k], b = p[(k + 3) % 4] - p[k];
       const double lengths = a.norm() * b.norm();
       const double sj = lengths > 0 ? a.cross(b).dot(unit_own) / lengths : -1;
-      min_sj = std::min(min_sj, sj);
+      worst = std::min(worst, sj);
       sum_sj += sj;
     }
+    min_sj = std::min(min_sj, worst);
+    nonconvex += !(worst > 0);
   }
   q.inverted_quads = inverted;
+  q.nonconvex_quads = nonconvex;
   q.min_scaled_jacobian = min_sj;
   q.mean_scaled_jacobian = nQ > 0 ? sum_sj / (4.0 * nQ) : 0;
   q.hausdorff_relative = diagonal > 0 ? farthest / diagonal : 0;

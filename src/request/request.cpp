@@ -142,7 +142,7 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
     if (request.auto_options.onto_features > 0 && !request.split_large_turns && !out.constraints.sharp_edges.empty()) {
       FeatureAlignment& a = out.constraints.features;
       move_singularities_onto_features(designer.V(), designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N,
-                                       request.auto_options.onto_features, p.vertex, a);
+                                       request.auto_options.onto_features, request.auto_options.onto_flat_sectors, p.vertex, a);
       if (!a.snapped.empty()) {  // the sectors turned anew, unless a direction given by hand holds the face
         for (const FeatureSnap& k : a.snapped)
           for (int f : k.faces)
@@ -300,6 +300,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     bool relax;
     bool periods;
     double onto = kMapOntoFeatures;  // singularities moved onto feature lines from this many units
+    bool flat = false;               // and onto sectors whose quad corners would be flat (AutoOptions::onto_flat_sectors)
   };
   std::vector<Attempt> attempts{{1.0, request.relax, false}};
   if (escalate) {
@@ -309,10 +310,14 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     for (double units : {2.0, 4.0}) attempts.push_back({units, request.relax, false});
     if (!request.relax)
       for (double units : {2.0, 4.0}) attempts.push_back({units, true, false});
+    // Last, with a singularity beside a straight feature line moved onto it all the same: one quad gets a flat
+    // corner there, where the other placements fold the map.
+    if (own_onto && !request.split_large_turns && !request_sharp_edges(designer, request).empty())
+      for (double onto : {kMapOntoFeatures, kMapOntoFeaturesFar}) attempts.push_back({1.0, request.relax, false, onto, true});
   }
   // The attempts from the placement found (the first ones).
-  const int same_placement =
-      static_cast<int>(std::count_if(attempts.begin(), attempts.end(), [](const Attempt& a) { return a.units == 1 && a.onto == kMapOntoFeatures; }));
+  const int same_placement = static_cast<int>(
+      std::count_if(attempts.begin(), attempts.end(), [](const Attempt& a) { return a.units == 1 && a.onto == kMapOntoFeatures && !a.flat; }));
   MapOutcome best;
   FieldRequest kept = request;
   int tried = 0, kept_at = 0, maps = 0;
@@ -327,7 +332,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     }
     FieldRequest r = request;
     if (escalate) r.auto_options.cancel_distance = attempt.units * unit;
-    if (own_onto) r.auto_options.onto_features = attempt.onto * unit;
+    if (own_onto) r.auto_options.onto_features = attempt.onto * unit, r.auto_options.onto_flat_sectors = attempt.flat;
     r.relax = attempt.relax;
     if (attempt.relax) {
       // The relaxation keeps singularities a unit away from the aligned lines: the energy draws a −1/4 toward a
@@ -362,6 +367,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     m.relaxed = attempt.relax && !request.relax;
     m.periods = attempt.periods;
     m.onto_units = own_onto ? attempt.onto : 0.0;
+    m.onto_flat = own_onto && attempt.flat;
     if (tried == 1 || better(m, best)) {
       const int first = tried == 1 ? problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
