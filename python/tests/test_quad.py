@@ -40,6 +40,7 @@ def test_cube_quads_have_eight_valence_three_corners():
     assert sorted(int(q.vertex_cone[v]) for v in irregular) == sorted(r.singularities)
     assert q.ok and q.warning == "" and q.quality["singular_mismatches"] == 0
     assert q.quality["quads"] == len(QQ) and q.quality["irregular_vertices"] == 8
+    assert q.quality["nonconvex_quads"] == 0 and q.quality["min_scaled_jacobian"] > 0
     assert 280 < len(QQ) < 520
     assert "8 irregular" in repr(q)
 

@@ -1432,7 +1432,8 @@ class QuadMesh:
       vertex_cone  int64 (n,): the mesh vertex under each quad vertex (a singularity, or a vertex on an integer
                    point), else -1
       quality      dict: quads, vertices, euler_characteristic (and input_...), boundary_loops, manifold,
-                   oriented, irregular_vertices, singular_mismatches, inverted_quads, min/mean_scaled_jacobian,
+                   oriented, irregular_vertices, singular_mismatches, inverted_quads, nonconvex_quads (a flat or
+                   reflex corner), min/mean_scaled_jacobian,
                    hausdorff_relative, target_quads, extraction counts, problems, seconds (the `quad` object of
                    `trivcon quad --report`)
       warning      "" when every guarantee holds, else what failed, in one sentence
