@@ -376,7 +376,9 @@ TEST(FeatureAlignment, SparsePathsTakeTheSmallestTurn) {
   mirrored.V.col(0) *= -1;
   mirrored.F.col(1).swap(mirrored.F.col(2));
   for (const Mesh& m : {make_capped_cylinder(6, 96, 12), mirrored}) {
-  FieldDesigner designer(m.V, m.F);
+  SolverOptions sparse;
+  sparse.max_dense_paths = 256;
+  FieldDesigner designer(m.V, m.F, sparse);
   const Solved s = solve_with_features(designer, 30);
   const std::vector<FixedPath>& paths = designer.solver().fixed_paths();
   ASSERT_GT(paths.size(), 256u) << "the dense route would be taken";

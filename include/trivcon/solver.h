@@ -53,6 +53,11 @@ struct SolverOptions {
   // rest of the policy (split_large_turns, trivcon/split_large_turns.h, lowers the weights of edges that keep turning
   // by π/N or more). Its size must be the edge count.
   std::vector<double> edge_weight_scale = {};
+  // Beyond this many fixed-face paths the Cholesky route keeps them out of the dense block and rounds each
+  // path's turn on its own (docs/solver.md, "Fixed-face paths"); up to it, every path's turn is chosen with
+  // the cycles (nearest lattice point), the smoother field. The dense block costs about paths³ (1,055 paths:
+  // 0.3 s; 4,223: 9 s and 650 MB).
+  int max_dense_paths = 2048;
 };
 
 struct Connection {

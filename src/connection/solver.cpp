@@ -21,8 +21,6 @@
 namespace trivcon {
 
 namespace {
-// Beyond this many fixed-face paths the Cholesky route keeps them out of the dense block.
-constexpr int kMaxDensePaths = 256;
 // Iterative refinement (see ConnectionSolver::solve): when the largest constraint residual exceeds this
 // (relative to max(1, the right-hand sides' scale): a quarter of what verification accepts), up to this many
 // steps. Not lower: one substitution's round-off alone grows with the mesh to the order of this limit, and
@@ -238,7 +236,7 @@ void ConnectionSolver::Impl::lay_out_rows(double epsilon) {
   // Many fixed faces (e.g. a whole aligned boundary) would make the dense block large: then the Cholesky
   // route orders the path rows with the vertex rows (sparse, fill-reducing) and rounds their turns
   // from the field without them (see round_sparse_path_turns).
-  sparse_paths = options.solver == SolverKind::Cholesky && static_cast<int>(paths.size()) > kMaxDensePaths;
+  sparse_paths = options.solver == SolverKind::Cholesky && static_cast<int>(paths.size()) > options.max_dense_paths;
   if (!sparse_paths)
     for (int k = 0; k < static_cast<int>(paths.size()); ++k) rows.push_back({RowKind::Path, k});
   for (int l : connection::loop_rows(t, dropped_loop)) rows.push_back({RowKind::Loop, l});
