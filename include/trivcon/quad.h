@@ -71,7 +71,8 @@ struct QuadQuality {
   int inverted_quads = 0;
   double min_scaled_jacobian = 0, mean_scaled_jacobian = 0;  // per corner: sine of its angle about the quad's normal
   // Quads with a corner of scaled Jacobian ≤ 0 (flat or reflex; not inverted): where a cone sits on a straight
-  // feature line or in a strip between two, or the map turns at a concave boundary (a corner that moves nothing fixed).
+  // feature line or in a strip between two, or the map turns at a concave boundary, at a vertex the relaxation
+  // of src/quad/relax.h keeps in place (a cone, a vertex on an aligned edge or on the boundary).
   int nonconvex_quads = 0;
   // Largest distance from a quad's centre or edge midpoint to the input surface (its component, when vertex_face
   // is given), over the input's bounding box diagonal (the vertices lie on the surface by construction).

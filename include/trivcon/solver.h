@@ -55,8 +55,8 @@ struct SolverOptions {
   std::vector<double> edge_weight_scale = {};
   // Beyond this many fixed-face paths the Cholesky route keeps them out of the dense block and rounds each
   // path's turn on its own (docs/solver.md, "Fixed-face paths"); up to it, every path's turn is chosen with
-  // the cycles (nearest lattice point), the smoother field. The dense block costs about paths³ (1,055 paths:
-  // 0.3 s; 4,223: 9 s and 650 MB).
+  // the cycles (nearest lattice point), the smoother field. The dense block costs about paths³ (BENCHMARKS.md,
+  // "Fixed-face paths: the dense route up to 2,048"). 0: always the sparse route.
   int max_dense_paths = 2048;
 };
 
