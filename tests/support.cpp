@@ -213,6 +213,12 @@ Mesh sheared_box(int n) {
   return m;
 }
 
+SolverOptions sparse_path_options() {
+  SolverOptions options;
+  options.max_dense_paths = 256;
+  return options;
+}
+
 Mesh perforated_plate(int nx, int ny, int m, int layers, double r) {
   std::map<std::pair<long long, long long>, int> id;
   std::vector<Eigen::Vector3d> points;

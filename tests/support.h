@@ -68,6 +68,9 @@ Mesh sheared_box(int n);
 // quads (each cut into two triangles) from the hole's circle, sampled at the angles of 4m points evenly spaced
 // along the cell's square, out to that square; the cells share their squares' points.
 Mesh perforated_plate(int nx, int ny, int m, int layers, double r);
+// Solver options that send more than 256 fixed-face paths down the sparse route (SolverOptions::max_dense_paths),
+// for the tests of that route on meshes of a few hundred paths.
+SolverOptions sparse_path_options();
 
 // Checks every structural invariant of a Topology against F (the input) alone. Cheap: O(F log F).
 void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const std::string& what);

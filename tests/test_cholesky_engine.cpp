@@ -10,6 +10,7 @@
 #include <map>
 #include <string>
 
+#include "support.h"
 #ifdef TRIVCON_WITH_SUITESPARSE
 #include "linalg/cholmod.h"
 #endif
@@ -60,9 +61,8 @@ void balance(const Topology& t, IndexPrescription& p) {
 }
 
 Design solve(const Case& c, Factorization factorization, std::vector<int>* fixed_used = nullptr) {
-  SolverOptions options;
+  SolverOptions options = test::sparse_path_options();  // the aligned disk's paths: the sparse route, tested here too
   options.factorization = factorization;
-  options.max_dense_paths = 256;  // the aligned disk's paths take the sparse route, which this file tests too
   FieldDesigner designer(c.mesh.V, c.mesh.F, options);
   IndexPrescription p;
   p.N = c.N;

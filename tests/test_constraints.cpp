@@ -281,9 +281,7 @@ TEST(Constraints, ManyFixedFacesSparseRoute) {
 // their directions (here random, within ±π/N after parallel transport).
 TEST(Constraints, SparsePathsTakeTheSmallestTurnEitherWay) {
   const Mesh m = make_disk(24, 12);
-  SolverOptions sparse;
-  sparse.max_dense_paths = 256;
-  FieldDesigner d(m.V, m.F, sparse);
+  FieldDesigner d(m.V, m.F, test::sparse_path_options());
   std::mt19937 random(7);
   std::uniform_real_distribution<double> angle(-kPi, kPi);
   IndexPrescription p;

@@ -376,9 +376,7 @@ TEST(FeatureAlignment, SparsePathsTakeTheSmallestTurn) {
   mirrored.V.col(0) *= -1;
   mirrored.F.col(1).swap(mirrored.F.col(2));
   for (const Mesh& m : {make_capped_cylinder(6, 96, 12), mirrored}) {
-  SolverOptions sparse;
-  sparse.max_dense_paths = 256;
-  FieldDesigner designer(m.V, m.F, sparse);
+  FieldDesigner designer(m.V, m.F, test::sparse_path_options());
   const Solved s = solve_with_features(designer, 30);
   const std::vector<FixedPath>& paths = designer.solver().fixed_paths();
   ASSERT_GT(paths.size(), 256u) << "the dense route would be taken";

@@ -579,9 +579,7 @@ TEST(Formulation, AnnulusAlignedCrossFieldLoopIndices) {
     SCOPED_TRACE("segments " + std::to_string(segments));
     const int N = 4;
     const Mesh m = make_annulus(4, segments);
-    SolverOptions options;
-    options.max_dense_paths = 256;
-    FieldDesigner designer(m.V, m.F, options);
+    FieldDesigner designer(m.V, m.F, test::sparse_path_options());
     const std::map<int, double> aligned = boundary_alignment(designer.V(), designer.topology(), designer.geometry());
     ASSERT_EQ(static_cast<int>(aligned.size()), 2 * segments);
     std::vector<int> faces;

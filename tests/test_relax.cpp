@@ -342,9 +342,7 @@ TEST(Relax, AReachOfThreeEdgesPassesRisesThatStepsStopAt) {
   // off in places, and the energy has rises there that single steps stop at (with the dense route, steps
   // alone get as far as the reach does on this plate).
   const Mesh m = test::perforated_plate(3, 2, 8, 6, 0.15);
-  SolverOptions sparse;
-  sparse.max_dense_paths = 256;
-  FieldDesigner designer(m.V, m.F, sparse);
+  FieldDesigner designer(m.V, m.F, test::sparse_path_options());
   const Topology& t = designer.topology();
   IndexPrescription p = aligned_cross_field(designer, m);
   AutoOptions automatic;
@@ -516,9 +514,7 @@ TEST(Relax, DualsGiveTheExactFirstOrderAndTheEstimateTheSecond) {
   }
   {  // an aligned disk with more fixed-face paths than the dense block takes (their rows among the vertex rows)
     const Mesh m = make_disk(50, 6);
-    SolverOptions sparse;
-    sparse.max_dense_paths = 256;
-    FieldDesigner designer(m.V, m.F, sparse);
+    FieldDesigner designer(m.V, m.F, test::sparse_path_options());
     IndexPrescription p;
     p.N = 4;
     p.fixed = boundary_alignment(m.V, designer.topology(), designer.geometry());

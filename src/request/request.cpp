@@ -304,15 +304,17 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   };
   std::vector<Attempt> attempts{{1.0, request.relax, false}};
   if (escalate) {
+    // The attempts with other moves onto feature lines: only when this search sets the distance and lines exist.
+    const bool onto_attempts = own_onto && !request.split_large_turns && !request_sharp_edges(designer, request).empty();
     if (!request.relax) attempts.push_back({1.0, true, false}), attempts.push_back({1.0, true, true});
-    if (own_onto && !request.split_large_turns && !request_sharp_edges(designer, request).empty())
+    if (onto_attempts)
       attempts.push_back({1.0, request.relax, false, kMapOntoFeaturesFar});
     for (double units : {2.0, 4.0}) attempts.push_back({units, request.relax, false});
     if (!request.relax)
       for (double units : {2.0, 4.0}) attempts.push_back({units, true, false});
     // Last, with a singularity beside a straight feature line moved onto it all the same: one quad gets a flat
     // corner there, where the other placements fold the map.
-    if (own_onto && !request.split_large_turns && !request_sharp_edges(designer, request).empty())
+    if (onto_attempts)
       for (double onto : {kMapOntoFeatures, kMapOntoFeaturesFar}) attempts.push_back({1.0, request.relax, false, onto, true});
   }
   // The attempts from the placement found (the first ones).
