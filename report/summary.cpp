@@ -105,6 +105,7 @@ nlohmann::ordered_json relax_summary_json(const RelaxResult& r) {
           {"cancelled_pairs", cancelled},
           {"candidates_evaluated", r.candidates_evaluated},
           {"converged", r.converged},
+          {"out_of_solves", r.out_of_solves},
           {"seconds", r.seconds}};
   if (r.periods_used) out["periods_before"] = r.periods_before, out["periods_after"] = r.periods_after;
   return out;
@@ -119,8 +120,13 @@ std::string relax_summary_line(const RelaxResult& r) {
   s << std::setprecision(3) << ", " << r.moves.size() << " moves";
   if (cancelled > 0) s << " (" << cancelled << " cancelling a pair)";
   if (r.periods_used) s << ", periods " << r.periods_before << " -> " << r.periods_after;
-  s << ", " << r.candidates_evaluated << " candidate solves, " << r.seconds << " s"
-    << (r.converged ? "" : " (stopped at --relax-max-moves: a move may still lower the energy)");
+  s << ", " << r.candidates_evaluated << " candidate solves, " << r.seconds << " s";
+  if (r.out_of_solves)
+    s << " (stopped at the placement search's budget of candidate solves: a move may still lower the energy)";
+  else if (r.out_of_time)
+    s << " (stopped at the time limit: a move may still lower the energy)";
+  else if (!r.converged)
+    s << " (stopped at --relax-max-moves: a move may still lower the energy)";
   return s.str();
 }
 

@@ -93,6 +93,7 @@ TEST(CliRelax, PinsHoldAndMaxMovesStops) {
   EXPECT_NE(one.out.find(", 1 moves, "), std::string::npos) << one.out;
   EXPECT_NE(one.out.find("(stopped at --relax-max-moves: a move may still lower the energy)"), std::string::npos) << one.out;
   EXPECT_FALSE(nlohmann::json::parse(slurp(report))["relax"]["converged"].get<bool>());
+  EXPECT_FALSE(nlohmann::json::parse(slurp(report))["relax"]["out_of_solves"].get<bool>()) << "no budget of solves from the CLI";
 }
 
 // A +1/4 and a −1/4 two edges apart on a sphere with eight +1/4 more: with --relax-cancel 2 they annihilate

@@ -109,6 +109,23 @@ TEST(Relax, EightQuarterSingularitiesReachTheCubesCorners) {
   for (auto [v, n] : r.prescription.vertex) at.push_back(v);
   EXPECT_EQ(at, corners);
   EXPECT_LT(r.energy_after, 1e-9 * r.energy_before) << "with +1/4 at every corner the field is parallel on each face";
+
+  // A budget of candidate solves stops it where the unbounded run was after as many: the same moves so far.
+  EXPECT_FALSE(r.out_of_solves);
+  EXPECT_FALSE(periods_usable(designer)) << "no fixed faces";
+  ASSERT_GT(r.candidates_evaluated, 4);
+  RelaxOptions budget;
+  budget.max_solves = 4;
+  const RelaxResult cut = relax(designer, p, budget);
+  expect_sound(designer, p, cut, budget);
+  EXPECT_EQ(cut.candidates_evaluated, 4);
+  EXPECT_TRUE(cut.out_of_solves);
+  EXPECT_FALSE(cut.converged);
+  ASSERT_LE(cut.moves.size(), r.moves.size());
+  for (size_t k = 0; k < cut.moves.size(); ++k) {
+    EXPECT_EQ(cut.moves[k].from, r.moves[k].from);
+    EXPECT_EQ(cut.moves[k].to, r.moves[k].to);
+  }
 }
 
 TEST(Relax, PinsHoldAndMaxMovesStops) {
@@ -151,6 +168,8 @@ TEST(Relax, PinsHoldAndMaxMovesStops) {
   EXPECT_EQ(error_of([&] { relax(designer, p, bad); }), "relax: cancel_distance must be at least 0, not -2");
   bad = {}, bad.max_seconds = -1;
   EXPECT_EQ(error_of([&] { relax(designer, p, bad); }), "relax: max_seconds must be at least 0");
+  bad = {}, bad.max_solves = -3;
+  EXPECT_EQ(error_of([&] { relax(designer, p, bad); }), "relax: max_solves must be at least 0, not -3");
 }
 
 // Avoided vertices receive nothing, but a singularity on one may leave; a separation keeps two singularities
@@ -234,6 +253,11 @@ TEST(Relax, AlignedDiskKeepsItsBoundaryAndFixedFaces) {
   const RelaxResult r = relax(designer, p);
   expect_sound(designer, p, r);
   EXPECT_TRUE(r.converged);
+  // One component of fixed faces (the boundary's): no periods to compare.
+  EXPECT_FALSE(periods_usable(designer));
+  RelaxOptions with;
+  with.period_weight = 1;
+  EXPECT_FALSE(relax(designer, p, with).periods_used);
   double closest = 1e300;
   for (auto [a, n] : r.prescription.vertex)
     for (auto [b, k] : r.prescription.vertex)
@@ -327,6 +351,7 @@ TEST(Relax, PeriodsAroundAlignedLoopsArePredictedAndLowered) {
   const RelaxResult r = relax(designer, p, with);
   expect_sound(designer, p, r, with);
   EXPECT_TRUE(r.periods_used);
+  EXPECT_TRUE(periods_usable(designer));
   EXPECT_NEAR(r.periods_before, T0[0] * T0[0] + T0[1] * T0[1], 1e-9 * std::max(1.0, r.periods_before));
   EXPECT_LT(r.periods_after, r.periods_before);
   // Without the weight the periods are not looked at.

@@ -13,7 +13,7 @@
 // of indices (less the cancelled pairs). Generator and loop indices, and the fixed directions, stay as the
 // prescription gives them (free ones are chosen smoothest by every solve, as in any design). A move is
 // accepted only when a real solve (designer.solver().solve) lowers the energy by more than 1e-12 of it;
-// relax stops when no candidate does, or after max_moves moves.
+// relax stops when no candidate does, after max_moves moves, or after max_solves candidate solves.
 //
 // Periods (docs/solver.md, "Periods"). Let s_e = x_e / w_e on the primal edges. At every face f that is not
 // fixed, Σ_{e∈f} g_fe s_e = 0 (g_fe = +1 where f = edge_faces(e, 0), −1 where f = edge_faces(e, 1)): rotating
@@ -63,6 +63,8 @@ struct RelaxOptions {
   int cancel_distance = 0;  // > 0: an index n may meet a −n at most this many edges away, both vanishing; 0: never
   int reach = 1;            // ≥ 1: a singularity may move to a free vertex at most this many edges away in one move
   double max_seconds = 0;   // > 0: stop after about this long (checked between solves), with the moves made so far
+  int max_solves = 0;       // > 0: stop after this many candidate solves, with the moves made so far (unlike
+                            // max_seconds, the same result on every machine)
   // > 0: the objective is E + period_weight · P, P = Σ_C T_C² the squared periods of the conformal scale around
   // the components C of fixed faces (see "Periods" above); 0: E alone. Ignored (RelaxResult::periods_used false)
   // with fewer than two components, or when their sensitivities would take more than kMaxPeriodValues numbers.
@@ -87,8 +89,9 @@ struct RelaxResult {
   bool periods_used = false;     // the objective had the period term (RelaxOptions::period_weight)
   double periods_before = 0, periods_after = 0;  // P = Σ_C T_C² (0 when not used)
   int candidates_evaluated = 0;  // real solves of candidate moves
-  bool converged = false;        // stopped because no candidate lowers the energy (not at max_moves or max_seconds)
+  bool converged = false;        // stopped because no candidate lowers the energy (not at max_moves, max_seconds or max_solves)
   bool out_of_time = false;      // stopped at max_seconds
+  bool out_of_solves = false;    // stopped at max_solves
   double seconds = 0;
 };
 
@@ -114,8 +117,11 @@ struct RelaxCandidate {
 std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, const IndexPrescription& prescription,
                                              const Connection& connection, const RelaxOptions& options = {});
 
+// Whether relax with period_weight > 0 would use the periods with designer's fixed faces (RelaxResult::periods_used:
+// at least two components, and their sensitivities within kMaxPeriodValues numbers).
+bool periods_usable(const FieldDesigner& designer);
 // Relaxes `start` as above; throws trivcon::Error for an invalid prescription (as a design would), a pin out
-// of range, a negative max_moves, cancel_distance, max_seconds or period_weight, or a reach below 1. Polls
+// of range, a negative max_moves, cancel_distance, max_seconds, max_solves or period_weight, or a reach below 1. Polls
 // trivcon/cancel.h once per candidate solve.
 RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start, const RelaxOptions& options = {});
 

@@ -130,7 +130,7 @@ struct MapOutcome {
   Parametrization param;   // not made (empty) when the field did not pass verification
   int placements = 1;      // automatic placements tried (map_request)
   double cancel_units = 0; // with automatic placement: the cancel distance used, in units of the map (0: the request's own)
-  int first_problems = 0;  // the first attempt's problems (below), when it was placed again
+  int first_problems = 0;  // the first attempt's problems (below; its map made without retries), when it was placed again
   double first_distortion = 0;  // the first attempt's mean singular-value ratio, when it was placed again
   bool relaxed = false;    // the kept placement was relaxed by map_request (not by the request's own relax)
   bool periods = false;    // and with the periods in the objective (kMapPeriodWeight)
@@ -149,6 +149,10 @@ inline constexpr double kMapDistortionGoal = 1.5;
 inline constexpr double kMapPeriodWeight = 3;
 // The reach (RelaxOptions::reach) of map_request's relaxed attempts.
 inline constexpr int kMapRelaxReach = 3;
+// The candidate solves (RelaxOptions::max_solves) of each of map_request's own relaxations: kMapRelaxWork / the
+// mesh's vertices (a solve costs about one back-substitution), at least kMapRelaxMinSolves.
+inline constexpr double kMapRelaxWork = 6e7;
+inline constexpr int kMapRelaxMinSolves = 500;
 // map_request does not relax a placement whose first attempt has more singularities than this (each move ranks
 // every singularity's candidates again).
 inline constexpr size_t kMapRelaxMaxSingularities = 600;
@@ -163,8 +167,11 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // give a map without folds), then those relaxed, and last (with sharp edges) moved onto the lines from
 // kMapOntoFeatures and kMapOntoFeaturesFar units also onto sectors where a quad gets a flat corner
 // (AutoOptions::onto_flat_sectors); with the request's own relax, every placement is relaxed. A
-// placement equal to an earlier one is not mapped again, and none is relaxed when the first has more than
-// kMapRelaxMaxSingularities singularities. The search ends at the first map without problems
+// placement equal to an earlier one is not mapped again, one equal before relaxation is not relaxed again, the
+// periods' relaxation is skipped where they are not used (periods_usable), none is relaxed when the first has
+// more than kMapRelaxMaxSingularities singularities, and each relaxation stops at its budget (kMapRelaxWork).
+// While other attempts may follow, the maps are made without ParamOptions::retries; the kept map is made again
+// with them when it has problems. The search ends at the first map without problems
 // within the goal, or without problems once the placement found was mapped as found and relaxed both ways; the kept map is the one with the fewest
 // problems, then the least stretch beyond the goal (the earliest of equals). `request` is left as the kept one
 // was made.

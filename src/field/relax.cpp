@@ -30,6 +30,7 @@ std::vector<char> pinned_vertices(const Topology& t, const RelaxOptions& options
   if (options.reach < 1) throw Error("relax: reach must be at least 1, not " + std::to_string(options.reach));
   if (!(options.period_weight >= 0) || !std::isfinite(options.period_weight)) throw Error("relax: period_weight must be a finite number of at least 0");
   if (!(options.max_seconds >= 0)) throw Error("relax: max_seconds must be at least 0");
+  if (options.max_solves < 0) throw Error("relax: max_solves must be at least 0, not " + std::to_string(options.max_solves));
   if (!(options.separation >= 0) || !std::isfinite(options.separation)) throw Error("relax: separation must be a finite distance of at least 0");
   std::vector<char> pinned(t.num_vertices, 0);
   for (int v : options.pins) {
@@ -98,13 +99,11 @@ struct Periods {
   }
 };
 
-Periods make_periods(const FieldDesigner& designer, double weight) {
-  Periods p;
-  if (!(weight > 0)) return p;
+// The components of the fixed faces through shared vertices (union-find over their vertices), in the order of
+// their first face.
+std::vector<std::vector<int>> fixed_face_components(const FieldDesigner& designer) {
   const Topology& t = designer.topology();
-  const ConnectionSolver& solver = designer.solver();
-  const std::vector<int>& fixed = solver.fixed_faces();
-  // Components through shared vertices (union-find over the vertices of fixed faces).
+  const std::vector<int>& fixed = designer.solver().fixed_faces();
   std::vector<int> parent(t.num_vertices, -1);
   auto find = [&](int a) {
     while (parent[a] != a) a = parent[a] = parent[parent[a]];
@@ -115,14 +114,27 @@ Periods make_periods(const FieldDesigner& designer, double weight) {
       if (parent[t.F(f, k)] < 0) parent[t.F(f, k)] = t.F(f, k);
   for (int f : fixed)
     for (int k = 1; k < 3; ++k) parent[find(t.F(f, k))] = find(t.F(f, 0));
+  std::vector<std::vector<int>> components;
   std::map<int, int> component_of_root;
   for (int f : fixed) {
-    const auto [it, added] = component_of_root.emplace(find(t.F(f, 0)), static_cast<int>(p.components.size()));
-    if (added) p.components.emplace_back();
-    p.components[it->second].push_back(f);
+    const auto [it, added] = component_of_root.emplace(find(t.F(f, 0)), static_cast<int>(components.size()));
+    if (added) components.emplace_back();
+    components[it->second].push_back(f);
   }
-  if (p.components.size() < 2 ||
-      static_cast<double>(p.components.size()) * t.num_vertices > kMaxPeriodValues) {
+  return components;
+}
+
+bool usable(const std::vector<std::vector<int>>& components, const Topology& t) {
+  return components.size() >= 2 && static_cast<double>(components.size()) * t.num_vertices <= kMaxPeriodValues;
+}
+
+Periods make_periods(const FieldDesigner& designer, double weight) {
+  Periods p;
+  if (!(weight > 0)) return p;
+  const Topology& t = designer.topology();
+  const ConnectionSolver& solver = designer.solver();
+  p.components = fixed_face_components(designer);
+  if (!usable(p.components, t)) {
     p.components.clear();
     return p;
   }
@@ -146,6 +158,8 @@ std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const I
                                           const Connection& connection, const RelaxOptions& options, const Periods& periods);
 
 }  // namespace
+
+bool periods_usable(const FieldDesigner& designer) { return usable(fixed_face_components(designer), designer.topology()); }
 
 std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, const IndexPrescription& prescription,
                                              const Connection& connection, const RelaxOptions& options) {
@@ -324,6 +338,10 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
         r.out_of_time = true;
         break;
       }
+      if (options.max_solves > 0 && r.candidates_evaluated >= options.max_solves) {
+        r.out_of_solves = true;
+        break;
+      }
       IndexPrescription p = r.prescription;
       apply(move, p);
       Connection next = solver.solve(p);
@@ -349,7 +367,7 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
       moved = true;
       break;
     }
-    if (r.out_of_time) break;
+    if (r.out_of_time || r.out_of_solves) break;
     if (moved) {
       checking = false;
     } else if (!checking && !held) {

@@ -8,7 +8,9 @@
 #include <limits>
 #include <map>
 #include <queue>
+#include <set>
 #include <string>
+#include <tuple>
 
 #include "trivcon/error.h"
 
@@ -302,11 +304,16 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     double onto = kMapOntoFeatures;  // singularities moved onto feature lines from this many units
     bool flat = false;               // and onto sectors whose quad corners would be flat (AutoOptions::onto_flat_sectors)
   };
+  const std::vector<int> sharp = request_sharp_edges(designer, request);
+  // The edges on iso-lines (the relaxation keeps singularities away from them; the periods are theirs).
+  const std::vector<int> aligned = request_param_options(designer, request, sharp, edge_length, target_faces).aligned_edges;
   std::vector<Attempt> attempts{{1.0, request.relax, false}};
   if (escalate) {
     // The attempts with other moves onto feature lines: only when this search sets the distance and lines exist.
-    const bool onto_attempts = own_onto && !request.split_large_turns && !request_sharp_edges(designer, request).empty();
-    if (!request.relax) attempts.push_back({1.0, true, false}), attempts.push_back({1.0, true, true});
+    const bool onto_attempts = own_onto && !request.split_large_turns && !sharp.empty();
+    // (Without aligned edges there are no periods: that relaxation would repeat the one before.)
+    if (!request.relax) attempts.push_back({1.0, true, false});
+    if (!request.relax && !aligned.empty()) attempts.push_back({1.0, true, true});
     if (onto_attempts)
       attempts.push_back({1.0, request.relax, false, kMapOntoFeaturesFar});
     for (double units : {2.0, 4.0}) attempts.push_back({units, request.relax, false});
@@ -325,10 +332,23 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   int tried = 0, kept_at = 0, maps = 0;
   size_t first_singularities = 0;  // the first placement's
   std::vector<std::map<int, int>> placed;  // each map's singularities
+  // The placements before relaxation, by the attempt's units, distance onto the lines and flat sectors (each
+  // relaxed attempt follows the same one unrelaxed), and the ones relaxed, with the periods or without.
+  using PlacementKey = std::tuple<double, double, bool>;
+  std::map<PlacementKey, std::map<int, int>> unrelaxed;
+  std::set<std::pair<std::map<int, int>, bool>> relaxed_from;
+  // The maps are made without ParamOptions::retries while other attempts may follow (a retry costs up to a few
+  // maps, another placement often mends more); the kept map is made again with them if it still has problems.
+  const bool screen = attempts.size() > 1;
   for (const Attempt& attempt : attempts) {
+    const PlacementKey key{attempt.units, attempt.onto, attempt.flat};
+    const bool own_relax = attempt.relax && !request.relax;
     // Each accepted move ranks every singularity's candidates again: past kMapRelaxMaxSingularities (cheese,
-    // genus 133: 1,412 −1/4) a relaxation takes minutes, so those placements are not relaxed here.
-    if (attempt.relax && !request.relax && first_singularities > kMapRelaxMaxSingularities) {
+    // genus 133: 1,412 −1/4) a relaxation takes minutes, so those placements are not relaxed here. Nor are
+    // those relaxed already (the same start, the same result), nor with periods where there are none.
+    const auto start = unrelaxed.find(key);
+    if (own_relax && (first_singularities > kMapRelaxMaxSingularities || (attempt.periods && !periods_usable(designer)) ||
+                      (start != unrelaxed.end() && relaxed_from.count({start->second, attempt.periods})))) {
       ++tried;
       continue;
     }
@@ -339,13 +359,16 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     if (attempt.relax) {
       // The relaxation keeps singularities a unit away from the aligned lines: the energy draws a −1/4 toward a
       // round hole's boundary, where the rounding would put it on the boundary's iso-line.
-      const std::vector<int> aligned = request_param_options(designer, r, request_sharp_edges(designer, r), edge_length, target_faces).aligned_edges;
       r.relax_options.avoid = vertices_near_edges(designer, aligned, unit);
       // and a unit from each other: two closer than that can be rounded onto one integer point.
       r.relax_options.separation = unit;
       if (attempt.periods) r.relax_options.period_weight = kMapPeriodWeight;
       // and a singularity may jump up to kMapRelaxReach edges: steps alone stop in a crowd along the aligned lines.
       r.relax_options.reach = std::max(r.relax_options.reach, kMapRelaxReach);
+      // Its candidate solves are bounded (each costs about one back-substitution, so in proportion to the
+      // vertices): with hundreds of singularities on a large mesh a relaxation would take minutes.
+      if (own_relax && r.relax_options.max_solves == 0)
+        r.relax_options.max_solves = std::max(kMapRelaxMinSolves, static_cast<int>(kMapRelaxWork / std::max(1, designer.topology().num_vertices)));
     }
     MapOutcome m;
     m.field = solve_request(designer, F, r);
@@ -358,11 +381,14 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
       continue;
     }
     if (tried == 1) first_singularities = m.field.prescription.vertex.size();
+    if (!attempt.relax) unrelaxed.emplace(key, m.field.prescription.vertex);
+    if (own_relax && start != unrelaxed.end()) relaxed_from.insert({start->second, attempt.periods});
     // The same singularities as an earlier attempt (nothing closer than the new distance to cancel): the same map.
     if (std::find(placed.begin(), placed.end(), m.field.prescription.vertex) != placed.end()) continue;
     placed.push_back(m.field.prescription.vertex);
     ++maps;
     ParamOptions options = request_param_options(designer, r, m.field, edge_length, target_faces);
+    if (screen) options.retries = 0;
     m.param = parametrize(m.field.designer(designer), m.field.design, options);
     if (quads) m.quads = extract_quads(m.field.designer(designer), m.param);
     m.cancel_units = escalate ? attempt.units : 0.0;
@@ -386,6 +412,11 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   // was made; solving the kept request again would place and relax again for the same result).
   if (kept_at != tried && designer.fixed_faces() != best.field.constraints.fixed_faces)
     designer.set_fixed_faces(best.field.constraints.fixed_faces);
+  if (screen && best.field.verified && problems(best) > 0) {
+    ParamOptions options = request_param_options(designer, kept, best.field, edge_length, target_faces);
+    best.param = parametrize(best.field.designer(designer), best.field.design, options);
+    if (quads) best.quads = extract_quads(best.field.designer(designer), best.param);
+  }
   best.placements = maps;
   if (maps == 1) best.first_problems = 0, best.first_distortion = 0;
   request = kept;
