@@ -642,7 +642,8 @@ async function makeQuads() {
     const q = r.report.quad;
     const irregular = q.singular_mismatches === 0 ? 'all at the singularities' : `${q.singular_mismatches} NOT at a singularity of their valence`;
     $('quadinfo').textContent = `${q.quads} quads (target ${target}), ${q.irregular_vertices} irregular vertices (${irregular}), ` +
-      `chi ${q.euler_characteristic}, scaled Jacobian min ${q.min_scaled_jacobian.toFixed(3)}, mean ${q.mean_scaled_jacobian.toFixed(3)}` +
+      `chi ${q.euler_characteristic}, scaled Jacobian min ${q.min_scaled_jacobian.toFixed(3)}, mean ${q.mean_scaled_jacobian.toFixed(3)}, ` +
+      `${q.nonconvex_quads} with a flat or reflex corner` +
       (r.report.warning ? `. ${r.report.warning}` : '');
     $('dl-quads').disabled = false;
     status(r.report.warning ? 'quads: made, with problems (see Quads)' : `quads: ${q.quads} made`);

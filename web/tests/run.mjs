@@ -373,6 +373,9 @@ async function main() {
       assert.equal(r.vertices - edges.size + r.quads, 2);
       assert.equal(await T(() => window.__trivcon.quadSegments), 4 * r.quads);
       assert.match(await T(() => window.__trivcon.quadInfo), new RegExp(`^${r.quads} quads \\(target 2000\\), ${sing.length} irregular vertices \\(all at the singularities\\)`));
+      // The worst corners: how many quads have a flat or reflex one (the report's count).
+      assert.ok(Number.isInteger(r.nonconvex_quads));
+      assert.match(await T(() => window.__trivcon.quadInfo), new RegExp(`, ${r.nonconvex_quads} with a flat or reflex corner`));
       assert.equal(await T(() => document.getElementById('dl-quads').disabled), false);
       await page.click('#showquads');
       assert.equal(await T(() => window.__trivcon.quadSegments), 0);
