@@ -149,9 +149,11 @@ inline constexpr double kMapDistortionGoal = 1.5;
 inline constexpr double kMapPeriodWeight = 3;
 // The reach (RelaxOptions::reach) of map_request's relaxed attempts.
 inline constexpr int kMapRelaxReach = 3;
-// The candidate solves (RelaxOptions::max_solves) of each of map_request's own relaxations: kMapRelaxWork / the
-// mesh's vertices (a solve costs about one back-substitution), at least kMapRelaxMinSolves.
-inline constexpr double kMapRelaxWork = 6e7;
+// The candidate solves (RelaxOptions::max_solves) of each of map_request's own relaxations: kMapRelaxSolves per
+// singularity of its start (each moves a few edges, a move costs some tens of solves), but at most kMapRelaxWork
+// / the mesh's vertices (a solve costs about one back-substitution), and at least kMapRelaxMinSolves.
+inline constexpr int kMapRelaxSolves = 50;
+inline constexpr double kMapRelaxWork = 3e8;
 inline constexpr int kMapRelaxMinSolves = 500;
 // map_request does not relax a placement whose first attempt has more singularities than this (each move ranks
 // every singularity's candidates again).
@@ -169,7 +171,7 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // (AutoOptions::onto_flat_sectors); with the request's own relax, every placement is relaxed. A
 // placement equal to an earlier one is not mapped again, one equal before relaxation is not relaxed again, the
 // periods' relaxation is skipped where they are not used (periods_usable), none is relaxed when the first has
-// more than kMapRelaxMaxSingularities singularities, and each relaxation stops at its budget (kMapRelaxWork).
+// more than kMapRelaxMaxSingularities singularities, and each relaxation stops at its budget (kMapRelaxSolves, kMapRelaxWork).
 // While other attempts may follow, the maps are made without ParamOptions::retries; the kept map is made again
 // with them when it has problems. The search ends at the first map without problems
 // within the goal, or without problems once the placement found was mapped as found and relaxed both ways; the kept map is the one with the fewest

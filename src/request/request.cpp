@@ -365,10 +365,13 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
       if (attempt.periods) r.relax_options.period_weight = kMapPeriodWeight;
       // and a singularity may jump up to kMapRelaxReach edges: steps alone stop in a crowd along the aligned lines.
       r.relax_options.reach = std::max(r.relax_options.reach, kMapRelaxReach);
-      // Its candidate solves are bounded (each costs about one back-substitution, so in proportion to the
-      // vertices): with hundreds of singularities on a large mesh a relaxation would take minutes.
-      if (own_relax && r.relax_options.max_solves == 0)
-        r.relax_options.max_solves = std::max(kMapRelaxMinSolves, static_cast<int>(kMapRelaxWork / std::max(1, designer.topology().num_vertices)));
+      // Its candidate solves are bounded: with hundreds of singularities on a large mesh a relaxation would take
+      // minutes.
+      if (own_relax && r.relax_options.max_solves == 0) {
+        const double singularities = static_cast<double>(start != unrelaxed.end() ? start->second.size() : first_singularities);
+        const double work = kMapRelaxWork / std::max(1, designer.topology().num_vertices);
+        r.relax_options.max_solves = std::max(kMapRelaxMinSolves, static_cast<int>(std::min(kMapRelaxSolves * singularities, work)));
+      }
     }
     MapOutcome m;
     m.field = solve_request(designer, F, r);
