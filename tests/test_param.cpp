@@ -212,6 +212,37 @@ TEST(Param, ArmadilloFoldsAreUntangled) {
   }
 }
 
+// The near-miss retries resumed from a map made without them (what a search that screens many maps does) give
+// the map parametrize gives with them, without making the screened maps again. Genus 4 at 120 squares: the first
+// map and its unit-size variant keep folds, a retry at another edge length has none.
+TEST(Param, RetriesResumeFromTheScreenedMap) {
+  const Mesh m = make_genus_surface(4, 3);
+  FieldRequest req;
+  req.auto_place = true;
+  ParamOptions o;
+  o.target_faces = 120;
+  const MapRun whole = run(m, req, o);
+  ParamOptions screening = o;
+  screening.retries = 0;
+  const MapRun screened = run(m, req, screening);
+  const ParamQuality& s = screened.param.quality;
+  ASSERT_GT(s.flipped_faces + s.degenerate_faces + s.winding_errors, 0);  // the case this test is for
+  EXPECT_EQ(s.attempts, 2);
+  EXPECT_GT(s.first_factorizations, 0);
+  const Parametrization resumed = parametrize_retries(*screened.designer, screened.outcome.design, o, screened.param);
+  EXPECT_GT(resumed.quality.attempts, 2);
+  EXPECT_EQ(resumed.quality.attempts, whole.param.quality.attempts);
+  EXPECT_EQ(resumed.quality.flipped_faces + resumed.quality.degenerate_faces + resumed.quality.winding_errors, 0) << param_warning(resumed);
+  EXPECT_TRUE(resumed.uv == whole.param.uv);
+  EXPECT_EQ(resumed.cut_edges, whole.param.cut_edges);
+  EXPECT_TRUE(resumed.translation == whole.param.translation);
+  EXPECT_EQ(resumed.edge_length, whole.param.edge_length);
+  // A map that parametrize did not make (no first factorizations recorded) is refused.
+  Parametrization foreign = screened.param;
+  foreign.quality.first_factorizations = 0;
+  EXPECT_THROW(parametrize_retries(*screened.designer, screened.outcome.design, o, foreign), Error);
+}
+
 TEST(Param, SeveralComponents) {
   const Mesh m = concatenate({make_torus(36, 12), make_cube_sphere(4, true), make_disk(6, 8)});
   FieldRequest req;

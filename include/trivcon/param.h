@@ -72,6 +72,7 @@ struct ParamQuality {
   // the quad mesh gets a vertex of another valence than the singularities say (0 expected).
   int winding_errors = 0;
   int attempts = 1;           // maps made (ParamOptions::retries); the one kept is described here
+  int first_factorizations = 0;  // the first map's factorizations (the retries' budget counts against them)
   std::vector<int> first_flipped;  // up to 10 ids of flipped or degenerate faces
   double max_transition_residual = 0;  // over cut edges: how far φ_R − J^r φ_L is from one whole vector at both ends
   double max_cone_offset = 0;          // distance of a singular vertex's (u, v) from the nearest integer point
@@ -110,6 +111,13 @@ struct Parametrization {
 // The map of `design`'s field (N = 4) on `designer`'s mesh. Throws trivcon::Error for another N, a missing
 // or non-positive scale, an aligned edge id out of range, or a system our factorization finds not positive definite.
 Parametrization parametrize(const FieldDesigner& designer, const Design& design, const ParamOptions& options);
+
+// The near-miss retries alone, resumed from `screened`: a map parametrize made with the same designer, design and
+// options but retries = 0. The result equals parametrize(designer, design, options); the maps `screened` made
+// are not made again (a search that screens many fields' maps retries only the one it keeps). Throws
+// trivcon::Error when `screened` does not come from parametrize.
+Parametrization parametrize_retries(const FieldDesigner& designer, const Design& design, const ParamOptions& options,
+                                    const Parametrization& screened);
 
 // The (u, v) of the corners of the input's faces `F` (the faces the designer was built from), F × 6: (u, v)
 // of corner 0, 1, 2 in the input's corner order.

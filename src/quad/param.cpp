@@ -1196,6 +1196,49 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   return out;
 }
 
+int problems(const ParamQuality& q) { return q.flipped_faces + q.degenerate_faces + q.winding_errors; }
+
+// The sizing moves the rounding's integers: where its map keeps problems, the map of the field's unit size is
+// made too, and the one with fewer problems kept; the retries try both.
+std::vector<ParamOptions> size_variants(const ParamOptions& options) {
+  std::vector<ParamOptions> variants{options};
+  if (options.sizing_rounds > 0) {
+    variants.push_back(options);
+    variants.back().sizing_rounds = 0;
+  }
+  return variants;
+}
+
+// The near-miss retries from `best`, the first map (or its unit-size variant) with the search's time so far.
+Parametrization retry_near_miss(const FieldDesigner& designer, const Design& design, const ParamOptions& options, Parametrization best,
+                                linalg::Clock::time_point start, double seconds_before) {
+  const int first_factorizations = best.quality.first_factorizations;
+  int retry_factorizations = 0;
+  const int near_miss = std::max(16, best.quality.faces / 20000);
+  bool necessary = false;
+  for (int n : best.cone_index) necessary |= n >= 4;
+  const std::vector<ParamOptions> variants = size_variants(options);
+  const int n = static_cast<int>(variants.size());
+  int attempts = best.quality.attempts, retried = 0;
+  best.quality.seconds_retries = 0;
+  if (problems(best.quality) > 0 && problems(best.quality) <= near_miss && !necessary)
+    for (double scale : {0.97, 1.03, 0.94, 1.06})
+      for (const ParamOptions& variant : variants) {
+        // At most `retries` edge lengths, and while they have cost less than twice the first per variant, counted
+        // in factorizations (each a solve's main cost; unlike wall time, the same on every machine, so the same map
+        // everywhere).
+        if (problems(best.quality) == 0 || retried >= options.retries * n || retry_factorizations >= 2 * n * first_factorizations) break;
+        Parametrization other = parametrize_at(designer, design, variant, scale);
+        ++attempts, ++retried;
+        retry_factorizations += other.quality.factorizations;
+        if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other);
+      }
+  best.quality.attempts = attempts;
+  best.quality.first_factorizations = first_factorizations;
+  best.quality.seconds_retries = seconds_before + linalg::seconds_since(start) - best.quality.seconds_total();  // the attempts not kept
+  return best;
+}
+
 }  // namespace
 
 // The rounding's outcome is sensitive to the scale: a map left with a few folds or wrong windings (a near miss)
@@ -1206,41 +1249,22 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   const auto start = linalg::Clock::now();
   Parametrization best = parametrize_at(designer, design, options, 1.0);
   const int first_factorizations = best.quality.factorizations;
-  int retry_factorizations = 0;
-  auto problems = [](const ParamQuality& q) { return q.flipped_faces + q.degenerate_faces + q.winding_errors; };
-  const int near_miss = std::max(16, best.quality.faces / 20000);
-  bool necessary = false;
-  for (int n : best.cone_index) necessary |= n >= 4;
+  const std::vector<ParamOptions> variants = size_variants(options);
   int attempts = 1;
-  // The sizing moves the rounding's integers: where its map keeps problems, the map of the field's unit size is
-  // made too, and the one with fewer problems kept; the retries below try both.
-  std::vector<ParamOptions> variants{options};
-  if (options.sizing_rounds > 0) {
-    variants.push_back(options);
-    variants.back().sizing_rounds = 0;
-  }
   if (problems(best.quality) > 0 && variants.size() > 1) {
     Parametrization other = parametrize_at(designer, design, variants[1], 1.0);
     ++attempts;
     if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other);
   }
-  int retried = 0;
-  if (problems(best.quality) > 0 && problems(best.quality) <= near_miss && !necessary)
-    for (double scale : {0.97, 1.03, 0.94, 1.06})
-      for (const ParamOptions& variant : variants) {
-        // At most `retries` edge lengths, and while they have cost less than twice the first per variant, counted
-        // in factorizations (each a solve's main cost; unlike wall time, the same on every machine, so the same map
-        // everywhere).
-        const int n = static_cast<int>(variants.size());
-        if (problems(best.quality) == 0 || retried >= options.retries * n || retry_factorizations >= 2 * n * first_factorizations) break;
-        Parametrization other = parametrize_at(designer, design, variant, scale);
-        ++attempts, ++retried;
-        retry_factorizations += other.quality.factorizations;
-        if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other);
-      }
   best.quality.attempts = attempts;
-  best.quality.seconds_retries = linalg::seconds_since(start) - best.quality.seconds_total();  // the attempts not kept
-  return best;
+  best.quality.first_factorizations = first_factorizations;
+  return retry_near_miss(designer, design, options, std::move(best), start, 0.0);
+}
+
+Parametrization parametrize_retries(const FieldDesigner& designer, const Design& design, const ParamOptions& options,
+                                    const Parametrization& screened) {
+  if (screened.quality.first_factorizations <= 0) throw Error("param: the map to resume was not made by parametrize");
+  return retry_near_miss(designer, design, options, screened, linalg::Clock::now(), screened.quality.seconds_total());
 }
 
 Eigen::MatrixXd input_corner_uv(const Parametrization& param, const Topology& topology, const MatrixX3i& F) {

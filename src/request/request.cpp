@@ -338,7 +338,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   std::map<PlacementKey, std::map<int, int>> unrelaxed;
   std::set<std::pair<std::map<int, int>, bool>> relaxed_from;
   // The maps are made without ParamOptions::retries while other attempts may follow (a retry costs up to a few
-  // maps, another placement often mends more); the kept map is made again with them if it still has problems.
+  // maps, another placement often mends more); the kept map's retries follow if it still has problems.
   const bool screen = attempts.size() > 1;
   for (const Attempt& attempt : attempts) {
     const PlacementKey key{attempt.units, attempt.onto, attempt.flat};
@@ -416,9 +416,12 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   if (kept_at != tried && designer.fixed_faces() != best.field.constraints.fixed_faces)
     designer.set_fixed_faces(best.field.constraints.fixed_faces);
   if (screen && best.field.verified && problems(best) > 0) {
+    // Its first maps (at the edge length and at the field's unit size) were made while screening: the retries
+    // resume from them.
     ParamOptions options = request_param_options(designer, kept, best.field, edge_length, target_faces);
-    best.param = parametrize(best.field.designer(designer), best.field.design, options);
-    if (quads) best.quads = extract_quads(best.field.designer(designer), best.param);
+    Parametrization param = parametrize_retries(best.field.designer(designer), best.field.design, options, best.param);
+    if (quads && param.uv != best.param.uv) best.quads = extract_quads(best.field.designer(designer), param);
+    best.param = std::move(param);
   }
   best.placements = maps;
   if (maps == 1) best.first_problems = 0, best.first_distortion = 0;
