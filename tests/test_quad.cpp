@@ -441,6 +441,53 @@ TEST(Quad, DiskAndGridsEndOnTheirAlignedBoundary) {
   }
 }
 
+// A parallelogram (the unit square's grid sheared by `degrees`): at two of its corners one triangle holds both
+// boundary edges, so its field follows one of them and meets the other off a right angle. Within
+// kAlignedEdgeTolerance that edge is put on an iso-line too, and the corner becomes a quad corner: the quads are
+// the sheared grid itself, with no trace leaving the surface.
+Mesh parallelogram(int n, double degrees) {
+  Mesh m;
+  const double shear = std::tan(degrees * 3.141592653589793 / 180);
+  m.V.resize((n + 1) * (n + 1), 3);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) m.V.row(j * (n + 1) + i) << (i + shear * j) / n, static_cast<double>(j) / n, 0;
+  m.F.resize(2 * n * n, 3);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, f = 2 * (j * n + i);
+      m.F.row(f) << a, a + 1, a + n + 2;
+      m.F.row(f + 1) << a, a + n + 2, a + n + 1;
+    }
+  return m;
+}
+
+TEST(Quad, ParallelogramCornersInOneTriangleBecomeQuadCorners) {
+  FieldRequest req;
+  req.align_boundary = true;
+  req.auto_place = true;
+  for (double degrees : {10.0, 20.0, 25.0}) {
+    ParamOptions o;
+    o.target_faces = 100;
+    const Pipeline r = run(parallelogram(20, degrees), req, o);
+    const std::string what = "sheared by " + std::to_string(degrees) + " degrees";
+    EXPECT_EQ(r.param.quality.unaligned_edges, 0) << what;
+    EXPECT_EQ(r.param.quality.flipped_faces + r.param.quality.degenerate_faces, 0) << what << ": " << param_warning(r.param);
+    expect_clean(r, what);
+    EXPECT_EQ(r.quads.quality.irregular_vertices, 0) << what;
+    if (degrees > 20) continue;  // valid, but not the grid itself
+    EXPECT_EQ(r.quads.quality.quads, 100) << what;
+    // Every quad is the grid's parallelogram: its scaled Jacobian is the cosine of the shear.
+    EXPECT_NEAR(r.quads.quality.min_scaled_jacobian, std::cos(degrees * 3.141592653589793 / 180), 0.02) << what;
+  }
+  // Past the tolerance (a corner of 45° off a right angle cannot be a quad corner) the edge is left unaligned and
+  // counted; the quads say why they fail.
+  ParamOptions o;
+  o.target_faces = 100;
+  const Pipeline r = run(parallelogram(20, 45), req, o);
+  EXPECT_GT(r.param.quality.unaligned_edges, 0);
+  EXPECT_FALSE(r.quads.quality.problems.empty());
+}
+
 TEST(Quad, UnalignedBoundaryIsReported) {
   // Without the boundary on iso-lines the traces leave the surface there: said, not hidden.
   ParamOptions o;

@@ -29,12 +29,18 @@
 
 namespace trivcon {
 
+// An aligned edge is put on an iso-line in each face beside it whose field runs along it or across it within
+// this angle (radians, π/6): where one triangle holds two boundary or sharp edges meeting between 60° and 120°
+// (or 150° and 210°), its field follows one and the other is aligned too, the corner a quad corner; further off
+// the edge is left unaligned (counted in ParamQuality::unaligned_edges) rather than folding the map.
+constexpr double kAlignedEdgeTolerance = 0.5235987755982988;
+
 struct ParamOptions {
   double edge_length = 0;   // the quad edge length in the mesh's units (> 0 wins over target_faces)
   double target_faces = 0;  // otherwise: about this many unit squares (edge_length = √(area / target_faces))
   // Edges to put on integer iso-lines (topology edge ids): boundary edges (align_boundary) and sharp edges.
-  // An edge is aligned in each face beside it whose field runs along it or across it (within 0.1 rad);
-  // the others are counted in ParamQuality::unaligned_edges.
+  // An edge is aligned in each face beside it whose field runs along it or across it (within
+  // kAlignedEdgeTolerance); the others are counted in ParamQuality::unaligned_edges.
   std::vector<int> aligned_edges;
   // Greedy rounding: each round fixes the integers nearest to whole numbers, this fraction of those left (at
   // least one), then re-solves.

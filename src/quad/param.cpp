@@ -335,7 +335,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       const double relative = g.half_edge_angle(f, k) - theta[f];
       const double quarters = relative / (kPi / 2);
       const double nearest = std::round(quarters);
-      if (std::abs(quarters - nearest) * (kPi / 2) > 0.1) continue;
+      if (std::abs(quarters - nearest) * (kPi / 2) > kAlignedEdgeTolerance) continue;
       const int along = ((static_cast<long long>(nearest) % 2) + 2) % 2;  // 0: along ±u (v constant), 1: along ±v
       aligned.emplace_back(e, f);
       aligned_coordinate.push_back(along == 0 ? 1 : 0);
