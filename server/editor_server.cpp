@@ -1238,7 +1238,16 @@ struct EditorServer::Impl {
                 {
                   CancelScope scope(stop_flag);  // SIGTERM ends it between two solves
                   try {
-                    x = with_designer(r.fixed_faces, [&](const FieldDesigner& d) { return relax(d, r.prescription, o); });
+                    x = with_designer(r.fixed_faces, [&](const FieldDesigner& d) {
+                      std::optional<Field> guide;  // after Auto: the fixed-face paths' turns, as request_design reads them
+                      {
+                        std::lock_guard guide_lock(auto_guide_mutex);
+                        guide = auto_guide;
+                      }
+                      IndexPrescription p = r.prescription;
+                      guide_paths(d, p, guide ? &*guide : nullptr);
+                      return relax(d, p, o);
+                    });
                   } catch (const Cancelled&) {
                     throw BadRequest{503, "the editor is stopping"};
                   }

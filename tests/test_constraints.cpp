@@ -307,6 +307,69 @@ TEST(Constraints, SparsePathsTakeTheSmallestTurnEitherWay) {
   EXPECT_GT(one_edge, 50);
 }
 
+// With a path guide (IndexPrescription::path_guide) the sparse route takes each path's whole turns from the
+// guide: the connection turns along every path, relative to parallel transport, exactly as the guide does, where
+// the guide turns by less than π/N across each edge and holds the fixed directions. Here the guide is a direction
+// winding at 6 radians per unit across the disk, every 40th face fixed to it: paths of several edges turn by more
+// than π/N, where the smallest turn per path (no guide) takes another. A guide of another size, or with a NaN,
+// is refused.
+TEST(Constraints, SparsePathsFollowTheirGuide) {
+  const Mesh m = make_disk(24, 12);
+  SolverOptions options;
+  options.max_dense_paths = 0;  // always the sparse route
+  FieldDesigner d(m.V, m.F, options);
+  const Topology& t = d.topology();
+  IndexPrescription p;
+  p.N = 4;
+  for (int f = 0; f < m.F.rows(); ++f) {
+    const Eigen::Vector3d centre = (m.V.row(m.F(f, 0)) + m.V.row(m.F(f, 1)) + m.V.row(m.F(f, 2))).transpose() / 3;
+    p.path_guide.push_back(d.geometry().angle_in_face(f, Eigen::Vector3d(std::cos(6 * centre.x()), std::sin(6 * centre.x()), 0)));
+    if (f % 40 == 0) p.fixed[f] = p.path_guide.back();
+  }
+  d.set_fixed_faces(keys(p.fixed));
+  ASSERT_TRUE(d.solver().sparse_paths());
+  const double step = kPi / 2;
+  auto reduced = [step](double a) { return a - step * std::floor(a / step + 0.5); };
+  IndexPrescription unguided_prescription = p;
+  unguided_prescription.path_guide.clear();
+  const Design guided = d.design(p), unguided = d.design(unguided_prescription);
+  EXPECT_TRUE(design_verified(guided));
+  EXPECT_TRUE(design_verified(unguided));
+  int long_turns = 0, differ = 0;
+  for (const FixedPath& path : d.solver().fixed_paths()) {
+    double guide_turn = 0, turn = 0, unguided_turn = 0;
+    for (size_t i = 0; i < path.path.edges.size(); ++i) {
+      const int e = path.path.edges[i], s = path.path.signs[i];
+      const int from = t.edge_faces(e, s > 0 ? 0 : 1), to = t.edge_faces(e, s > 0 ? 1 : 0);
+      const double across = p.path_guide[from] + s * d.geometry().rho(e) - p.path_guide[to];
+      ASSERT_LT(std::abs(reduced(across)), step / 2 - 0.1);  // the guide is smooth
+      guide_turn += reduced(across);
+      turn += s * guided.connection.x(e), unguided_turn += s * unguided.connection.x(e);
+    }
+    EXPECT_NEAR(turn, guide_turn, 1e-9);
+    long_turns += std::abs(guide_turn) > step / 2;
+    differ += std::abs(unguided_turn - guide_turn) > 1;
+  }
+  EXPECT_GT(long_turns, 0);  // the case this test is for
+  EXPECT_GT(differ, 0);
+  IndexPrescription wrong = p;
+  wrong.path_guide.pop_back();
+  EXPECT_THROW(
+      try { d.design(wrong); } catch (const Error& e) {
+        EXPECT_TRUE(test::contains(e.what(), "path guide has")) << e.what();
+        throw;
+      },
+      Error);
+  wrong = p;
+  wrong.path_guide[5] = std::nan("");
+  EXPECT_THROW(
+      try { d.design(wrong); } catch (const Error& e) {
+        EXPECT_TRUE(test::contains(e.what(), "face 5 is not a number")) << e.what();
+        throw;
+      },
+      Error);
+}
+
 // Fixed faces walled in by zero-weight edges (here: every edge unusable) are still joined to the others:
 // one path per fixed face beyond the first of each component, so every direction is held. Before, the
 // regions grew through usable edges only, and a fixed face whose neighbours no region reached was left out.

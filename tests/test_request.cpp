@@ -9,6 +9,7 @@
 #include "trivcon/error.h"
 #include "trivcon/generate.h"
 #include "trivcon/request.h"
+#include "support.h"
 
 namespace trivcon {
 namespace {
@@ -98,6 +99,31 @@ TEST(Request, AutoTurnsTowardTheSmoothestFieldUnlessRooted) {
   const FieldOutcome rooted = solve_request(d, m.F, r);
   EXPECT_NEAR(rooted.design.field.angle(0), 0.0, 1e-12);
   EXPECT_GT(mean_difference(rooted.design.field), 0.1);
+}
+
+// --auto on the sparse path route (more fixed-face paths than SolverOptions::max_dense_paths): the request gives
+// the solver the smoothest field as the paths' guide, and the field is the one the dense route makes. A plate with
+// 27 round holes, its boundary aligned (2,111 paths): the smallest turn per path gave 7 times the energy.
+TEST(Request, AutoOnTheSparsePathRouteMatchesTheDenseRoute) {
+  const Mesh m = test::perforated_plate(9, 3, 16, 4, 0.3);
+  FieldRequest r;
+  r.prescription.N = 4;
+  r.auto_place = true;
+  r.align_boundary = true;
+  SolverOptions dense_options;
+  dense_options.max_dense_paths = 1 << 20;
+  FieldDesigner dense(m.V, m.F, dense_options), sparse(m.V, m.F);
+  const FieldOutcome a = solve_request(dense, m.F, r), b = solve_request(sparse, m.F, r);
+  ASSERT_FALSE(dense.solver().sparse_paths());
+  ASSERT_TRUE(sparse.solver().sparse_paths());  // the default limit, 2,048
+  EXPECT_TRUE(a.prescription.path_guide.empty());
+  EXPECT_EQ(b.prescription.path_guide.size(), static_cast<size_t>(m.F.rows()));
+  ASSERT_TRUE(a.verified && b.verified);
+  EXPECT_EQ(a.prescription.vertex, b.prescription.vertex);
+  EXPECT_NEAR(b.design.connection.energy, a.design.connection.energy, 1e-8 * a.design.connection.energy);
+  IndexPrescription unguided = b.prescription;
+  unguided.path_guide.clear();
+  EXPECT_GT(sparse.design(unguided).connection.energy, 5 * a.design.connection.energy);
 }
 
 TEST(Request, SplittingRefusesWhatItCannotCarry) {

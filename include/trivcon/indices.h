@@ -34,6 +34,11 @@ struct IndexPrescription {
   std::map<int, int> loop;       // boundary loop id → n; absent: chosen to make the field smoothest
   std::map<int, double> fixed;   // face → direction (angle in the face's frame) the field must have there,
                                  // modulo 2π/N (trivcon/constraints.h)
+  // Optional: an N-field's angle per face (e.g. the smoothest field --auto reads its singularities from,
+  // AutoResult::field) whose turn along each fixed-face path chooses the path's whole number of turns where
+  // the solver does not choose them with the cycles (SolverOptions::max_dense_paths); empty: each path's
+  // smallest turn. It changes which exact field is made, never its singularities.
+  std::vector<double> path_guide;
 };
 
 // Parses an index "3", "-1", "1/4", "-3/2" into units of 1/N; throws naming `where` when it is not

@@ -65,9 +65,16 @@ struct RequestConstraints {
 RequestConstraints request_constraints(const FieldDesigner& designer, const FieldRequest& request);
 
 // The design of `prescription` (its fixed map complete: RequestConstraints::fixed) on a designer already set
-// up for its fixed faces; with `guide`, components without a root or fixed face are turned toward it.
+// up for its fixed faces; with `guide` (the smoothest field, AutoResult::field), components without a root or
+// fixed face are turned toward it, and it is the fixed-face paths' guide (guide_paths).
 Design request_design(const FieldDesigner& designer, const IndexPrescription& prescription,
                       const std::vector<std::pair<int, double>>& roots = {}, const Field* guide = nullptr);
+
+// Sets `prescription.path_guide` to `guide`'s angles where the designer's solver reads the fixed-face paths'
+// whole turns path by path (ConnectionSolver::sparse_paths) and none is set: the turns the smoothest field makes
+// along them, close to what the dense route would choose with the cycles. No-op without a guide of the same N and
+// mesh.
+void guide_paths(const FieldDesigner& designer, IndexPrescription& prescription, const Field* guide);
 
 // The request's smoothest field and singularities (auto_place), with the constraints' fixed faces held.
 AutoResult request_auto(const FieldDesigner& designer, const FieldRequest& request, const RequestConstraints& constraints);

@@ -148,6 +148,9 @@ class ConnectionSolver {
   int regularized_edges() const;
   int floored_edges() const;  // interior edges raised to SolverOptions::weight_floor
   const std::vector<FixedPath>& fixed_paths() const;
+  // Whether the paths' whole turns are read per path (IndexPrescription::path_guide), not chosen with the
+  // cycles: more than SolverOptions::max_dense_paths paths on the Cholesky route.
+  bool sparse_paths() const;
 
  private:
   struct Impl;

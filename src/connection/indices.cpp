@@ -3,6 +3,7 @@
 // src/io/singularity_files.cpp).
 #include "trivcon/indices.h"
 
+#include <cmath>
 #include <cstdlib>
 #include <string>
 
@@ -20,6 +21,10 @@ void validate_prescription(const Topology& t, int num_generators, const IndexPre
       throw Error("singular vertex " + std::to_string(v) + " is on boundary loop " + std::to_string(t.vertex_boundary_loop[v]) +
                   ": a boundary vertex has no dual cycle (set the loop's index with --boundary instead)");
   }
+  if (!p.path_guide.empty() && static_cast<int>(p.path_guide.size()) != t.num_faces)
+    throw Error("the path guide has " + std::to_string(p.path_guide.size()) + " angles, the mesh " + std::to_string(t.num_faces) + " faces");
+  for (size_t f = 0; f < p.path_guide.size(); ++f)
+    if (!std::isfinite(p.path_guide[f])) throw Error("the path guide's angle at face " + std::to_string(f) + " is not a number");
   for (auto [g, n] : p.generator)
     if (g < 0 || g >= num_generators)
       throw Error("generator " + std::to_string(g) + " out of range (the mesh has " + std::to_string(num_generators) + " generators)");

@@ -317,6 +317,7 @@ const std::vector<int>& ConnectionSolver::fixed_faces() const { return impl_->fi
 int ConnectionSolver::regularized_edges() const { return impl_->regularized_edges; }
 int ConnectionSolver::floored_edges() const { return impl_->floored_edges; }
 const std::vector<FixedPath>& ConnectionSolver::fixed_paths() const { return impl_->paths; }
+bool ConnectionSolver::sparse_paths() const { return impl_->sparse_paths; }
 
 // Every vertex row must reach a boundary vertex or the dropped vertex of its component through edges of
 // positive weight; otherwise the Laplacian is singular and the vertex's curvature has nowhere to go
@@ -467,24 +468,37 @@ ConnectionSolver::Impl::CycleRhs ConnectionSolver::Impl::cycle_rhs(const IndexPr
   return c;
 }
 
-// With the path rows sparse, each path's whole number of turns n_E is the one that makes the connection's
-// turn along the path, beyond parallel transport, smallest: for a path of one edge (two adjacent fixed
-// faces, most of them on feature lines and boundaries) that turn is the edge's x itself, fixed by the two
-// directions alone, so this is the principal matching of the two fixed directions. (Rounding instead the
-// turn of the field without path constraints, which knows nothing of the fixed directions, gave a CAD
-// mesh many times the energy of the dense route's choice, and needed a second factorization; this choice
-// is close to it there, BENCHMARKS.md "Fixed directions".) Returns the right-hand side of the vertex and
-// path rows.
+// With the path rows sparse, each path's whole number of turns n_E is read from a field: the path's row asks
+// Σ s_e x_e = h − (2π/N) n_E along it (h = path_target), and a field β turns along the path, relative to parallel
+// transport, by T = Σ s_e x_e with s_e x_e = β_cur + s_e ρ_e − β_next reduced to (−π/N, π/N] at each step
+// (trivcon/field.h's convention, β_R = β_L + ρ_e − x_e); n_E = round((h − T)/(2π/N)). With the prescription's
+// path_guide (the smoothest field, which the fixed directions hold) that is the guide's own turn; without one,
+// T = 0: the smallest turn, which for a path of one edge (two adjacent fixed faces, most of them on feature
+// lines and boundaries) is the principal matching of the two directions. (Rounding instead the turn of the
+// field without path constraints, which knows nothing of the fixed directions, gave a CAD mesh many times the
+// energy of the dense route's choice, and needed a second factorization, BENCHMARKS.md "Fixed directions".)
+// Returns the right-hand side of the vertex and path rows.
 Eigen::VectorXd ConnectionSolver::Impl::round_sparse_path_turns(const IndexPrescription& prescription, const Eigen::VectorXd& b_D,
                                                                 Eigen::VectorXd& n_E) const {
   const double step = 2 * kPi / prescription.N;
   const int nP = static_cast<int>(paths.size());
+  const std::vector<double>& guide = prescription.path_guide;
+  auto reduced = [step](double a) { return a - step * std::floor(a / step + 0.5); };
   n_E.resize(nP);
   Eigen::VectorXd b = b_D;
   b.conservativeResize(num_vertex_rows + nP);
   for (int k = 0; k < nP; ++k) {
     const double h = path_target(k, prescription);
-    n_E(k) = std::floor(h / step + 0.5 + 1e-7);
+    double turn = 0;
+    if (!guide.empty()) {
+      const DualCycle& path = paths[k].path;
+      for (size_t i = 0; i < path.edges.size(); ++i) {
+        const int e = path.edges[i], s = path.signs[i];
+        const int from = topology.edge_faces(e, s > 0 ? 0 : 1), to = topology.edge_faces(e, s > 0 ? 1 : 0);
+        turn += reduced(guide[from] + s * geometry.rho(e) - guide[to]);
+      }
+    }
+    n_E(k) = std::floor((h - turn) / step + 0.5 + 1e-7);
     b(num_vertex_rows + k) = h - step * n_E(k);
   }
   return b;

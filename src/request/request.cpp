@@ -81,9 +81,19 @@ RequestConstraints request_constraints(const FieldDesigner& designer, const Fiel
   return c;
 }
 
+void guide_paths(const FieldDesigner& designer, IndexPrescription& prescription, const Field* guide) {
+  if (!guide || guide->N != prescription.N || !prescription.path_guide.empty() || guide->angle.size() != designer.topology().num_faces ||
+      !designer.solver().sparse_paths())
+    return;
+  prescription.path_guide.assign(guide->angle.data(), guide->angle.data() + guide->angle.size());
+}
+
 Design request_design(const FieldDesigner& designer, const IndexPrescription& prescription, const std::vector<std::pair<int, double>>& roots,
                       const Field* guide) {
-  Design d = designer.design(prescription, roots);
+  IndexPrescription guided;
+  const bool guiding = guide && prescription.path_guide.empty() && guide->N == prescription.N && designer.solver().sparse_paths();
+  if (guiding) guided = prescription, guide_paths(designer, guided, guide);
+  Design d = designer.design(guiding ? guided : prescription, roots);
   // A rotation by a constant per component changes none of the design's checks (trivcon/auto.h).
   if (guide && guide->N == prescription.N) turn_toward(designer, d.field, *guide, prescription.fixed, roots);
   return d;
@@ -156,6 +166,9 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
       }
     }
   }
+  // Where the solver reads the fixed-face paths' whole turns path by path, the relaxation and the design read them
+  // from the smoothest field.
+  if (out.auto_result && !request.split_large_turns) guide_paths(designer, p, &out.auto_result->field);
   if (request.relax) {
     out.relax_result = relax(designer, p, request.relax_options);
     p = out.relax_result->prescription;
