@@ -81,17 +81,25 @@ RequestConstraints request_constraints(const FieldDesigner& designer, const Fiel
   return c;
 }
 
+namespace {
+
+bool path_guide_applies(const FieldDesigner& designer, const IndexPrescription& prescription, const Field* guide) {
+  return guide && guide->N == prescription.N && prescription.path_guide.empty() && guide->angle.size() == designer.topology().num_faces &&
+         designer.solver().sparse_paths();
+}
+
+}  // namespace
+
 void guide_paths(const FieldDesigner& designer, IndexPrescription& prescription, const Field* guide) {
-  if (!guide || guide->N != prescription.N || !prescription.path_guide.empty() || guide->angle.size() != designer.topology().num_faces ||
-      !designer.solver().sparse_paths())
-    return;
-  prescription.path_guide.assign(guide->angle.data(), guide->angle.data() + guide->angle.size());
+  if (path_guide_applies(designer, prescription, guide))
+    prescription.path_guide.assign(guide->angle.data(), guide->angle.data() + guide->angle.size());
 }
 
 Design request_design(const FieldDesigner& designer, const IndexPrescription& prescription, const std::vector<std::pair<int, double>>& roots,
                       const Field* guide) {
+  // The guide's copy only where it applies: an edit on the dense route designs the prescription as it is.
   IndexPrescription guided;
-  const bool guiding = guide && prescription.path_guide.empty() && guide->N == prescription.N && designer.solver().sparse_paths();
+  const bool guiding = path_guide_applies(designer, prescription, guide);
   if (guiding) guided = prescription, guide_paths(designer, guided, guide);
   Design d = designer.design(guiding ? guided : prescription, roots);
   // A rotation by a constant per component changes none of the design's checks (trivcon/auto.h).
