@@ -54,6 +54,10 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
   report["fixed"] = {{"faces", prescription.fixed.size()},
                      {"align_boundary", run.align_boundary},
                      {"paths", designer.solver().fixed_paths().size()},
+                     // How each path's whole turns were chosen (docs/solver.md, "Fixed-face paths").
+                     {"path_turns", c.path_turns == Connection::PathTurns::WithTheCycles ? "with the cycles"
+                                    : c.path_turns == Connection::PathTurns::FromTheGuide ? "from the guide"
+                                                                                         : "smallest"},
                      {"regularized_edges", designer.solver().regularized_edges()},
                      {"max_error", d.max_fixed_error},
                      {"conflicts", conflicts}};

@@ -151,8 +151,28 @@ TEST(CliAuto, FixedFacesAreHonoured) {
   for (const auto& [v, index] : report_singularities(j)) sum += index == "1/4" ? 1 : index == "-1/4" ? -1 : 100;
   EXPECT_EQ(sum, 8);
   EXPECT_EQ(j["fixed"]["faces"], 2);
+  EXPECT_EQ(j["fixed"]["path_turns"], "with the cycles");
   EXPECT_LE(j["fixed"]["max_error"].get<double>(), 1e-9);
   EXPECT_TRUE(j["verified"].get<bool>());
+}
+
+// More fixed-face paths than the dense route takes (a plate with 27 round holes, its boundary aligned: 2,111):
+// --auto reads their turns from the smoothest field, and says so; the same singularities given with -s take the
+// smallest turn per path, a field of several times the energy (docs/solver.md, "Fixed-face paths").
+TEST(CliAuto, ManyFixedFacePathsTakeTheirTurnsFromTheSmoothestField) {
+  const std::string mesh = mesh_file(test::perforated_plate(9, 3, 16, 4, 0.3), "plate.obj");
+  const std::string auto_report = temp_file("auto.json"), given_report = temp_file("given.json"), sing = temp_file("plate.sing");
+  auto r = run_cli("solve " + mesh + " -N 4 --auto --align-boundary --sing-out " + sing + " --report " + auto_report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run_cli("solve " + mesh + " -N 4 -s " + sing + " --align-boundary --report " + given_report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json a = read_json(auto_report), g = read_json(given_report);
+  EXPECT_EQ(a["fixed"]["paths"], 2111);
+  EXPECT_EQ(a["fixed"]["path_turns"], "from the guide");
+  EXPECT_EQ(g["fixed"]["path_turns"], "smallest");
+  EXPECT_EQ(report_singularities(a), report_singularities(g));
+  EXPECT_TRUE(a["verified"].get<bool>() && g["verified"].get<bool>());
+  EXPECT_GT(g["energy"].get<double>(), 5 * a["energy"].get<double>());
 }
 
 TEST(CliAuto, CurvatureAlignmentOnAFatTorusHasNoSingularities) {

@@ -335,6 +335,8 @@ TEST(Constraints, SparsePathsFollowTheirGuide) {
   const Design guided = d.design(p), unguided = d.design(unguided_prescription);
   EXPECT_TRUE(design_verified(guided));
   EXPECT_TRUE(design_verified(unguided));
+  EXPECT_EQ(guided.connection.path_turns, Connection::PathTurns::FromTheGuide);
+  EXPECT_EQ(unguided.connection.path_turns, Connection::PathTurns::Smallest);
   int long_turns = 0, differ = 0;
   for (const FixedPath& path : d.solver().fixed_paths()) {
     double guide_turn = 0, turn = 0, unguided_turn = 0;

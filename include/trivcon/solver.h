@@ -68,6 +68,9 @@ struct Connection {
   std::vector<char> generator_chosen;  // 1 where the solver chose the index
   std::vector<char> loop_chosen;
   std::vector<int> path_turn;  // per fixed-face path, the whole number j of 1/N turns chosen
+  // How they were chosen: with the cycles (the dense route), or path by path (SolverOptions::max_dense_paths) from
+  // IndexPrescription::path_guide when given, else as the smallest turn.
+  enum class PathTurns { WithTheCycles, FromTheGuide, Smallest } path_turns = PathTurns::WithTheCycles;
   double energy = 0;           // Σ x_e² / w_e
   // Verification: largest |Σ coefficient · x − right-hand side| over all interior vertices (including
   // the dropped ones), all loops and all generators, and the scale of the right-hand sides.

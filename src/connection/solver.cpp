@@ -560,6 +560,7 @@ Connection ConnectionSolver::Impl::result(const IndexPrescription& prescription,
   result.loop_index.assign(t.boundary_loops.size(), 0);
   result.loop_chosen.assign(t.boundary_loops.size(), 0);
   result.path_turn.assign(paths.size(), 0);
+  if (sparse_paths) result.path_turns = prescription.path_guide.empty() ? Connection::PathTurns::Smallest : Connection::PathTurns::FromTheGuide;
   double path_residual = 0;
   for (int k = 0; k < n_E.size(); ++k) {
     result.path_turn[k] = static_cast<int>(n_E(k));
