@@ -32,7 +32,8 @@ namespace trivcon {
 // An aligned edge is put on an iso-line in each face beside it whose field runs along it or across it within
 // this angle (radians, π/6): where one triangle holds two boundary or sharp edges meeting between 60° and 120°
 // (or 150° and 210°), its field follows one and the other is aligned too, the corner a quad corner; further off
-// the edge is left unaligned (counted in ParamQuality::unaligned_edges) rather than folding the map.
+// the edge is left unaligned and counted (ParamQuality::unaligned_edges): the choice between along and across
+// would be arbitrary there.
 constexpr double kAlignedEdgeTolerance = 0.5235987755982988;
 
 struct ParamOptions {
