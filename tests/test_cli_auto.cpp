@@ -157,8 +157,9 @@ TEST(CliAuto, FixedFacesAreHonoured) {
 }
 
 // More fixed-face paths than the dense route takes (a plate with 27 round holes, its boundary aligned: 2,111):
-// --auto reads their turns from the smoothest field, and says so; the same singularities given with -s take the
-// smallest turn per path, a field of several times the energy (docs/solver.md, "Fixed-face paths").
+// their turns are read from the smoothest field, and the report says so; --auto's singularities given back with -s
+// make the same field (the smallest turn per path would give several times the energy, docs/solver.md,
+// "Fixed-face paths").
 TEST(CliAuto, ManyFixedFacePathsTakeTheirTurnsFromTheSmoothestField) {
   const std::string mesh = mesh_file(test::perforated_plate(9, 3, 16, 4, 0.3), "plate.obj");
   const std::string auto_report = temp_file("auto.json"), given_report = temp_file("given.json"), sing = temp_file("plate.sing");
@@ -169,10 +170,10 @@ TEST(CliAuto, ManyFixedFacePathsTakeTheirTurnsFromTheSmoothestField) {
   const nlohmann::json a = read_json(auto_report), g = read_json(given_report);
   EXPECT_EQ(a["fixed"]["paths"], 2111);
   EXPECT_EQ(a["fixed"]["path_turns"], "from the guide");
-  EXPECT_EQ(g["fixed"]["path_turns"], "smallest");
+  EXPECT_EQ(g["fixed"]["path_turns"], "from the guide");
   EXPECT_EQ(report_singularities(a), report_singularities(g));
   EXPECT_TRUE(a["verified"].get<bool>() && g["verified"].get<bool>());
-  EXPECT_GT(g["energy"].get<double>(), 5 * a["energy"].get<double>());
+  EXPECT_NEAR(g["energy"].get<double>(), a["energy"].get<double>(), 1e-9 * a["energy"].get<double>());
 }
 
 TEST(CliAuto, CurvatureAlignmentOnAFatTorusHasNoSingularities) {

@@ -101,8 +101,9 @@ TEST(Request, AutoTurnsTowardTheSmoothestFieldUnlessRooted) {
   EXPECT_GT(mean_difference(rooted.design.field), 0.1);
 }
 
-// --auto on the sparse path route (more fixed-face paths than SolverOptions::max_dense_paths): the request gives
-// the solver the smoothest field as the paths' guide, and the field is the one the dense route makes. A plate with
+// The sparse path route (more fixed-face paths than SolverOptions::max_dense_paths): the request gives the solver
+// the smoothest field as the paths' guide, with --auto or singularities given, and the field is the one the dense
+// route makes. A plate with
 // 27 round holes, its boundary aligned (2,111 paths): the smallest turn per path gave 7 times the energy.
 TEST(Request, AutoOnTheSparsePathRouteMatchesTheDenseRoute) {
   const Mesh m = test::perforated_plate(9, 3, 16, 4, 0.3);
@@ -124,6 +125,15 @@ TEST(Request, AutoOnTheSparsePathRouteMatchesTheDenseRoute) {
   IndexPrescription unguided = b.prescription;
   unguided.path_guide.clear();
   EXPECT_GT(sparse.design(unguided).connection.energy, 5 * a.design.connection.energy);
+  // The same singularities given (no auto_place): the request makes the smoothest field for the guide all the same.
+  FieldRequest given = r;
+  given.auto_place = false;
+  given.prescription.vertex = b.prescription.vertex;
+  const FieldOutcome c = solve_request(sparse, m.F, given);
+  EXPECT_FALSE(c.auto_result.has_value());
+  EXPECT_EQ(c.prescription.path_guide.size(), static_cast<size_t>(m.F.rows()));
+  ASSERT_TRUE(c.verified);
+  EXPECT_NEAR(c.design.connection.energy, a.design.connection.energy, 1e-8 * a.design.connection.energy);
 }
 
 TEST(Request, SplittingRefusesWhatItCannotCarry) {

@@ -175,8 +175,16 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
     }
   }
   // Where the solver reads the fixed-face paths' whole turns path by path, the relaxation and the design read them
-  // from the smoothest field.
-  if (out.auto_result && !request.split_large_turns) guide_paths(designer, p, &out.auto_result->field);
+  // from the smoothest field: --auto's, or, for singularities given, one made for this (so that --auto's
+  // singularities given back with -s make the same field).
+  if (!request.split_large_turns && p.path_guide.empty() && designer.solver().sparse_paths()) {
+    if (out.auto_result) {
+      guide_paths(designer, p, &out.auto_result->field);
+    } else {
+      const AutoResult smoothest = request_auto(designer, request, out.constraints);
+      guide_paths(designer, p, &smoothest.field);
+    }
+  }
   if (request.relax) {
     out.relax_result = relax(designer, p, request.relax_options);
     p = out.relax_result->prescription;
