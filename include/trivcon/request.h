@@ -179,8 +179,8 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // placement equal to an earlier one is not mapped again, one equal before relaxation is not relaxed again, the
 // periods' relaxation is skipped where they are not used (periods_usable), none is relaxed when the first has
 // more than kMapRelaxMaxSingularities singularities, and each relaxation stops at its budget (kMapRelaxSolves, kMapRelaxWork).
-// While other attempts may follow, the maps are made without ParamOptions::retries; the kept map is made again
-// with them when it has problems. The search ends at the first map without problems
+// While other attempts may follow, the maps are made without ParamOptions::retries; when the kept map has
+// problems its retries follow, resumed from it (parametrize_retries). The search ends at the first map without problems
 // within the goal, or without problems once the placement found was mapped as found and relaxed both ways; the kept map is the one with the fewest
 // problems, then the least stretch beyond the goal (the earliest of equals). `request` is left as the kept one
 // was made.
