@@ -57,6 +57,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   run.placements = made.placements, run.cancel_units = made.cancel_units, run.first_problems = made.first_problems;
   run.first_distortion = made.first_distortion, run.relaxed = made.relaxed;
   run.relaxed_periods = made.periods;
+  run.retried_maps = made.retried_maps;
   run.onto_units = made.onto_units;
   run.onto_flat = made.onto_flat;
   run.quads = std::move(made.quads);
@@ -107,7 +108,8 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                            {"onto_features_units", run.onto_units},
                            {"onto_flat_sectors", run.onto_flat},
                            {"first_problems", run.first_problems},
-                           {"first_distortion", run.first_distortion}};
+                           {"first_distortion", run.first_distortion},
+                           {"retried_maps", run.retried_maps}};
   for (size_t i = 0; i < param.cones.size(); ++i)
     report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
   return report;

@@ -43,6 +43,7 @@ struct MapRun {
   double cancel_units = 0;
   int first_problems = 0;
   double first_distortion = 0;
+  int retried_maps = 0;          // MapOutcome::retried_maps
   bool relaxed = false;
   bool relaxed_periods = false;  // relaxed with the periods (MapOutcome::periods)
   double onto_units = 0;         // MapOutcome::onto_units

@@ -219,6 +219,7 @@ TEST(CliQuad, PlateWith27HolesIsCleanAtTheFirstPlacement) {
   EXPECT_EQ(j["align_boundary"], true);
   EXPECT_NEAR(j["quad"]["quads"].get<double>(), 1000, 300);
   EXPECT_EQ(j["placement"]["placements"], 1);
+  EXPECT_EQ(j["placement"]["retried_maps"], 0);  // clean without the near-miss retries
   EXPECT_EQ(j["placement"]["relaxed"], false);
   EXPECT_EQ(j["param"]["flipped_faces"], 0);
   EXPECT_EQ(j["param"]["degenerate_faces"], 0);

@@ -3,7 +3,9 @@
 // tested against it through their own files; here the layer itself).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "trivcon/common.h"
 #include "trivcon/error.h"
@@ -134,6 +136,33 @@ TEST(Request, AutoOnTheSparsePathRouteMatchesTheDenseRoute) {
   EXPECT_EQ(c.prescription.path_guide.size(), static_cast<size_t>(m.F.rows()));
   ASSERT_TRUE(c.verified);
   EXPECT_NEAR(c.design.connection.energy, a.design.connection.energy, 1e-8 * a.design.connection.energy);
+}
+
+// The placement search screens maps without their near-miss retries; where the kept map's retries leave problems,
+// the next screened maps' follow (kMapRetryCandidates in all), and the map kept is the best after them. Genus 4
+// at 100 squares: both maps made keep problems, so both are retried; at 110 the kept one is mended by its own
+// and the search stops there.
+TEST(Request, MapSearchRetriesTheRunnersUpWhenTheKeptMapKeepsProblems) {
+  const Mesh m = make_genus_surface(4, 3);
+  auto search = [&](double target) {
+    FieldDesigner d(m.V, m.F);
+    FieldRequest r;
+    r.prescription.N = 4;
+    r.auto_place = true;
+    MapOutcome o = map_request(d, m.F, r, 0, target, true);
+    const ParamQuality& q = o.param.quality;
+    const int problems = q.flipped_faces + q.degenerate_faces + q.winding_errors + static_cast<int>(o.quads->quality.problems.size());
+    return std::make_tuple(o.placements, o.retried_maps, problems, r.auto_options.cancel_distance);
+  };
+  const auto [placements, retried, problems, cancel] = search(100);
+  (void)cancel;
+  ASSERT_GT(problems, 0);  // the case this test is for
+  EXPECT_EQ(placements, 2);
+  EXPECT_EQ(retried, std::min(placements, kMapRetryCandidates));
+  const auto [placements_110, retried_110, problems_110, cancel_110] = search(110);
+  EXPECT_EQ(problems_110, 0);
+  EXPECT_EQ(retried_110, 1);
+  EXPECT_GT(cancel_110, 0);
 }
 
 TEST(Request, SplittingRefusesWhatItCannotCarry) {

@@ -139,6 +139,7 @@ struct MapOutcome {
   double cancel_units = 0; // with automatic placement: the cancel distance used, in units of the map (0: the request's own)
   int first_problems = 0;  // the first attempt's problems (below; its map made without retries), when it was placed again
   double first_distortion = 0;  // the first attempt's mean singular-value ratio, when it was placed again
+  int retried_maps = 0;    // screened maps whose near-miss retries were made (kMapRetryCandidates at most)
   bool relaxed = false;    // the kept placement was relaxed by map_request (not by the request's own relax)
   bool periods = false;    // and with the periods in the objective (kMapPeriodWeight)
   double onto_units = 0;   // with automatic placement and sharp edges: the distance singularities were moved onto them from, in units
@@ -162,6 +163,10 @@ inline constexpr int kMapRelaxReach = 3;
 inline constexpr int kMapRelaxSolves = 50;
 inline constexpr double kMapRelaxWork = 3e8;
 inline constexpr int kMapRelaxMinSolves = 500;
+// When the kept map's near-miss retries (ParamOptions::retries) leave problems, map_request retries the next
+// screened maps too, in rank, up to this many maps in all: ranked before their retries, the one they mend may
+// not be first.
+inline constexpr int kMapRetryCandidates = 3;
 // map_request does not relax a placement whose first attempt has more singularities than this (each move ranks
 // every singularity's candidates again).
 inline constexpr size_t kMapRelaxMaxSingularities = 600;

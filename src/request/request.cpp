@@ -358,6 +358,14 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
       std::count_if(attempts.begin(), attempts.end(), [](const Attempt& a) { return a.units == 1 && a.onto == kMapOntoFeatures && !a.flat; }));
   MapOutcome best;
   FieldRequest kept = request;
+  // The screened maps next in rank after the kept one (better first, at most kMapRetryCandidates − 1), with
+  // their requests: their retries follow where the kept map's leave problems.
+  std::vector<std::pair<MapOutcome, FieldRequest>> runners;
+  auto rank_runner = [&](MapOutcome m, const FieldRequest& r) {
+    auto at = std::find_if(runners.begin(), runners.end(), [&](const auto& x) { return better(m, x.first); });
+    if (at - runners.begin() < kMapRetryCandidates - 1) runners.insert(at, {std::move(m), r});
+    if (static_cast<int>(runners.size()) > kMapRetryCandidates - 1) runners.pop_back();
+  };
   int tried = 0, kept_at = 0, maps = 0;
   size_t first_singularities = 0;  // the first placement's
   std::vector<std::map<int, int>> placed;  // each map's singularities
@@ -431,9 +439,12 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     if (tried == 1 || better(m, best)) {
       const int first = tried == 1 ? problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
+      if (tried > 1 && screen) rank_runner(std::move(best), kept);
       best = std::move(m);
       best.first_problems = first, best.first_distortion = first_distortion;
       kept = r, kept_at = tried;
+    } else if (screen) {
+      rank_runner(std::move(m), r);
     }
     // Past the goal only the first placement is relaxed: once its attempts are made, a map without problems ends
     // the search.
@@ -444,15 +455,35 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   // was made; solving the kept request again would place and relax again for the same result).
   if (kept_at != tried && designer.fixed_faces() != best.field.constraints.fixed_faces)
     designer.set_fixed_faces(best.field.constraints.fixed_faces);
+  // A screened map's retries, resumed from its first maps (at the edge length and at the field's unit size); the
+  // designer holds that field's fixed faces.
+  auto retry = [&](MapOutcome& m, const FieldRequest& r) {
+    if (designer.fixed_faces() != m.field.constraints.fixed_faces) designer.set_fixed_faces(m.field.constraints.fixed_faces);
+    ParamOptions options = request_param_options(designer, r, m.field, edge_length, target_faces);
+    Parametrization param = parametrize_retries(m.field.designer(designer), m.field.design, options, m.param);
+    if (quads && param.uv != m.param.uv) m.quads = extract_quads(m.field.designer(designer), param);
+    m.param = std::move(param);
+  };
+  int retried = 0;
   if (screen && best.field.verified && problems(best) > 0) {
-    // Its first maps (at the edge length and at the field's unit size) were made while screening: the retries
-    // resume from them.
-    ParamOptions options = request_param_options(designer, kept, best.field, edge_length, target_faces);
-    Parametrization param = parametrize_retries(best.field.designer(designer), best.field.design, options, best.param);
-    if (quads && param.uv != best.param.uv) best.quads = extract_quads(best.field.designer(designer), param);
-    best.param = std::move(param);
+    retry(best, kept);
+    ++retried;
+    // Ranked without their retries, a runner-up may still be the one they mend: theirs follow, in rank, until a
+    // map has no problems.
+    for (auto& [m, r] : runners) {
+      if (problems(best) == 0) break;
+      retry(m, r);
+      ++retried;
+      if (better(m, best)) {
+        m.first_problems = best.first_problems, m.first_distortion = best.first_distortion;
+        best = std::move(m);
+        kept = r;
+      }
+    }
+    if (designer.fixed_faces() != best.field.constraints.fixed_faces) designer.set_fixed_faces(best.field.constraints.fixed_faces);
   }
   best.placements = maps;
+  best.retried_maps = retried;
   if (maps == 1) best.first_problems = 0, best.first_distortion = 0;
   request = kept;
   return best;
