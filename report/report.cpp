@@ -134,6 +134,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"rewound_regions", q.rewound_regions},
           {"flipped_faces", q.flipped_faces},
           {"degenerate_faces", q.degenerate_faces},
+          {"collapsed_faces", q.collapsed_faces},
           {"winding_errors", q.winding_errors},
           {"attempts", q.attempts},
           {"first_flipped", q.first_flipped},

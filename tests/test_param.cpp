@@ -243,6 +243,67 @@ TEST(Param, RetriesResumeFromTheScreenedMap) {
   EXPECT_THROW(parametrize_retries(*screened.designer, screened.outcome.design, o, foreign), Error);
 }
 
+// A sphere as modelling tools export it (a grid of (rings + 1) × (segments + 1) points, unwelded): each pole is a
+// row of points at one place, joined by edges of length 0, and the seam two coincident columns, so the surface is a
+// disk whose one boundary loop runs along both sides of the seam and through both poles. With the boundary aligned,
+// an edge of length 0 has no direction (no face is fixed to it) and is a point on both iso-lines: the pole rows map
+// to one integer point each, their faces collapse to segments (counted as such, not as folds) and nothing folds.
+TEST(Param, UnweldedSphereWithItsBoundaryAligned) {
+  const int rings = 24, segments = 48;
+  Mesh m;
+  m.V.resize((rings + 1) * (segments + 1), 3);
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const double theta = kPi * i / rings, phi = 2 * kPi * j / segments;
+      const double r = i == 0 || i == rings ? 0.0 : std::sin(theta);  // the poles exactly at one point, as files write them
+      m.V.row(i * (segments + 1) + j) << r * std::cos(phi), r * std::sin(phi), -std::cos(theta);
+    }
+  m.F.resize(2 * rings * segments, 3);
+  for (int i = 0, f = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const int a = i * (segments + 1) + j, b = a + 1, c = a + segments + 1, d = c + 1;
+      m.F.row(f++) << a, b, d;
+      m.F.row(f++) << a, d, c;
+    }
+  FieldDesigner probe(m.V, m.F);
+  ASSERT_EQ(probe.topology().boundary_loops.size(), 1u);
+  // No face is fixed to a pole row's edge: the faces beside only such edges are free (the last one also has a seam
+  // edge, which it follows), every other face follows its boundary edge.
+  const std::map<int, double> fixed = boundary_alignment(probe.V(), probe.topology(), probe.geometry());
+  for (int j = 0; j + 1 < segments; ++j) EXPECT_EQ(fixed.count(2 * j), 0u) << "pole face " << 2 * j;
+  EXPECT_EQ(fixed.size(), 2u * (rings - 1) + 2);  // beside the seam: one face per ring on each side, and the two pole faces there
+  for (auto [f, angle] : fixed) EXPECT_TRUE(std::isfinite(angle));
+  FieldRequest req;
+  req.auto_place = true;
+  req.align_boundary = true;
+  ParamOptions o;
+  o.target_faces = 600;
+  const MapRun r = run(m, req, o);
+  const ParamQuality& q = r.param.quality;
+  EXPECT_EQ(q.flipped_faces, 0) << param_warning(r.param);
+  EXPECT_EQ(q.degenerate_faces, 0);
+  EXPECT_EQ(q.collapsed_faces, 2 * segments);  // one triangle per segment at each pole
+  EXPECT_EQ(q.unaligned_edges, 0);
+  EXPECT_TRUE(q.seamless);
+  expect_seamless(r);
+  // Each pole corner on an integer point, and a face's two corners at a pole at the same (u, v): its pole edge maps
+  // to a point (the charts across the cut differ by their transitions, checked above).
+  const Topology& t = r.designer->topology();
+  auto pole = [&](int v) { return v / (segments + 1) == 0 || v / (segments + 1) == rings; };
+  int pole_edges = 0;
+  for (int f = 0; f < t.num_faces; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t.F(f, k), b = t.F(f, (k + 1) % 3);
+      if (!pole(a)) continue;
+      EXPECT_EQ(whole_offset(r.param.uv(3 * f + k, 0)) + whole_offset(r.param.uv(3 * f + k, 1)), 0.0) << "face " << f;
+      if (pole(b) && a / (segments + 1) == b / (segments + 1)) {
+        ++pole_edges;
+        EXPECT_EQ(r.param.uv.row(3 * f + k), r.param.uv.row(3 * f + (k + 1) % 3)) << "face " << f;
+      }
+    }
+  EXPECT_EQ(pole_edges, 2 * segments);
+}
+
 TEST(Param, SeveralComponents) {
   const Mesh m = concatenate({make_torus(36, 12), make_cube_sphere(4, true), make_disk(6, 8)});
   FieldRequest req;

@@ -48,7 +48,8 @@ void add_fixed_direction(const std::string& spec, const Topology& topology, cons
                          const FaceIdMap& face_id = nullptr);
 
 // --align-boundary: every face with a boundary edge, fixed to the direction of that edge as the
-// boundary loop runs (surface on the left); the longest such edge where a face has several.
+// boundary loop runs (surface on the left); the longest such edge where a face has several. An edge of length
+// 0 (its ends one point) has no direction: a face beside no other boundary edge is not fixed.
 std::map<int, double> boundary_alignment(const MatrixX3d& V, const Topology& topology, const Geometry& geometry);
 
 // Pairs of edge-adjacent fixed faces whose directions, after parallel transport across the shared

@@ -75,6 +75,7 @@ struct ParamQuality {
   int rewound_regions = 0;    // of those, regions untangled again from their least squares against a wrong winding
   int flipped_faces = 0;      // faces whose (u, v) triangle is inverted
   int degenerate_faces = 0;   // faces whose (u, v) triangle has (nearly) zero area
+  int collapsed_faces = 0;    // faces with an edge of length 0 on the surface, not turned over (not counted above)
   // Interior vertices whose (u, v) corner angles do not sum to 2π(1 − k) (k the index, 0 off the cones): where
   // the quad mesh gets a vertex of another valence than the singularities say (0 expected).
   int winding_errors = 0;

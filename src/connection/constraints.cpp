@@ -95,7 +95,7 @@ std::map<int, double> boundary_alignment(const MatrixX3d& V, const Topology& t, 
       if (!t.is_boundary_edge(t.face_edges(f, k))) continue;
       // f's boundary half-edge runs corner k → k+1, the direction of its boundary loop.
       const double length = (V.row(t.F(f, (k + 1) % 3)) - V.row(t.F(f, k))).squaredNorm();
-      if (length > longest) longest = length, fixed[f] = g.half_edge_angle(f, k);
+      if (length > 0 && length > longest) longest = length, fixed[f] = g.half_edge_angle(f, k);
     }
   }
   return fixed;

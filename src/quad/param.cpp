@@ -327,6 +327,19 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   for (int e : options.aligned_edges) {
     if (e < 0 || e >= nE) throw Error("param: aligned edge " + std::to_string(e) + " is out of range (the mesh has " + std::to_string(nE) + " edges)");
     bool any = false;
+    // An edge of length 0 (its two ends one point of the surface, as a pole row of an unwelded sphere) has no
+    // direction: both its ends get one (u, v), so that it is a point on both iso-lines through it.
+    if ((V.row(t.edge_vertices(e, 0)) - V.row(t.edge_vertices(e, 1))).squaredNorm() == 0) {
+      for (int side = 0; side < 2; ++side) {
+        const int f = t.edge_faces(e, side);
+        if (f < 0) continue;
+        for (int c = 0; c < 2; ++c) aligned.emplace_back(e, f), aligned_coordinate.push_back(c);
+        any = true;
+      }
+      any ? ++q.aligned_edges : ++q.unaligned_edges;
+      if (any) out.aligned_edges.push_back(e);
+      continue;
+    }
     for (int side = 0; side < 2; ++side) {
       const int f = t.edge_faces(e, side);
       if (f < 0) continue;
@@ -519,7 +532,15 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   auto uv_area = [&](int f) {
     return signed_area(out.uv.row(3 * f).transpose(), out.uv.row(3 * f + 1).transpose(), out.uv.row(3 * f + 2).transpose());
   };
-  auto folded = [&](int f) { return !(uv_area(f) > 1e-12 * face_area[f] * s * s); };
+  // A face with two corners at one point of the surface (an edge of length 0) has no shape to keep: with that
+  // edge aligned (above) it maps to a segment, of area 0 by construction. Not a fold unless turned over.
+  std::vector<char> collapsed(nF, 0);
+  for (int f = 0; f < nF; ++f)
+    for (int k = 0; k < 3; ++k) collapsed[f] |= (V.row(t.F(f, k)) - V.row(t.F(f, (k + 1) % 3))).squaredNorm() == 0;
+  auto folded = [&](int f) {
+    const double a = uv_area(f), tolerance = 1e-12 * face_area[f] * s * s;
+    return !(a > tolerance) && !(collapsed[f] && !(a < -tolerance));
+  };
   // Σ of the signed (u, v) corner angles at vertex v.
   auto uv_angle_sum = [&](int v, bool rough = false) {
     double angle = 0;
@@ -567,6 +588,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       else if (++stalled == patience) return;
       if (round >= 3 && folds > std::max(1000, nF / 50)) return;
       for (int f = 0; f < nF; ++f) {
+        if (collapsed[f] && !folded(f)) continue;
         const double ratio = folded(f) ? 20.0 : distortion(f);
         if (ratio > 2) weight[f] += std::min(ratio - 1, 20.0);
       }
@@ -1143,6 +1165,10 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   double mapped_area = 0;  // of the faces neither flipped nor degenerate: the mean distortion's weights
   for (int f = 0; f < nF; ++f) {
     const double a = uv_area(f);
+    if (collapsed[f] && !folded(f)) {
+      ++q.collapsed_faces;
+      continue;
+    }
     const double ratio = distortion(f);
     q.max_distortion = std::max(q.max_distortion, ratio);
     if (a < -1e-12 * face_area[f] * s * s) {
