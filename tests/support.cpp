@@ -219,6 +219,25 @@ SolverOptions sparse_path_options() {
   return options;
 }
 
+Mesh unwelded_sphere(int rings, int segments) {
+  Mesh m;
+  m.V.resize((rings + 1) * (segments + 1), 3);
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const double theta = kPi * i / rings, phi = 2 * kPi * j / segments;
+      const double r = i == 0 || i == rings ? 0.0 : std::sin(theta);  // the poles exactly at one point, as files write them
+      m.V.row(i * (segments + 1) + j) << r * std::cos(phi), r * std::sin(phi), -std::cos(theta);
+    }
+  m.F.resize(2 * rings * segments, 3);
+  for (int i = 0, f = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const int a = i * (segments + 1) + j, b = a + 1, c = a + segments + 1, d = c + 1;
+      m.F.row(f++) << a, b, d;
+      m.F.row(f++) << a, d, c;
+    }
+  return m;
+}
+
 Mesh perforated_plate(int nx, int ny, int m, int layers, double r) {
   std::map<std::pair<long long, long long>, int> id;
   std::vector<Eigen::Vector3d> points;

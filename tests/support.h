@@ -68,6 +68,11 @@ Mesh sheared_box(int n);
 // quads (each cut into two triangles) from the hole's circle, sampled at the angles of 4m points evenly spaced
 // along the cell's square, out to that square; the cells share their squares' points.
 Mesh perforated_plate(int nx, int ny, int m, int layers, double r);
+// The unit sphere as modelling tools export it: a grid of (rings + 1) × (segments + 1) points by latitude and
+// longitude, unwelded, two triangles per cell. Each pole is a row of `segments` + 1 points at one place (exactly),
+// joined by edges of length 0, and the seam two coincident columns: a disk whose one boundary loop runs along both
+// sides of the seam and through both poles; the triangle of each cell beside a pole has an edge of length 0.
+Mesh unwelded_sphere(int rings, int segments);
 // Solver options that send more than 256 fixed-face paths down the sparse route (SolverOptions::max_dense_paths),
 // for the tests of that route on meshes of a few hundred paths.
 SolverOptions sparse_path_options();

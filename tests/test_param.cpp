@@ -243,28 +243,13 @@ TEST(Param, RetriesResumeFromTheScreenedMap) {
   EXPECT_THROW(parametrize_retries(*screened.designer, screened.outcome.design, o, foreign), Error);
 }
 
-// A sphere as modelling tools export it (a grid of (rings + 1) × (segments + 1) points, unwelded): each pole is a
-// row of points at one place, joined by edges of length 0, and the seam two coincident columns, so the surface is a
-// disk whose one boundary loop runs along both sides of the seam and through both poles. With the boundary aligned,
+// A sphere as modelling tools export it (unwelded_sphere: each pole a row of points at one place, joined by edges of
+// length 0; the seam two coincident columns; a disk with one boundary loop). With the boundary aligned,
 // an edge of length 0 has no direction (no face is fixed to it) and is a point on both iso-lines: the pole rows map
 // to one integer point each, their faces collapse to segments (counted as such, not as folds) and nothing folds.
 TEST(Param, UnweldedSphereWithItsBoundaryAligned) {
   const int rings = 24, segments = 48;
-  Mesh m;
-  m.V.resize((rings + 1) * (segments + 1), 3);
-  for (int i = 0; i <= rings; ++i)
-    for (int j = 0; j <= segments; ++j) {
-      const double theta = kPi * i / rings, phi = 2 * kPi * j / segments;
-      const double r = i == 0 || i == rings ? 0.0 : std::sin(theta);  // the poles exactly at one point, as files write them
-      m.V.row(i * (segments + 1) + j) << r * std::cos(phi), r * std::sin(phi), -std::cos(theta);
-    }
-  m.F.resize(2 * rings * segments, 3);
-  for (int i = 0, f = 0; i < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      const int a = i * (segments + 1) + j, b = a + 1, c = a + segments + 1, d = c + 1;
-      m.F.row(f++) << a, b, d;
-      m.F.row(f++) << a, d, c;
-    }
+  const Mesh m = test::unwelded_sphere(rings, segments);
   FieldDesigner probe(m.V, m.F);
   ASSERT_EQ(probe.topology().boundary_loops.size(), 1u);
   // No face is fixed to a pole row's edge: the faces beside only such edges are free (the last one also has a seam

@@ -441,6 +441,31 @@ TEST(Quad, DiskAndGridsEndOnTheirAlignedBoundary) {
   }
 }
 
+// A sphere exported unwelded (unwelded_sphere): each pole a row of points at one place, the seam a boundary loop
+// along both its sides. The map puts each pole row on one integer point (docs/param.md), and the quad mesh has one
+// vertex there, not one per point of the row; the boundary's last direction at the seam's end beside a pole, whose
+// next face is a segment in (u, v), stays with the face before it. The quads end on the seam, χ and the loop are
+// the input's.
+TEST(Quad, UnweldedSphereHasOneQuadVertexAtEachPole) {
+  const Mesh m = test::unwelded_sphere(24, 48);
+  FieldRequest req;
+  req.align_boundary = true;
+  req.auto_place = true;
+  ParamOptions o;
+  o.target_faces = 600;
+  cancel_for_map(req, FieldDesigner(m.V, m.F), 0, o.target_faces);
+  const Pipeline r = run(m, req, o);
+  ASSERT_EQ(r.param.quality.flipped_faces + r.param.quality.degenerate_faces, 0) << param_warning(r.param);
+  EXPECT_EQ(r.param.quality.collapsed_faces, 2 * 48);
+  expect_clean(r, "unwelded sphere");
+  EXPECT_EQ(r.quads.quality.failed_traces, 0);
+  for (double z : {-1.0, 1.0}) {
+    int at_pole = 0;
+    for (int i = 0; i < r.quads.V.rows(); ++i) at_pole += (r.quads.V.row(i) - Eigen::RowVector3d(0, 0, z)).norm() < 1e-12;
+    EXPECT_EQ(at_pole, 1) << "pole " << z;
+  }
+}
+
 // A parallelogram (the unit square's grid sheared by `degrees`): at two of its corners one triangle holds both
 // boundary edges, so its field follows one of them and meets the other off a right angle. Within
 // kAlignedEdgeTolerance that edge is put on an iso-line too, and the corner becomes a quad corner: the quads are

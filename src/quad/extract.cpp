@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "linalg/timing.h"
@@ -126,7 +127,16 @@ class Extractor {
 
   void build_fans();
   void build_charts();
+  void join_points();
   void find_points();
+  // The corner of face f at vertex v or at a vertex joined to it (join_points; v the first of them).
+  // Whether face f's (u, v) triangle has zero area (a face holding an edge of length 0 maps to a segment).
+  bool flat(int f) const { return cross(at(f, 1) - at(f, 0), at(f, 2) - at(f, 0)) == 0; }
+  int corner_at(int v, int f) const {
+    for (int k = 0; k < 3; ++k)
+      if (joined_[t_.F(f, k)] == v) return k;
+    return -1;
+  }
   void fan_slots(int v, std::vector<Slot>& out) const;
   void edge_slots(int e, std::vector<Slot>& out) const;
   int find_slot(int node, int face, int code) const;
@@ -152,7 +162,9 @@ class Extractor {
   const Parametrization& param_;
   const QuadOptions& options_;
   std::vector<char> cut_;
-  std::vector<int> fan_offsets_, fan_faces_;
+  std::vector<int> fan_offsets_, fan_faces_, fan_corners_;  // fan_corners_: the corner of each fan face at the vertex
+  std::vector<int> joined_;                  // per vertex: the first vertex of its joined point (join_points), else itself
+  std::vector<char> boundary_fan_;           // per vertex: its (joined) fan starts and ends at the boundary
   std::vector<P2> U_;
   std::vector<char> positive_;
   std::vector<Node> nodes_;
@@ -186,10 +198,83 @@ void Extractor::build_fans() {
     const int first = f;
     for (int k = 0; k < degree; ++k) {
       fan_faces_.push_back(f);
+      fan_corners_.push_back(t_.corner_of(f, v));
       const int g = other_face(t_.face_edges(f, (t_.corner_of(f, v) + 2) % 3), f);
       if (g < 0 || g == first) break;
       f = g;
     }
+  }
+  fan_offsets_[nV] = static_cast<int>(fan_faces_.size());
+  joined_.resize(nV);
+  boundary_fan_.resize(nV);
+  for (int v = 0; v < nV; ++v) joined_[v] = v, boundary_fan_[v] = t_.is_boundary_vertex(v);
+}
+
+// Vertices at one point of the surface and of the map (ends of an edge of length 0 with one chart value, an integer
+// point: the pole row of a sphere exported unwelded, whose map ties them, docs/param.md) are one point of the quad
+// mesh. The first of them (smallest id) takes their fans joined in order (b's after a's where a's last face is b's
+// first: the face holding both); the others keep none. Where the fans do not chain so, the vertices stay apart.
+void Extractor::join_points() {
+  const int nV = t_.num_vertices;
+  std::vector<int> parent(nV);
+  for (int v = 0; v < nV; ++v) parent[v] = v;
+  auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  bool any = false;
+  for (int e = 0; e < t_.num_edges; ++e) {
+    const int a = t_.edge_vertices(e, 0), b = t_.edge_vertices(e, 1);
+    if ((V_.row(a) - V_.row(b)).squaredNorm() != 0) continue;
+    const int f = chart_face(e);
+    const P2 pa = at(f, t_.corner_of(f, a));
+    if (pa != at(f, t_.corner_of(f, b)) || !whole(pa)) continue;
+    const int ra = find(a), rb = find(b);
+    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb), any = true;
+  }
+  if (!any) return;
+  std::vector<std::vector<int>> members(nV);
+  for (int v = 0; v < nV; ++v) members[find(v)].push_back(v);
+  std::vector<std::vector<std::pair<int, int>>> fans(nV);  // (face, corner) per vertex, as they will be
+  for (int v = 0; v < nV; ++v)
+    for (int j = fan_offsets_[v]; j < fan_offsets_[v + 1]; ++j) fans[v].push_back({fan_faces_[j], fan_corners_[j]});
+  for (int root = 0; root < nV; ++root) {
+    const std::vector<int>& m = members[root];
+    if (m.size() < 2) continue;
+    bool empty = false;
+    for (int v : m) empty |= fans[v].empty();
+    if (empty) continue;
+    std::multimap<int, int> starting;  // first fan face → member (a fan of one face starts and ends with it)
+    for (int v : m) starting.emplace(fans[v].front().first, v);
+    auto next = [&](int v) {
+      const auto [lo, hi] = starting.equal_range(fans[v].back().first);
+      for (auto it = lo; it != hi; ++it)
+        if (it->second != v) return it->second;
+      return -1;
+    };
+    std::map<int, int> before;
+    for (int v : m)
+      if (const int w = next(v); w >= 0) before[w] = v;
+    int start = m.front();
+    for (int v : m)
+      if (!before.count(v)) start = v;
+    const bool cycle = static_cast<int>(before.size()) == static_cast<int>(m.size());
+    std::vector<int> order{start};
+    for (int w = next(start); w >= 0 && w != start && order.size() <= m.size(); w = next(w)) order.push_back(w);
+    if (order.size() != m.size()) continue;
+    std::vector<std::pair<int, int>> fan;
+    for (int v : order)
+      for (const auto& entry : fans[v])
+        if (fan.empty() || fan.back().first != entry.first) fan.push_back(entry);
+    if (cycle && fan.size() > 1 && fan.back().first == fan.front().first) fan.pop_back();
+    for (int v : m) fans[v].clear(), joined_[v] = root;
+    fans[root] = std::move(fan);
+    boundary_fan_[root] = !cycle;
+  }
+  fan_faces_.clear(), fan_corners_.clear();
+  for (int v = 0; v < nV; ++v) {
+    fan_offsets_[v] = static_cast<int>(fan_faces_.size());
+    for (auto [f, k] : fans[v]) fan_faces_.push_back(f), fan_corners_.push_back(k);
   }
   fan_offsets_[nV] = static_cast<int>(fan_faces_.size());
 }
@@ -230,11 +315,12 @@ void Extractor::find_points() {
   for (int v = 0; v < nV; ++v) {
     if (fan_offsets_[v] == fan_offsets_[v + 1]) continue;
     const int f = fan_faces_[fan_offsets_[v]];
-    const P2 p = at(f, t_.corner_of(f, v));
+    const P2 p = at(f, fan_corners_[fan_offsets_[v]]);
     if (!whole(p)) continue;
     vertex_node_[v] = static_cast<int>(nodes_.size());
-    nodes_.push_back({Kind::kVertex, v, f, p, t_.is_boundary_vertex(v)});
+    nodes_.push_back({Kind::kVertex, v, f, p, boundary_fan_[v] != 0});
   }
+  for (int v = 0; v < nV; ++v) vertex_node_[v] = vertex_node_[joined_[v]];
   // Inside edges, in the chart of L (or the only face): whole points strictly between the ends, along the
   // coordinate that changes most.
   edge_node_offsets_.assign(nE + 1, 0);
@@ -318,11 +404,15 @@ void Extractor::find_points() {
 void Extractor::fan_slots(int v, std::vector<Slot>& out) const {
   out.clear();
   const int begin = fan_offsets_[v], end = fan_offsets_[v + 1];
-  const bool boundary = t_.is_boundary_vertex(v);
+  const bool boundary = boundary_fan_[v];
+  // A boundary fan's last direction, along the boundary, is its last face's second edge; where the fan ends in faces
+  // flat in (u, v) (segments along that edge), the face before them holds it.
+  int last = end - 1;
+  while (boundary && last > begin && flat(fan_faces_[last])) --last;
   for (int j = begin; j < end; ++j) {
     const int f = fan_faces_[j];
     if (!positive_[f]) continue;
-    const int k = t_.corner_of(f, v);
+    const int k = fan_corners_[j];
     const P2 p = at(f, k), e1 = at(f, k + 1) - p, e2 = at(f, k + 2) - p;
     std::array<int, 4> codes{};
     int n = 0;
@@ -330,7 +420,7 @@ void Extractor::fan_slots(int v, std::vector<Slot>& out) const {
       const P2 d = unit(c);
       const bool inside = cross(e1, d) > 0 && cross(d, e2) > 0;
       const bool on_first = cross(e1, d) == 0 && dot(e1, d) > 0;
-      const bool on_last = boundary && j == end - 1 && cross(e2, d) == 0 && dot(e2, d) > 0;
+      const bool on_last = boundary && j == last && cross(e2, d) == 0 && dot(e2, d) > 0;
       if (inside || on_first || on_last) codes[n++] = c;
     }
     sort_counter_clockwise(codes, n);  // from e1 on
@@ -372,13 +462,14 @@ int Extractor::find_slot(int node, int face, int code) const {
 }
 
 // The slot of vertex node `node` for direction `code` of `face`'s chart, a direction in the closed sector of the
-// face's corner: one along the sector's second edge belongs to the next face counter-clockwise.
+// face's corner: one along the sector's second edge belongs to the next face counter-clockwise, unless that face is
+// flat in (u, v) (a boundary fan's last direction then stays with this face, fan_slots).
 int Extractor::arrive_at_vertex(int node, int face, int code) const {
-  const int v = nodes_[node].element, k = t_.corner_of(face, v);
+  const int v = nodes_[node].element, k = corner_at(v, face);
   const P2 e2 = at(face, k + 2) - at(face, k), d = unit(code);
   if (cross(e2, d) == 0 && dot(e2, d) > 0) {
     const int e = t_.face_edges(face, (k + 2) % 3), g = other_face(e, face);
-    if (g >= 0) return find_slot(node, g, across_code(e, face, code));
+    if (g >= 0 && !flat(g)) return find_slot(node, g, across_code(e, face, code));
   }
   return find_slot(node, face, code);
 }
@@ -438,7 +529,7 @@ State Extractor::start(int node, int slot) const {
       }
     return s;
   }
-  const int v = n.element, k = t_.corner_of(sl.face, v);
+  const int k = corner_at(n.element, sl.face), v = t_.F(sl.face, k);
   const P2 p = at(sl.face, k);
   s.target = p + d * kUnit;
   const P2 e1 = at(sl.face, k + 1) - p, e2 = at(sl.face, k + 2) - p;
@@ -467,7 +558,7 @@ State Extractor::through_vertex(int v, int face, int code, P2 target) const {
     const P2 e2 = at(face, k + 2) - at(face, k), d = unit(back_code);
     if (cross(e2, d) == 0 && dot(e2, d) > 0) {
       const int e = t_.face_edges(face, (k + 2) % 3), g = other_face(e, face);
-      if (g >= 0) back_code = across_code(e, face, back_code), back_face = g;
+      if (g >= 0 && !flat(g)) back_code = across_code(e, face, back_code), back_face = g;
     }
   }
   int index = -1;
@@ -598,7 +689,7 @@ Eigen::Vector3d Extractor::barycentric(const Node& n, int& face) const {
   face = n.face;
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   if (n.kind == Kind::kVertex) {
-    b[t_.corner_of(face, n.element)] = 1;
+    b[corner_at(n.element, face)] = 1;
     return b;
   }
   auto coordinate = [](P2 p) { return Eigen::Vector2d(static_cast<double>(p.x), static_cast<double>(p.y)); };
@@ -637,6 +728,7 @@ QuadMesh Extractor::run() {
   }
   build_fans();
   build_charts();
+  join_points();
   find_points();
   const int nN = static_cast<int>(nodes_.size());
   q_.integer_points = nN;
