@@ -470,7 +470,7 @@ TEST(Quad, UnweldedSphereHasOneQuadVertexAtEachPole) {
 // boundary edges, so its field follows one of them and meets the other off a right angle. Within
 // kAlignedEdgeTolerance that edge is put on an iso-line too, and the corner becomes a quad corner: the quads are
 // the sheared grid itself, with no trace leaving the surface.
-Mesh parallelogram(int n, double degrees) {
+Mesh parallelogram(int n, double degrees, bool other_diagonal = false) {
   Mesh m;
   const double shear = std::tan(degrees * 3.141592653589793 / 180);
   m.V.resize((n + 1) * (n + 1), 3);
@@ -480,8 +480,13 @@ Mesh parallelogram(int n, double degrees) {
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
       const int a = j * (n + 1) + i, f = 2 * (j * n + i);
-      m.F.row(f) << a, a + 1, a + n + 2;
-      m.F.row(f + 1) << a, a + n + 2, a + n + 1;
+      if (other_diagonal) {
+        m.F.row(f) << a, a + 1, a + n + 1;
+        m.F.row(f + 1) << a + 1, a + n + 2, a + n + 1;
+      } else {
+        m.F.row(f) << a, a + 1, a + n + 2;
+        m.F.row(f + 1) << a, a + n + 2, a + n + 1;
+      }
     }
   return m;
 }
@@ -511,6 +516,16 @@ TEST(Quad, ParallelogramCornersInOneTriangleBecomeQuadCorners) {
   const Pipeline r = run(parallelogram(20, 45), req, o);
   EXPECT_GT(r.param.quality.unaligned_edges, 0);
   EXPECT_FALSE(r.quads.quality.problems.empty());
+  // With the other diagonal the triangles held alone are the acute corners: at 45°–60° (sheared by 30°–45°), an
+  // acute corner cannot be flat, so the edge the field does not follow is aligned across the other, and the
+  // corner is a quad corner.
+  for (double degrees : {35.0, 40.0}) {
+    const Pipeline acute = run(parallelogram(20, degrees, true), req, o);
+    const std::string what = "acute corners, sheared by " + std::to_string(degrees) + " degrees";
+    EXPECT_EQ(acute.param.quality.unaligned_edges, 0) << what;
+    EXPECT_EQ(acute.param.quality.flipped_faces + acute.param.quality.degenerate_faces, 0) << what << ": " << param_warning(acute.param);
+    expect_clean(acute, what);
+  }
 }
 
 TEST(Quad, UnalignedBoundaryIsReported) {

@@ -35,6 +35,10 @@ namespace trivcon {
 // the edge is left unaligned and counted (ParamQuality::unaligned_edges): the choice between along and across
 // would be arbitrary there.
 constexpr double kAlignedEdgeTolerance = 0.5235987755982988;
+// Where one triangle holds two aligned edges at an acute corner between this angle (radians, π/4) and 60°, the
+// edge its field does not follow is aligned across the other all the same: an acute corner cannot be flat, so it
+// is a quad corner (below π/4, sharp edges meet at a narrow corner whose sector turns, trivcon/features.h).
+constexpr double kAcuteCorner = 0.7853981633974483;
 
 struct ParamOptions {
   double edge_length = 0;   // the quad edge length in the mesh's units (> 0 wins over target_faces)

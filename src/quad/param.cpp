@@ -324,8 +324,38 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // Integer unknowns: 2 per cone, 1 per aligned (edge, face), 2 per cut edge.
   std::vector<std::pair<int, int>> aligned;  // (edge, face) with the coordinate that is constant: stored below
   std::vector<int> aligned_coordinate;
+  std::vector<char> to_align(nE, 0);
   for (int e : options.aligned_edges) {
     if (e < 0 || e >= nE) throw Error("param: aligned edge " + std::to_string(e) + " is out of range (the mesh has " + std::to_string(nE) + " edges)");
+    to_align[e] = 1;
+  }
+  // The coordinate constant along edge e in face f (0: u, 1: v) where the field runs along or across it within
+  // kAlignedEdgeTolerance; −1 otherwise.
+  auto constant_coordinate = [&](int e, int f) {
+    int k = 0;
+    while (t.face_edges(f, k) != e) ++k;
+    const double quarters = (g.half_edge_angle(f, k) - theta[f]) / (kPi / 2);
+    const double nearest = std::round(quarters);
+    if (std::abs(quarters - nearest) * (kPi / 2) > kAlignedEdgeTolerance) return -1;
+    return ((static_cast<long long>(nearest) % 2) + 2) % 2 == 0 ? 1 : 0;  // along ±u: v constant
+  };
+  // Past the tolerance, an edge meeting another aligned edge of its face at an acute corner of kAcuteCorner or more
+  // (below that a narrow corner's sector turns, trivcon/features.h; a corner in one triangle of 45°–60°) is
+  // across it: that corner cannot be flat, so it is a quad corner.
+  auto across_acute_corner = [&](int e, int f) {
+    int k = 0;
+    while (t.face_edges(f, k) != e) ++k;
+    for (int j : {(k + 1) % 3, (k + 2) % 3}) {
+      const int other = t.face_edges(f, j);
+      if (!to_align[other]) continue;
+      const int c = constant_coordinate(other, f);
+      if (c < 0) continue;
+      const double corner = g.corner_angles(f, j == (k + 1) % 3 ? j : k);  // at the vertex the two edges share
+      if (corner >= kAcuteCorner && corner < kPi / 2 - kAlignedEdgeTolerance) return 1 - c;
+    }
+    return -1;
+  };
+  for (int e : options.aligned_edges) {
     bool any = false;
     // An edge of length 0 (its two ends one point of the surface, as a pole row of an unwelded sphere) has no
     // direction: both its ends get one (u, v), so that it is a point on both iso-lines through it.
@@ -343,15 +373,11 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     for (int side = 0; side < 2; ++side) {
       const int f = t.edge_faces(e, side);
       if (f < 0) continue;
-      int k = 0;
-      while (t.face_edges(f, k) != e) ++k;
-      const double relative = g.half_edge_angle(f, k) - theta[f];
-      const double quarters = relative / (kPi / 2);
-      const double nearest = std::round(quarters);
-      if (std::abs(quarters - nearest) * (kPi / 2) > kAlignedEdgeTolerance) continue;
-      const int along = ((static_cast<long long>(nearest) % 2) + 2) % 2;  // 0: along ±u (v constant), 1: along ±v
+      int c = constant_coordinate(e, f);
+      if (c < 0) c = across_acute_corner(e, f);
+      if (c < 0) continue;
       aligned.emplace_back(e, f);
-      aligned_coordinate.push_back(along == 0 ? 1 : 0);
+      aligned_coordinate.push_back(c);
       any = true;
     }
     any ? ++q.aligned_edges : ++q.unaligned_edges;
