@@ -79,6 +79,12 @@ Geometry compute_geometry(const MatrixX3d& V, const Topology& topology, int thre
 // glyph size, and of anything else measured "in mean edge lengths".
 double mean_edge_length(const MatrixX3d& V, const Topology& topology);
 
+// Whether edge e's two ends are at exactly one position (an edge of length 0: a pole row or seam of a mesh exported
+// unwelded, a collapsed edge).
+inline bool zero_length_edge(const MatrixX3d& V, const Topology& topology, int e) {
+  return V.row(topology.edge_vertices(e, 0)) == V.row(topology.edge_vertices(e, 1));
+}
+
 // Angle in face f's frame of a world direction, after projection onto the face's plane. Errors name the
 // face: a zero or non-finite direction, or one perpendicular to the face.
 double fixed_angle_from_direction(const Geometry& geometry, int face, const Eigen::Vector3d& direction);

@@ -92,10 +92,11 @@ std::map<int, double> boundary_alignment(const MatrixX3d& V, const Topology& t, 
   for (int f = 0; f < t.num_faces; ++f) {
     double longest = -1;
     for (int k = 0; k < 3; ++k) {
-      if (!t.is_boundary_edge(t.face_edges(f, k))) continue;
+      const int e = t.face_edges(f, k);
+      if (!t.is_boundary_edge(e) || zero_length_edge(V, t, e)) continue;  // no direction to follow
       // f's boundary half-edge runs corner k → k+1, the direction of its boundary loop.
       const double length = (V.row(t.F(f, (k + 1) % 3)) - V.row(t.F(f, k))).squaredNorm();
-      if (length > 0 && length > longest) longest = length, fixed[f] = g.half_edge_angle(f, k);
+      if (length > longest) longest = length, fixed[f] = g.half_edge_angle(f, k);
     }
   }
   return fixed;

@@ -441,7 +441,7 @@ std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topo
   bool any = false;
   for (int e = 0; e < t.num_edges; ++e) {
     const int i = t.edge_vertices(e, 0), j = t.edge_vertices(e, 1);
-    if (V.row(i) != V.row(j)) continue;
+    if (!zero_length_edge(V, t, e)) continue;
     any = true;
     const int a = root(i), b = root(j);
     if (a != b) parent[std::max(a, b)] = std::min(a, b);  // the root is the cluster's smallest id

@@ -225,7 +225,7 @@ void Extractor::join_points() {
   bool any = false;
   for (int e = 0; e < t_.num_edges; ++e) {
     const int a = t_.edge_vertices(e, 0), b = t_.edge_vertices(e, 1);
-    if ((V_.row(a) - V_.row(b)).squaredNorm() != 0) continue;
+    if (!zero_length_edge(V_, t_, e)) continue;
     const int f = chart_face(e);
     const P2 pa = at(f, t_.corner_of(f, a));
     if (pa != at(f, t_.corner_of(f, b)) || !whole(pa)) continue;

@@ -359,7 +359,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     bool any = false;
     // An edge of length 0 (its two ends one point of the surface, as a pole row of an unwelded sphere) has no
     // direction: both its ends get one (u, v), so that it is a point on both iso-lines through it.
-    if ((V.row(t.edge_vertices(e, 0)) - V.row(t.edge_vertices(e, 1))).squaredNorm() == 0) {
+    if (zero_length_edge(V, t, e)) {
       for (int side = 0; side < 2; ++side) {
         const int f = t.edge_faces(e, side);
         if (f < 0) continue;
@@ -562,7 +562,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // edge aligned (above) it maps to a segment, of area 0 by construction. Not a fold unless turned over.
   std::vector<char> collapsed(nF, 0);
   for (int f = 0; f < nF; ++f)
-    for (int k = 0; k < 3; ++k) collapsed[f] |= (V.row(t.F(f, k)) - V.row(t.F(f, (k + 1) % 3))).squaredNorm() == 0;
+    for (int k = 0; k < 3; ++k) collapsed[f] |= zero_length_edge(V, t, t.face_edges(f, k));
   auto folded = [&](int f) {
     const double a = uv_area(f), tolerance = 1e-12 * face_area[f] * s * s;
     return !(a > tolerance) && !(collapsed[f] && !(a < -tolerance));

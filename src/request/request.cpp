@@ -366,7 +366,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     if (at - runners.begin() < kMapRetryCandidates - 1) runners.insert(at, {std::move(m), r});
     if (static_cast<int>(runners.size()) > kMapRetryCandidates - 1) runners.pop_back();
   };
-  int tried = 0, kept_at = 0, maps = 0;
+  int tried = 0, maps = 0;
   size_t first_singularities = 0;  // the first placement's
   std::vector<std::map<int, int>> placed;  // each map's singularities
   // The placements before relaxation, by the attempt's units, distance onto the lines and flat sectors (each
@@ -442,7 +442,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
       if (tried > 1 && screen) rank_runner(std::move(best), kept);
       best = std::move(m);
       best.first_problems = first, best.first_distortion = first_distortion;
-      kept = r, kept_at = tried;
+      kept = r;
     } else if (screen) {
       rank_runner(std::move(m), r);
     }
@@ -450,11 +450,6 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     // the search.
     if (problems(best) == 0 && (stretch(best) == 0 || tried >= same_placement)) break;
   }
-  // The designer holds the last attempt's set-up (fixed faces turned for singularities moved onto features): it
-  // takes the kept field's fixed faces back, so that the designer is the kept field's (its design is kept as it
-  // was made; solving the kept request again would place and relax again for the same result).
-  if (kept_at != tried && designer.fixed_faces() != best.field.constraints.fixed_faces)
-    designer.set_fixed_faces(best.field.constraints.fixed_faces);
   // A screened map's retries, resumed from its first maps (at the edge length and at the field's unit size); the
   // designer holds that field's fixed faces.
   auto retry = [&](MapOutcome& m, const FieldRequest& r) {
@@ -480,8 +475,11 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
         kept = r;
       }
     }
-    if (designer.fixed_faces() != best.field.constraints.fixed_faces) designer.set_fixed_faces(best.field.constraints.fixed_faces);
   }
+  // The designer holds the last set-up (an attempt's or a retry's: fixed faces turned for singularities moved onto
+  // features): it takes the kept field's fixed faces back, so that the designer is the kept field's (its design is
+  // kept as it was made; solving the kept request again would place and relax again for the same result).
+  if (designer.fixed_faces() != best.field.constraints.fixed_faces) designer.set_fixed_faces(best.field.constraints.fixed_faces);
   best.placements = maps;
   best.retried_maps = retried;
   if (maps == 1) best.first_problems = 0, best.first_distortion = 0;
