@@ -215,6 +215,73 @@ TEST(Auto, CancellationRemovesACloseOppositePairAndKeepsGaussBonnet) {
             "automatic singularities: held vertex " + std::to_string(noisy.V.rows()) + " out of range");
 }
 
+// After the split's gathering (the map requests' placement), opposite singularities of different sizes meet:
+// a −2/4 between two +1/4 vanishes with them, a −2/4 beside one +1/4 becomes one −1/4 at its vertex.
+TEST(Auto, OppositeSingularitiesOfDifferentSizesMeet) {
+  const Mesh m = make_icosphere(3);
+  const Topology t = test::topo(m);
+  const double L = mean_edge_length(m.V, t);
+  const int a = 0;
+  std::vector<int> ring;  // a's neighbours
+  for (int e = 0; e < t.num_edges; ++e)
+    if (t.edge_vertices(e, 0) == a || t.edge_vertices(e, 1) == a) ring.push_back(t.edge_vertices(e, 0) + t.edge_vertices(e, 1) - a);
+  ASSERT_GE(ring.size(), 5u);
+  const std::map<int, int> three{{a, -2}, {ring[0], 1}, {ring[2], 1}};
+  std::vector<std::pair<int, int>> pairs;
+  int met = 0;
+  EXPECT_TRUE(cancel_singularity_pairs(m.V, t, three, 1.5 * L, &pairs, true, &met).empty());
+  EXPECT_EQ(met, 1);  // the nearer +1 met the −2; the −1 left and the other +1 are a whole pair
+  ASSERT_EQ(pairs.size(), 1u);
+  EXPECT_EQ(pairs[0].second, a);
+  // Without `partial`, only whole pairs cancel: none here.
+  EXPECT_EQ(cancel_singularity_pairs(m.V, t, three, 1.5 * L), three);
+  const std::map<int, int> two{{a, -2}, {ring[1], 1}};
+  met = 0;
+  EXPECT_EQ(cancel_singularity_pairs(m.V, t, two, 1.5 * L, nullptr, true, &met), (std::map<int, int>{{a, -1}}));
+  EXPECT_EQ(met, 1);
+  const std::map<int, int> big{{a, 3}, {ring[1], -1}};
+  EXPECT_EQ(cancel_singularity_pairs(m.V, t, big, 1.5 * L, nullptr, true), (std::map<int, int>{{a, 2}}));
+  // Too far apart: nothing meets.
+  EXPECT_EQ(cancel_singularity_pairs(m.V, t, two, 0.5 * L, nullptr, true), two);
+}
+
+// The split's gathering joins singularities of one sign only while every member of a cluster is within the
+// distance of every other. At 100 unit squares the −1/4 of a genus-7 plate's smoothest field are each within a
+// unit of another, and joined through each other they made one −56/4 (valence 60, no map).
+TEST(Auto, GatheringDoesNotChainARowOfSingularities) {
+  const Mesh m = make_genus_surface(7, 2);
+  const Topology t = test::topo(m);
+  const Geometry g = compute_geometry(m.V, t);
+  AutoOptions o;
+  o.cancel_distance = o.split_distance = std::sqrt(g.face_area.sum() / 100);
+  o.cancel_absolute = true;
+  o.split_above = 3;
+  const AutoResult r = auto_singularities(m.V, m.F, o);
+  EXPECT_EQ(index_sum(r.vertex), 4 * (2 - 2 * 7));
+  int largest = 0;
+  for (auto [v, n] : r.vertex) largest = std::max(largest, std::abs(n));
+  EXPECT_LE(largest, 3);
+  EXPECT_GE(r.vertex.size(), 16u);
+}
+
+// Input_wheel (genus 11) placed for a map of 4,000 squares: the gathering makes −1/2 singularities with +1/4
+// beside them (24 pairs within one and a half units before); they meet, and no opposite singularities are left
+// within the unit.
+TEST(Auto, InputWheelsOppositeSingularitiesMeetForAMap) {
+  TRIVCON_REQUIRE_SHARED();
+  const MeshData m = read_mesh(test::shared_mesh("Input_wheel.off"));
+  const Topology t = build_topology(m.F, static_cast<int>(m.V.rows()));
+  const Geometry g = compute_geometry(m.V, t);
+  AutoOptions o;
+  o.cancel_distance = o.split_distance = std::sqrt(g.face_area.sum() / 4000);
+  o.cancel_absolute = true;
+  o.split_above = 3;
+  const AutoResult r = auto_singularities(m.V, m.F, o);
+  EXPECT_GT(r.met, 0);
+  EXPECT_EQ(index_sum(r.vertex), 4 * -20);
+  EXPECT_EQ(cancel_singularity_pairs(m.V, t, r.vertex, o.cancel_distance, nullptr, true), r.vertex);
+}
+
 TEST(Auto, BadInputIsAClearError) {
   const Mesh m = make_icosphere(1);
   AutoOptions o;

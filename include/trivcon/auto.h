@@ -49,8 +49,11 @@ struct AutoOptions {
   // units, along edges) are gathered at the member nearest their centroid; a gathered sum |n| > split_above, and
   // any gathered positive sum, becomes |n| singularities of ±1 on interior vertices about split_distance from
   // it, far from each other (gathered negative sums up to split_above stay: one −2 is a quad vertex of valence
-  // 6, two −1 a fraction of a unit apart fold the map). `trivcon param` and `quad` with --auto use
-  // split_above = N − 1 = 3 and one quad edge: a quad vertex has valence 4 − n, none for n ≥ 4.
+  // 6, two −1 a fraction of a unit apart fold the map). A cluster joins closest pair first while every member
+  // stays within split_distance of every other. Then opposite singularities at most cancel_distance apart meet
+  // as far as their indices allow (cancel_singularity_pairs with `partial`): a −2 beside a +1 becomes one −1, a
+  // −2 between two +1 vanishes. `trivcon param` and `quad` with --auto use split_above = N − 1 = 3 and one quad
+  // edge: a quad vertex has valence 4 − n, none for n ≥ 4.
   int split_above = 0;
   double split_distance = 0;
   std::map<int, double> fixed;   // face → angle in its frame (radians), held as Dirichlet values
@@ -79,6 +82,7 @@ struct AutoResult {
   std::map<int, int> vertex;               // after that and cancellation: the singularities to prescribe
   std::vector<std::pair<int, int>> pairs;  // cancelled pairs (vertex of index +n, vertex of −n), in order
   int split = 0;                           // singularities split into ±1 ones (split_above)
+  int met = 0;                             // meetings of opposite singularities of different sizes after the split
   double energy = 0;                       // E(u) / ‖u‖²_M over the whole mesh (the Rayleigh quotient without fixed faces)
   int vanishing_faces = 0;                 // faces where |u_f| vanished (see above)
   std::string ordering;                    // the smoothest field's factor order: "AMD" or "coordinate dissection"
@@ -94,9 +98,12 @@ AutoResult auto_singularities(const FieldDesigner& designer, const AutoOptions& 
 AutoResult auto_singularities(const MatrixX3d& V, const MatrixX3i& F, const AutoOptions& options);
 
 // The cancellation above on its own, `distance` in the mesh's units: the singularities left, and the
-// cancelled pairs (positive vertex, negative vertex) appended to `pairs` when not null.
+// cancelled pairs (positive vertex, negative vertex) appended to `pairs` when not null. With `partial`,
+// opposite singularities of different sizes meet too: +a and −b at most `distance` apart (closest first) each
+// lose min(a, b), the larger keeping the rest at its vertex, and a vertex may meet several; `met` (when not null)
+// counts those meetings (whole pairs still go to `pairs`).
 std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& topology, const std::map<int, int>& vertex, double distance,
-                                            std::vector<std::pair<int, int>>* pairs = nullptr);
+                                            std::vector<std::pair<int, int>>* pairs = nullptr, bool partial = false, int* met = nullptr);
 
 // The summing over coincident vertices above on its own.
 std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topology& topology, const std::map<int, int>& vertex);

@@ -312,10 +312,14 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
 
 }  // namespace
 
-std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
-                                            std::vector<std::pair<int, int>>* pairs) {
-  if (!(distance >= 0) || !std::isfinite(distance))
-    throw Error("singularity cancellation: invalid distance " + std::to_string(distance) + " (need a finite number >= 0)");
+namespace {
+
+// Opposite singularities at most `distance` apart along edges, closest first (ties: smaller vertex ids). Whole
+// pairs (+n, −n) vanish, each vertex in one pair at most; with `partial`, any +a and −b also meet, min(a, b)
+// leaving each (the larger keeps the rest), and a vertex may meet several. Returns the singularities left;
+// whole pairs are appended to `pairs`, partial meetings counted in `met`.
+std::map<int, int> cancel_opposite(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
+                                   bool partial, std::vector<std::pair<int, int>>* pairs, int* met) {
   std::map<int, int> left = vertex;
   if (distance == 0) return left;
   // Candidate pairs from a Dijkstra search of radius `distance` around each positive singularity.
@@ -330,7 +334,7 @@ std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& 
     if (source < 0 || source >= t.num_vertices) throw Error("singularity cancellation: vertex " + std::to_string(source) + " out of range");
     field::edge_dijkstra(V, t, source, distance, true, dist, [&, source = source, n = n](int v, double d) {
       if (v != source)
-        if (auto it = vertex.find(v); it != vertex.end() && it->second == -n) candidates.push_back({d, source, v});
+        if (auto it = vertex.find(v); it != vertex.end() && (partial ? it->second < 0 : it->second == -n)) candidates.push_back({d, source, v});
       return true;
     });
   }
@@ -338,11 +342,27 @@ std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& 
     return a.d != b.d ? a.d < b.d : a.plus != b.plus ? a.plus < b.plus : a.minus < b.minus;
   });
   for (const Candidate& k : candidates) {
-    if (!left.count(k.plus) || !left.count(k.minus)) continue;
-    left.erase(k.plus), left.erase(k.minus);
-    if (pairs) pairs->emplace_back(k.plus, k.minus);
+    auto plus = left.find(k.plus), minus = left.find(k.minus);
+    if (plus == left.end() || minus == left.end()) continue;
+    const int m = std::min(plus->second, -minus->second);
+    if (plus->second == m && minus->second == -m) {
+      if (pairs) pairs->emplace_back(k.plus, k.minus);
+    } else if (met) {
+      ++*met;
+    }
+    if ((plus->second -= m) == 0) left.erase(plus);
+    if ((minus->second += m) == 0) left.erase(minus);
   }
   return left;
+}
+
+}  // namespace
+
+std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
+                                            std::vector<std::pair<int, int>>* pairs, bool partial, int* met) {
+  if (!(distance >= 0) || !std::isfinite(distance))
+    throw Error("singularity cancellation: invalid distance " + std::to_string(distance) + " (need a finite number >= 0)");
+  return cancel_opposite(V, t, vertex, distance, partial, pairs, met);
 }
 
 namespace {
@@ -356,21 +376,43 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
   std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
   // First, singularities of one sign closer than `distance` (along edges) are gathered into one of their summed
   // index at the member nearest to their centroid: two +1/4 on neighbouring vertices cannot sit on two integer
-  // points of a map one unit apart, but their sum split below can.
+  // points of a map one unit apart, but their sum split below can. Clusters join closest pair first, and only
+  // while every member stays within `distance` of every other (complete linkage): a row of −1/4 each a little
+  // less than a unit from the next is not one singularity of their whole sum.
   std::map<int, int> vertex;
   std::set<int> spread;  // gathered positive clusters, split again whatever their sum
   {
-    std::map<int, int> parent;
-    for (auto [v, n] : given) parent[v] = v;
-    std::function<int(int)> root = [&](int v) { return parent[v] == v ? v : parent[v] = root(parent[v]); };
+    struct Near {
+      double d;
+      int a, b;
+    };
+    std::vector<Near> close;
+    std::set<std::pair<int, int>> within;  // (a, b) with a < b, of one sign, at most `distance` apart
     for (auto [source, n] : given)
-      field::edge_dijkstra(V, t, source, distance, false, dist, [&, source = source, n = n](int v, double) {
-        if (auto it = given.find(v); v != source && it != given.end() && (it->second > 0) == (n > 0)) parent[root(v)] = root(source);
+      field::edge_dijkstra(V, t, source, distance, false, dist, [&, source = source, n = n](int v, double d) {
+        if (auto it = given.find(v); v > source && it != given.end() && (it->second > 0) == (n > 0))
+          close.push_back({d, source, v}), within.insert({source, v});
         return true;
       });
+    std::sort(close.begin(), close.end(), [](const Near& x, const Near& y) {
+      return x.d != y.d ? x.d < y.d : x.a != y.a ? x.a < y.a : x.b < y.b;
+    });
+    std::map<int, int> cluster;  // vertex → its cluster's key (a member)
     std::map<int, std::vector<int>> members;
-    for (auto [v, n] : given) members[root(v)].push_back(v);
-    for (const auto& [r, list] : members) {
+    for (auto [v, n] : given) cluster[v] = v, members[v] = {v};
+    for (const Near& k : close) {
+      int ca = cluster[k.a], cb = cluster[k.b];
+      if (ca == cb) continue;
+      bool all = true;
+      for (int x : members[ca])
+        for (int y : members[cb]) all = all && within.count({std::min(x, y), std::max(x, y)});
+      if (!all) continue;
+      if (members[ca].size() < members[cb].size()) std::swap(ca, cb);
+      for (int y : members[cb]) cluster[y] = ca, members[ca].push_back(y);
+      members.erase(cb);
+    }
+    for (auto& [r, list] : members) {
+      std::sort(list.begin(), list.end());
       Eigen::RowVector3d centroid = Eigen::RowVector3d::Zero();
       int total = 0;
       for (int v : list) centroid += V.row(v), total += given.at(v);
@@ -542,6 +584,7 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
     if (!(o.split_distance > 0) || !std::isfinite(o.split_distance))
       throw Error("automatic singularities: invalid split distance " + std::to_string(o.split_distance) + " (need a finite number > 0)");
     r.vertex = split_singularities(V, t, r.vertex, o.split_above, o.split_distance, r.split);
+    r.vertex = cancel_opposite(V, t, r.vertex, distance, true, &r.pairs, &r.met);
   }
   for (auto [v, n] : held)
     if ((r.vertex[v] += n) == 0) r.vertex.erase(v);
