@@ -40,7 +40,10 @@ void run_quad(const QuadCommand& o) {
 
   const auto t1 = Clock::now();
   StagedOutputs staged;
-  staged.write(o.output, [&](const std::string& path) { write_quad_mesh(path, quads.V, quads.Q); });
+  // A map folded everywhere can trace no quad: a mesh without faces is no file any reader takes, so -o is not
+  // written (the other outputs are) and the run fails below.
+  const bool empty = quads.Q.rows() == 0;
+  if (!empty) staged.write(o.output, [&](const std::string& path) { write_quad_mesh(path, quads.V, quads.Q); });
   if (!o.uv_out.empty()) staged.write(o.uv_out, [&](const std::string& path) { write_map_obj(path, run); });
   if (!o.sing_out.empty()) staged.write(o.sing_out, [&](const std::string& path) { write_map_singularities(path, run); });
   if (!o.report.empty()) {
@@ -75,7 +78,12 @@ void run_quad(const QuadCommand& o) {
               << fmt(q.seconds_check) << ")\n";
   }
   if (const std::string w = param_warning(param); !w.empty()) std::cerr << "trivcon: warning: " << w << "\n";
-  if (const std::string w = quad_warning(quads); !w.empty()) {
+  if (empty) {
+    std::cerr << "trivcon: error: the map gave no quads (" << p.flipped_faces + p.degenerate_faces << " of " << p.faces
+              << " faces folded or degenerate in (u, v), " << std::setprecision(3) << p.unit_squares << " unit squares): '" << o.output
+              << "' not written\n";
+    exit_code = kVerificationFailed;
+  } else if (const std::string w = quad_warning(quads); !w.empty()) {
     std::cerr << "trivcon: warning: " << w << "\n";
     exit_code = kVerificationFailed;
   }

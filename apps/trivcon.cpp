@@ -63,7 +63,7 @@ std::string exit_status_help() {
                   "a file that cannot be read or written, or out of memory"},
       {kUsageError, "Usage error: an unknown subcommand or option, a bad or missing value, a missing or extra argument"},
       {kVerificationFailed, "solve, param, quad: the result failed verification (the message says which check missed "
-                            "and by how much; the outputs are still written)"},
+                            "and by how much; the outputs are still written, but no quad mesh without quads)"},
       {kIndicesDiffer, "check: the field's indices differ from the prescription"},
       {kInternalError, "Internal error (a bug: the message starts with 'trivcon: internal error:')"},
   };

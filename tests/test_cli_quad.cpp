@@ -2,6 +2,8 @@
 // `trivcon quad`, run as a separate process: the quad mesh file read back and checked on its own (only quads,
 // each edge in at most two, χ, boundary loops, valences at the written singularities), the report, --uv-out,
 // --sing-out, PLY output, usage errors.
+#include <cmath>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -295,6 +297,42 @@ TEST(CliQuad, RoundDiskSplitsItsCentreIntoFourCorners) {
   EXPECT_EQ(valence3, 4);
   EXPECT_EQ(other, 0);
   EXPECT_NEAR(static_cast<double>(q.quads.size()), 1000.0, 300.0);
+}
+
+// A 20-sided prism whose caps are fans from one rim vertex (as CAD exports triangulate flat faces: no interior
+// vertex). With its rims as feature lines every cap face is fixed along the rim, the cap's index +1 sits on a
+// rim vertex, and its map folds everywhere: no quad can be traced. The run says so and fails (exit 3) without
+// writing an empty -o (no reader takes a mesh without faces), with the report written; the map keeps the
+// field's scale instead of fitting its cancelled area to the target (which made the unit vanish and the (u, v)
+// beyond 2^30).
+TEST(CliQuad, MapWithoutQuadsIsAnErrorAndNoEmptyFile) {
+  const int n = 20, stacks = 10;
+  Mesh m;
+  m.V.resize(n * (stacks + 1), 3);
+  for (int s = 0; s <= stacks; ++s)
+    for (int k = 0; k < n; ++k) m.V.row(s * n + k) << std::cos(2 * kPi * k / n), 2.85 * s / stacks, std::sin(2 * kPi * k / n);
+  std::vector<Eigen::Vector3i> faces;
+  for (int s = 0; s < stacks; ++s)
+    for (int k = 0; k < n; ++k) {
+      const int a = s * n + k, b = s * n + (k + 1) % n;
+      faces.emplace_back(a, a + n, b), faces.emplace_back(b, a + n, b + n);
+    }
+  for (int k = 1; k + 1 < n; ++k) faces.emplace_back(0, k, k + 1), faces.emplace_back(stacks * n, stacks * n + k + 1, stacks * n + k);
+  m.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t f = 0; f < faces.size(); ++f) m.F.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
+  const std::string mesh = mesh_file(m, "fan_prism.obj"), out = temp_file("fan_prism_q.obj"), report = temp_file("fan_prism.json");
+  const auto r = run_cli("quad " + mesh + " --auto --align-features 30 --target-faces 300 -o " + out + " --report " + report);
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("trivcon: error: the map gave no quads ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("'" + out + "' not written"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::ifstream(out).good());
+  const auto j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j["quad"]["quads"], 0);
+  EXPECT_GT(j["param"]["flipped_faces"].get<int>() + j["param"]["degenerate_faces"].get<int>(), 0);
+  // The field's scale: the unit of 300 squares over the prism's area, not a vanishing one.
+  const double edge = j["param"]["edge_length"];
+  EXPECT_GT(edge, 0.1);
+  EXPECT_LT(edge, 1.0);
 }
 
 TEST(CliQuad, UsageErrors) {

@@ -640,11 +640,17 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // the scale (nothing is fixed yet), so when it misses by more than 10 % it is rescaled exactly to cover
   // area / edge_length² unit squares, and the edge length reported is the one used. Before the sizing (which
   // reads the map's scale against s) and after it (which moves the area again).
+  // A map folded at large (its signed area less than 9/10 of its unsigned area: an index ≥ 1 folds a whole cap)
+  // has no area to fit: it is kept at the field's scale, since a rescale by its cancelled area could make the
+  // unit vanish.
   auto fit_target = [&]() {
     if (options.edge_length > 0 || !(q.target_squares > 0)) return;
-    double covered = 0;
-    for (int f = 0; f < nF; ++f) covered += uv_area(f);
-    if (!(covered > 0) || !std::isfinite(covered)) return;
+    double covered = 0, unsigned_area = 0;
+    for (int f = 0; f < nF; ++f) {
+      const double a = uv_area(f);
+      covered += a, unsigned_area += std::abs(a);
+    }
+    if (!(covered > 0.9 * unsigned_area) || !std::isfinite(covered)) return;
     const double ratio = std::sqrt(target_here / covered);
     if (std::abs(ratio * ratio - 1) <= 0.1) return;  // within 10 % in area the map is kept as it is
     s *= ratio;
