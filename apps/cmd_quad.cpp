@@ -80,7 +80,7 @@ void run_quad(const QuadCommand& o) {
   if (const std::string w = param_warning(param); !w.empty()) std::cerr << "trivcon: warning: " << w << "\n";
   if (empty) {
     std::cerr << "trivcon: error: the map gave no quads (" << p.flipped_faces + p.degenerate_faces << " of " << p.faces
-              << " faces folded or degenerate in (u, v), " << std::setprecision(3) << p.unit_squares << " unit squares): '" << o.output
+              << " faces folded or degenerate in (u, v), " << fmt(p.unit_squares) << " unit squares): '" << o.output
               << "' not written\n";
     exit_code = kVerificationFailed;
   } else if (const std::string w = quad_warning(quads); !w.empty()) {

@@ -7,7 +7,6 @@
 #include <array>
 #include <cmath>
 #include <complex>
-#include <functional>
 #include <exception>
 #include <limits>
 #include <memory>
@@ -312,14 +311,13 @@ std::vector<Complex> smoothest_values(const MatrixX3d& V, const Topology& t, con
 
 }  // namespace
 
-namespace {
-
 // Opposite singularities at most `distance` apart along edges, closest first (ties: smaller vertex ids). Whole
 // pairs (+n, −n) vanish, each vertex in one pair at most; with `partial`, any +a and −b also meet, min(a, b)
-// leaving each (the larger keeps the rest), and a vertex may meet several. Returns the singularities left;
-// whole pairs are appended to `pairs`, partial meetings counted in `met`.
-std::map<int, int> cancel_opposite(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
-                                   bool partial, std::vector<std::pair<int, int>>* pairs, int* met) {
+// leaving each (the larger keeps the rest), and a vertex may meet several.
+std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
+                                            std::vector<std::pair<int, int>>* pairs, bool partial, int* met) {
+  if (!(distance >= 0) || !std::isfinite(distance))
+    throw Error("singularity cancellation: invalid distance " + std::to_string(distance) + " (need a finite number >= 0)");
   std::map<int, int> left = vertex;
   if (distance == 0) return left;
   // Candidate pairs from a Dijkstra search of radius `distance` around each positive singularity.
@@ -354,15 +352,6 @@ std::map<int, int> cancel_opposite(const MatrixX3d& V, const Topology& t, const 
     if ((minus->second += m) == 0) left.erase(minus);
   }
   return left;
-}
-
-}  // namespace
-
-std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex, double distance,
-                                            std::vector<std::pair<int, int>>* pairs, bool partial, int* met) {
-  if (!(distance >= 0) || !std::isfinite(distance))
-    throw Error("singularity cancellation: invalid distance " + std::to_string(distance) + " (need a finite number >= 0)");
-  return cancel_opposite(V, t, vertex, distance, partial, pairs, met);
 }
 
 namespace {
@@ -584,7 +573,7 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
     if (!(o.split_distance > 0) || !std::isfinite(o.split_distance))
       throw Error("automatic singularities: invalid split distance " + std::to_string(o.split_distance) + " (need a finite number > 0)");
     r.vertex = split_singularities(V, t, r.vertex, o.split_above, o.split_distance, r.split);
-    r.vertex = cancel_opposite(V, t, r.vertex, distance, true, &r.pairs, &r.met);
+    r.vertex = cancel_singularity_pairs(V, t, r.vertex, distance, &r.pairs, true, &r.met);
   }
   for (auto [v, n] : held)
     if ((r.vertex[v] += n) == 0) r.vertex.erase(v);
