@@ -17,6 +17,7 @@
 #include "trivcon/constraints.h"
 #include "trivcon/error.h"
 #include "trivcon/io.h"
+#include "trivcon/request.h"
 
 namespace trivcon {
 namespace {
@@ -245,18 +246,22 @@ TEST(Auto, OppositeSingularitiesOfDifferentSizesMeet) {
   EXPECT_EQ(cancel_singularity_pairs(m.V, t, two, 0.5 * L, nullptr, true), two);
 }
 
+// The options `trivcon param` and `quad --auto` place singularities with for `squares` unit squares
+// (cancel_for_map: cancelling and gathering within one unit, sums above 3 split).
+AutoOptions map_placement(const FieldDesigner& designer, double squares) {
+  FieldRequest request;
+  request.auto_place = true;
+  cancel_for_map(request, designer, 0, squares);
+  return request.auto_options;
+}
+
 // The split's gathering joins singularities of one sign only while every member of a cluster is within the
 // distance of every other. At 100 unit squares the −1/4 of a genus-7 plate's smoothest field are each within a
 // unit of another, and joined through each other they made one −56/4 (valence 60, no map).
 TEST(Auto, GatheringDoesNotChainARowOfSingularities) {
   const Mesh m = make_genus_surface(7, 2);
-  const Topology t = test::topo(m);
-  const Geometry g = compute_geometry(m.V, t);
-  AutoOptions o;
-  o.cancel_distance = o.split_distance = std::sqrt(g.face_area.sum() / 100);
-  o.cancel_absolute = true;
-  o.split_above = 3;
-  const AutoResult r = auto_singularities(m.V, m.F, o);
+  const FieldDesigner designer(m.V, m.F);
+  const AutoResult r = auto_singularities(designer, map_placement(designer, 100));
   EXPECT_EQ(index_sum(r.vertex), 4 * (2 - 2 * 7));
   int largest = 0;
   for (auto [v, n] : r.vertex) largest = std::max(largest, std::abs(n));
@@ -270,16 +275,12 @@ TEST(Auto, GatheringDoesNotChainARowOfSingularities) {
 TEST(Auto, InputWheelsOppositeSingularitiesMeetForAMap) {
   TRIVCON_REQUIRE_SHARED();
   const MeshData m = read_mesh(test::shared_mesh("Input_wheel.off"));
-  const Topology t = build_topology(m.F, static_cast<int>(m.V.rows()));
-  const Geometry g = compute_geometry(m.V, t);
-  AutoOptions o;
-  o.cancel_distance = o.split_distance = std::sqrt(g.face_area.sum() / 4000);
-  o.cancel_absolute = true;
-  o.split_above = 3;
-  const AutoResult r = auto_singularities(m.V, m.F, o);
+  const FieldDesigner designer(m.V, m.F);
+  const AutoOptions o = map_placement(designer, 4000);
+  const AutoResult r = auto_singularities(designer, o);
   EXPECT_GT(r.met, 0);
   EXPECT_EQ(index_sum(r.vertex), 4 * -20);
-  EXPECT_EQ(cancel_singularity_pairs(m.V, t, r.vertex, o.cancel_distance, nullptr, true), r.vertex);
+  EXPECT_EQ(cancel_singularity_pairs(designer.V(), designer.topology(), r.vertex, o.cancel_distance, nullptr, true), r.vertex);
 }
 
 TEST(Auto, BadInputIsAClearError) {
