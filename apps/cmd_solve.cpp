@@ -71,12 +71,14 @@ void report_features(const SolveOptions& o, const FieldDesigner& designer, const
                        {"corner_faces", a.corner_faces},
                        {"conflicts", conflicts},
                        {"narrow_corners", narrow},
-                       {"boundary_overridden", c.boundary_overridden}};
+                       {"boundary_overridden", c.boundary_overridden},
+                       {"loose_edges", c.loose_edges.size()}};
   if (o.field.features.degrees_option->count() > 0) extra["features"]["degrees"] = o.field.features.degrees;
   if (o.field.features.file_option->count() > 0) extra["features"]["file"] = o.field.features.file;
   std::ostringstream text;
   text << "features: " << c.sharp_edges.size() << " sharp edges (" << c.convex_edges << " convex), " << a.fixed.size()
        << " faces fixed beside them, " << a.corner_faces << " beside two or more\n";
+  if (!c.loose_edges.empty()) text << loose_edges_line(c.loose_edges.size(), o.field.feature_min_length);
   if (!a.narrow.empty())
     text << "features: " << a.narrow.size() << " narrow corners (sharp edges meeting at less than pi/N) turned through by one step, "
          << "so that a map gives each a corner of its own (report: features.narrow_corners)\n";

@@ -40,6 +40,13 @@ void FieldOptions::add_to(CLI::App* cmd, bool fixed_N) {
                   "'FACE x y z' / 'FACE angle=A' lines; repeatable");
   cmd->add_flag("--align-boundary", align_boundary, "Fix every face with a boundary edge to that edge's direction");
   features.add_to(cmd, "every face beside one is fixed to its direction (with --auto too)");
+  feature_min_option =
+      cmd->add_option("--feature-min-length", feature_min_length,
+                      "With --align-features: sharp edges in a chain with a loose end shorter than L (in the mesh's units, along the "
+                      "chain) are not followed, again until none is left, as a scan's dashed creases (default: 0 for solve, all "
+                      "followed; one unit of the map for param and quad)")
+          ->check(CLI::NonNegativeNumber)
+          ->needs(features.degrees_option);
   auto_flag = cmd->add_flag("--auto", auto_place,
                             "Find the singularities automatically: those of the globally smoothest field (Knoppel et al. 2013), "
                             "then solve exactly with them");
@@ -114,6 +121,10 @@ FieldRequest FieldOptions::request(const FieldDesigner& designer, const Repaired
   r.align_boundary = align_boundary;
   if (features.degrees_option->count() > 0) r.feature_degrees = features.degrees;
   if (features.file_option->count() > 0) r.feature_edges = read_feature_edges(features.file, designer.topology());
+  if (feature_min_option->count() > 0) {
+    if (!std::isfinite(feature_min_length)) throw Error("--feature-min-length: expected a finite length >= 0 in the mesh's units");
+    r.feature_min_length = feature_min_length;
+  }
   if (split_large_turns && (!r.prescription.generator.empty() || !r.prescription.loop.empty()))
     throw Error(
         "--split-large-turns makes new generators and boundary loops: leave their indices to be chosen (no --generator, --boundary)");

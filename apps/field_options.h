@@ -23,6 +23,8 @@ struct FieldOptions {
   std::vector<std::string> fixes;
   bool align_boundary = false;
   FeatureOptions features;  // --align-features, --features
+  double feature_min_length = 0;  // --feature-min-length
+  CLI::Option* feature_min_option = nullptr;
   bool auto_place = false;  // --auto
   double auto_cancel = 0;   // --auto-cancel, in mean edge lengths
   std::string align;        // --align curvature[:t]

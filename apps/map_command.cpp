@@ -97,7 +97,9 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
     report["features"] = {{"sharp_edges", run.out.sharp_edges.size()},
                           {"conflicts", a.conflicts.size()},
                           {"narrow_corners", a.narrow.size()},
-                          {"singularities_moved_onto_them", a.snapped.size()}};
+                          {"singularities_moved_onto_them", a.snapped.size()},
+                          {"loose_edges", run.out.constraints.loose_edges.size()}};
+    if (run.request.feature_min_length) report["features"]["min_length"] = *run.request.feature_min_length;
   }
   if (run.out.relax_result) report["relax"] = relax_summary_json(*run.out.relax_result);
   if (run.request.auto_place)
@@ -138,6 +140,8 @@ std::string map_summary(const MapCommand& o, const MapRun& run) {
   return "mesh " + o.mesh + ": " + std::to_string(t.num_vertices) + " vertices, " + std::to_string(t.num_faces) + " faces, " +
          std::to_string(t.components.size()) + " component(s), chi " + std::to_string(t.euler_characteristic()) + ", " +
          std::to_string(t.boundary_loops.size()) + " boundary loop(s)\n" +
+         (run.out.constraints.loose_edges.empty() ? std::string()
+                                                  : loose_edges_line(run.out.constraints.loose_edges.size(), *run.request.feature_min_length)) +
          (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string()) +
          (run.placements > 1 ? placement_line(run) : std::string()) +
          "field: N 4, " + std::to_string(run.param.cones.size()) + " singular vertices, verified\n";

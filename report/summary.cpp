@@ -130,4 +130,11 @@ std::string relax_summary_line(const RelaxResult& r) {
   return s.str();
 }
 
+std::string loose_edges_line(size_t edges, double min_length) {
+  std::ostringstream s;
+  s << "features: " << edges << " sharp edges left out, in chains with a loose end shorter than " << std::setprecision(3) << min_length
+    << " (--feature-min-length; report: features.loose_edges)\n";
+  return s.str();
+}
+
 }  // namespace trivcon::cli

@@ -25,6 +25,8 @@ nlohmann::ordered_json repair_summary_json(const RepairedMesh& repaired);
 // candidate solves, time; and its one-line summary.
 nlohmann::ordered_json relax_summary_json(const RelaxResult& relax);
 std::string relax_summary_line(const RelaxResult& relax);
+// The line saying how many sharp edges were left out as short loose ends (FieldRequest::feature_min_length).
+std::string loose_edges_line(size_t edges, double min_length);
 
 using Clock = std::chrono::steady_clock;
 inline double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }

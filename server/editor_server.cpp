@@ -1192,7 +1192,7 @@ struct EditorServer::Impl {
                 const Request r = parse_request(body);
                 const int N = r.prescription.N;
                 std::shared_lock lock(designer_mutex);  // auto_singularities reads the designer; no refactoring meanwhile
-                const AutoResult a = request_auto(*designer, r.field, RequestConstraints{r.prescription.fixed, r.fixed_faces, {}, {}, 0, 0});
+                const AutoResult a = request_auto(*designer, r.field, RequestConstraints{r.prescription.fixed, r.fixed_faces, {}, {}, {}, 0, 0});
                 lock.unlock();
                 {
                   std::lock_guard guide_lock(auto_guide_mutex);

@@ -186,6 +186,52 @@ TEST(CliFeatures, CornerConflictsAreReported) {
   EXPECT_EQ(j["features"]["corner_faces"], 24);
 }
 
+// The flat-faced cube with a small spike raised from the middle of its top face: the spike's rim is sharp, a
+// closed piece of creases a quarter across, apart from the cube's twelve edges.
+Mesh spiked_cube(int n) {
+  Mesh m = make_cube_sphere(n, false);
+  for (int v = 0; v < m.V.rows(); ++v)
+    if (m.V(v, 2) == 1.0 && m.V(v, 0) == 0.0 && m.V(v, 1) == 0.0) m.V(v, 2) += 0.15;
+  return m;
+}
+
+// solve follows every sharp edge unless --feature-min-length is given; with it, the spike's piece (less than the
+// length across) is left out and said so. quad leaves it out by itself (one unit of the map) and makes its quads.
+TEST(CliFeatures, SmallPiecesOfCreasesAreLeftOutOfAMap) {
+  const int n = 16;
+  const Mesh m = spiked_cube(n);
+  const std::string mesh = mesh_file(m, "spiked.obj"), report = temp_file("r.json"), out = temp_file("q.obj");
+  FieldDesigner designer(m.V, m.F);
+  const size_t all = sharp_edges(m.V, designer.topology(), designer.geometry(), 30).size(), cube = 12 * n;
+  ASSERT_GT(all, cube);
+  auto r = run_cli("solve " + q(mesh) + " -N 4 --auto --align-features 30 --report " + q(report));
+  ASSERT_EQ(r.status, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j["features"]["sharp_edges"].get<size_t>(), all);
+  EXPECT_EQ(j["features"]["loose_edges"], 0);
+  r = run_cli("solve " + q(mesh) + " -N 4 --auto --align-features 30 --feature-min-length 0.3 --report " + q(report));
+  ASSERT_EQ(r.status, 0) << r.err;
+  j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j["features"]["sharp_edges"].get<size_t>(), cube);
+  EXPECT_EQ(j["features"]["loose_edges"].get<size_t>(), all - cube);
+  EXPECT_NE(r.out.find("features: " + std::to_string(all - cube) + " sharp edges left out, in chains with a loose end shorter than 0.3"),
+            std::string::npos)
+      << r.out;
+  // The map's unit at 200 squares: √(area / 200), above the spike's width.
+  double area = 0;
+  for (int f = 0; f < designer.topology().num_faces; ++f) area += designer.geometry().face_area[f];
+  r = run_cli("quad " + q(mesh) + " --auto --align-features 30 --target-faces 200 -o " + q(out) + " --report " + q(report));
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j["features"]["sharp_edges"].get<size_t>(), cube);
+  EXPECT_EQ(j["features"]["loose_edges"].get<size_t>(), all - cube);
+  EXPECT_NEAR(j["features"]["min_length"].get<double>(), std::sqrt(area / 200), 1e-9);
+  EXPECT_TRUE(j["quad"]["problems"].empty());
+  EXPECT_EQ(j["quad"]["euler_characteristic"], 2);
+  EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
+  EXPECT_EQ(j["param"]["flipped_faces"], 0);
+}
+
 TEST(CliFeatures, UsageAndInputErrors) {
   const std::string mesh = mesh_file(make_cube_sphere(2, false), "cube.obj");
   for (const std::string bad : {"-1", "200", "nan", "abc", "30x"}) {
@@ -209,6 +255,16 @@ TEST(CliFeatures, UsageAndInputErrors) {
   EXPECT_NE(r.err.find(edges + ":"), std::string::npos) << r.err;
   r = run_cli("solve " + q(mesh) + " -N 4 --features " + q(edges) + " --split-large-turns");
   EXPECT_EQ(r.status, 1);
+  r = run_cli("solve " + q(mesh) + " -N 4 --feature-min-length 1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--feature-min-length requires --align-features"), std::string::npos) << r.err;
+  for (const std::string bad : {"-1", "abc"}) {
+    r = run_cli("solve " + q(mesh) + " -N 4 --align-features 30 --feature-min-length " + bad);
+    EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+  }
+  r = run_cli("solve " + q(mesh) + " -N 4 --align-features 30 --feature-min-length nan");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("--feature-min-length: expected a finite length >= 0"), std::string::npos) << r.err;
 }
 
 TEST(CliFeatures, RenderDrawsTheSharpEdges) {

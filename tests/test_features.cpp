@@ -175,6 +175,86 @@ TEST(SharpEdges, CylinderRimsOnly) {
   EXPECT_NE(error_of([] { make_capped_cylinder(4, 8, 2, -1); }).find("height"), std::string::npos);
 }
 
+// Edges drawn on a flat 20 × 20 grid of the unit square (cells of h = 0.05) by grid steps, with a minimum length
+// of 0.25 (five cells): what stays and what goes is known from the drawing alone.
+TEST(SharpEdges, ShortLooseEndsAndSmallPiecesAreDropped) {
+  const int n = 20;
+  const double h = 1.0 / n;
+  const Mesh m = make_holed_grid(n, 0);
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  auto vertex = [&](int i, int j) {
+    for (int v = 0; v < m.V.rows(); ++v)
+      if (std::abs(m.V(v, 0) - i * h) < 1e-12 && std::abs(m.V(v, 1) - j * h) < 1e-12) return v;
+    ADD_FAILURE() << "no grid vertex (" << i << ", " << j << ")";
+    return -1;
+  };
+  auto edge = [&](int a, int b) {
+    for (int q = t.vertex_edge_offsets[a]; q < t.vertex_edge_offsets[a + 1]; ++q) {
+      const int e = t.vertex_edges[q];
+      if (t.edge_vertices(e, 0) == b || t.edge_vertices(e, 1) == b) return e;
+    }
+    ADD_FAILURE() << "no edge (" << a << ", " << b << ")";
+    return -1;
+  };
+  // The path of grid steps through the points given (each pair on one row or column).
+  auto path = [&](std::vector<std::pair<int, int>> points) {
+    std::vector<int> out;
+    for (size_t k = 0; k + 1 < points.size(); ++k) {
+      auto [i, j] = points[k];
+      const auto [i1, j1] = points[k + 1];
+      while (i != i1 || j != j1) {
+        const int a = vertex(i, j);
+        i += (i1 > i) - (i1 < i), j += (j1 > j) - (j1 < j);
+        out.push_back(edge(a, vertex(i, j)));
+      }
+    }
+    return out;
+  };
+  // A line of 18 cells whose loose ends are 6 cells long (from x = 1 and x = 19 to the junctions at x = 7, 13): stays.
+  const std::vector<int> line = path({{1, 10}, {19, 10}});
+  const std::vector<int> long_spur = path({{7, 10}, {7, 4}});       // 6 cells from the line: stays
+  const std::vector<int> short_spur = path({{11, 10}, {11, 13}});   // 3 cells: goes
+  const std::vector<int> dash = path({{2, 2}, {4, 2}});             // 2 cells on its own: goes
+  const std::vector<int> ring = path({{2, 16}, {3, 16}, {3, 17}, {2, 17}, {2, 16}});  // 1 × 1 loop: goes
+  const std::vector<int> square = path({{12, 12}, {18, 12}, {18, 18}, {12, 18}, {12, 12}});  // 6 × 6 loop: stays
+  // A 2-cell chain off the line that ends in two 2-cell spurs: the spurs go, then the chain is loose and goes.
+  const std::vector<int> fork = path({{13, 10}, {13, 8}});
+  const std::vector<int> tines = path({{11, 8}, {15, 8}});
+  std::vector<int> edges;
+  for (const auto* part : {&line, &long_spur, &short_spur, &dash, &ring, &square, &fork, &tines})
+    edges.insert(edges.end(), part->begin(), part->end());
+  std::sort(edges.begin(), edges.end());
+  std::vector<int> stays = line;
+  stays.insert(stays.end(), long_spur.begin(), long_spur.end());
+  stays.insert(stays.end(), square.begin(), square.end());
+  std::sort(stays.begin(), stays.end());
+  std::vector<int> goes;
+  std::set_difference(edges.begin(), edges.end(), stays.begin(), stays.end(), std::back_inserter(goes));
+  std::vector<int> dropped;
+  EXPECT_EQ(without_short_feature_ends(m.V, t, edges, 5 * h + 1e-9, &dropped), stays);
+  EXPECT_EQ(dropped, goes);
+  // Nothing goes without a length. With 0.4 the line's loose ends go, then what is left of it (6 cells between
+  // them), and the spurs; the square (0.42 across) stays.
+  EXPECT_EQ(without_short_feature_ends(m.V, t, edges, 0), edges);
+  std::vector<int> sorted_square = square;
+  std::sort(sorted_square.begin(), sorted_square.end());
+  EXPECT_EQ(without_short_feature_ends(m.V, t, edges, 0.4), sorted_square);
+}
+
+// A clean CAD-like part loses nothing: the cube's twelve edges end at junctions, and the block is wider than the
+// length.
+TEST(SharpEdges, ACubesEdgesAllStay) {
+  const Mesh m = make_cube_sphere(6, false);
+  FieldDesigner designer(m.V, m.F);
+  const std::vector<int> edges = sharp_edges(m.V, designer.topology(), designer.geometry(), 30);
+  std::vector<int> dropped;
+  EXPECT_EQ(without_short_feature_ends(m.V, designer.topology(), edges, 1.9, &dropped), edges);
+  EXPECT_TRUE(dropped.empty());
+  // Wider than the cube's diagonal (2√3): the whole piece is smaller than the length.
+  EXPECT_TRUE(without_short_feature_ends(m.V, designer.topology(), edges, 3.5).empty());
+}
+
 TEST(ReadFeatureEdges, ReadsPairsAndNamesTheLineOfEachError) {
   const Mesh m = make_cube_sphere(2, false);
   const Topology t = test::topo(m);

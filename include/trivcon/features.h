@@ -53,6 +53,19 @@ bool is_convex_edge(const MatrixX3d& V, const Topology& topology, const Geometry
 // throws trivcon::Error), in increasing id.
 std::vector<int> sharp_edges(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, double degrees);
 
+// The sharp edges without short loose ends, for a map: `edges` (interior edge ids, increasing) taken as a graph on
+// their vertices is cut into chains at every vertex where other than two of them meet; a chain with a free end
+// (a vertex with one sharp edge) shorter than `min_length` (in the mesh's units, along the chain) is dropped, and
+// again until none is left (dropping a spur can leave a junction with a free chain); then every connected piece
+// less than `min_length` across (the largest distance between two of its vertices) is dropped. Other chains
+// between junctions, and closed loops, stay whatever their length. A scan's creases come out of a dihedral
+// threshold as hundreds of dashes and tiny rings a fraction of a quad long; each asks the map for integer
+// iso-lines of its own, and lines that close together fold it. A clean CAD part's lines are long or end at
+// junctions: nothing is dropped there.
+// Returns the edges kept, increasing; `dropped` (optional) gets the others, increasing.
+std::vector<int> without_short_feature_ends(const MatrixX3d& V, const Topology& topology, const std::vector<int>& edges, double min_length,
+                                            std::vector<int>* dropped = nullptr);
+
 // Reads feature edges: one "i j" (vertex ids, either order) per line, '#' comments and blank lines skipped.
 // Errors name file:line: a malformed line, a vertex id out of range, a pair that is not an edge of the mesh,
 // a boundary edge, an edge listed twice. Returns edge ids in increasing order.

@@ -39,6 +39,10 @@ struct FieldRequest {
   bool align_boundary = false;           // fix every face with a boundary edge to that edge's direction
   std::optional<double> feature_degrees; // fix the faces beside every interior edge sharper than this (degrees)
   std::vector<int> feature_edges;        // ... and beside these edges (ids of the designer's topology)
+  // Of the edges sharper than feature_degrees, those in chains with a loose end shorter than this (in the mesh's
+  // units) are not followed (without_short_feature_ends, trivcon/features.h; listed edges always are). Unset:
+  // none dropped, except that map_request drops those shorter than one unit of the map.
+  std::optional<double> feature_min_length;
   bool auto_place = false;               // the singularities of the smoothest field (auto_singularities)
   AutoOptions auto_options;              // its cancel distance, iterations, curvature guidance (N and fixed: the request's)
   std::vector<std::pair<int, double>> roots;  // (face, angle): where a component's field starts
@@ -55,6 +59,7 @@ struct RequestConstraints {
   std::map<int, double> fixed;    // every fixed face: face -> angle in its frame
   std::vector<int> fixed_faces;   // its faces, increasing (FieldDesigner::set_fixed_faces)
   std::vector<int> sharp_edges;   // the feature edges, increasing
+  std::vector<int> loose_edges;   // sharp edges left out as short loose ends (feature_min_length), increasing
   FeatureAlignment features;      // the faces fixed beside them, corners, conflicts
   int convex_edges = 0;           // sharp edges that are ridges (is_convex_edge)
   int boundary_overridden = 0;    // faces align_boundary fixed that a sharp edge turned (modulo 2π/N)
@@ -170,7 +175,8 @@ inline constexpr int kMapRetryCandidates = 3;
 // map_request does not relax a placement whose first attempt has more singularities than this (each move ranks
 // every singularity's candidates again).
 inline constexpr size_t kMapRelaxMaxSingularities = 600;
-// cancel_for_map, solve_request, and the map with request_param_options (and its quad mesh with `quads`). With
+// cancel_for_map, solve_request, and the map with request_param_options (and its quad mesh with `quads`); a request
+// that detects sharp edges (feature_degrees) without a feature_min_length gets one unit of the map. With
 // automatic placement and no cancel distance in the request, a map left with folded or degenerate faces or wrong
 // windings (or, with `quads`, whose quad mesh fails a check of check_quads), or stretched beyond
 // kMapDistortionGoal, is made again: from the same singularities relaxed (trivcon/relax.h; kept a unit from the

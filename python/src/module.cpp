@@ -987,7 +987,8 @@ PYBIND11_MODULE(_core, m) {
              std::map<int, double> fixed, bool align_boundary, std::optional<double> feature_degrees,
              std::vector<std::pair<int, int>> feature_edges, std::vector<std::pair<int, double>> roots, double auto_cancel, bool auto_cancel_absolute, int auto_iterations,
              std::optional<double> curvature_t, bool split, int max_rounds, bool relax, std::vector<int> relax_pins, int relax_cancel,
-             int relax_max_moves, int relax_reach, double relax_periods, double map_edge_length, double map_target_faces) {
+             int relax_max_moves, int relax_reach, double relax_periods, double map_edge_length, double map_target_faces,
+             std::optional<double> feature_min_length) {
             // The library's request layer (trivcon/request.h) does the work; here only the conversion.
             FieldRequest q;
             q.prescription.N = N;
@@ -997,6 +998,7 @@ PYBIND11_MODULE(_core, m) {
             q.prescription.fixed = std::move(fixed);
             q.align_boundary = align_boundary;
             q.feature_degrees = feature_degrees;
+            q.feature_min_length = feature_min_length;
             for (size_t k = 0; k < feature_edges.size(); ++k) {  // vertex pairs, as a --features file names them
               const auto [i, j] = feature_edges[k];
               const int e = edge_between(s->topology(), i, j);
@@ -1103,6 +1105,7 @@ PYBIND11_MODULE(_core, m) {
           py::arg("auto_iterations"), py::arg("curvature_t"), py::arg("split"), py::arg("max_rounds"), py::arg("relax") = false,
           py::arg("relax_pins") = std::vector<int>{}, py::arg("relax_cancel") = 0, py::arg("relax_max_moves") = 10000,
           py::arg("relax_reach") = 1, py::arg("relax_periods") = 0.0, py::arg("map_edge_length") = 0.0, py::arg("map_target_faces") = 0.0,
+          py::arg("feature_min_length") = std::nullopt,
           "One field request (trivcon/request.h; vertex None: the smoothest field's singularities, chosen for a map at the given "
           "scale as the map commands do when one is > 0, cancel_for_map): (designer of the final mesh, "
           "DesignResult, AutoResult or None, parent face of each face (with split), rounds, converged, sharp edges, relaxation "

@@ -106,6 +106,34 @@ def test_auto_for_a_map_is_the_programs(cli, tmp_path):
         d.solve(4, "auto", map_edge_length=-1)
 
 
+def test_small_pieces_of_creases_are_left_out_of_a_map(cli, tmp_path):
+    # A flat-faced cube with a small spike on its top face: its rim is a closed piece of creases 0.25 across.
+    # feature_min_length leaves it out (as --feature-min-length); a map's request leaves out what is shorter
+    # than one unit by itself, as `trivcon quad` does, with the same singularities.
+    n = 16
+    V, F = trivcon.make_cube_sphere(n, spherical=False)
+    V[(V[:, 0] == 0) & (V[:, 1] == 0) & (V[:, 2] == 1), 2] += 0.15
+    d = trivcon.FieldDesigner(V, F)
+    every = d.solve(4, "auto", align_features=30).sharp_edges
+    assert len(every) > 12 * n
+    assert len(d.solve(4, "auto", align_features=30, feature_min_length=0.3).sharp_edges) == 12 * n
+    r = d.solve(4, "auto", align_features=30, map_target_faces=200)
+    assert len(r.sharp_edges) == 12 * n
+    on_cube = (np.abs(V[r.sharp_edges]) == 1).sum(axis=2) >= 2  # both ends on a cube edge
+    assert on_cube.all()
+    mesh, sing = tmp_path / "spiked.obj", tmp_path / "s.txt"
+    trivcon.write_mesh(str(mesh), V, F)
+    cli("quad", mesh, "--auto", "--align-features", 30, "--target-faces", 200, "-o", tmp_path / "q.obj", "--sing-out", sing)
+    program = {int(v): k for v, k in (line.split() for line in sing.read_text().splitlines() if not line.startswith("#"))}
+    assert {v: str(k) for v, k in r.singularities.items()} == program
+    q = r.quad(target_faces=200)
+    assert q.ok and q.quality["euler_characteristic"] == 2
+    with pytest.raises(trivcon.Error, match="^feature_min_length needs align_features$"):
+        d.solve(4, "auto", feature_min_length=1)
+    with pytest.raises(trivcon.Error, match=r"^feature_min_length must be a number >= 0, not -1$"):
+        d.solve(4, "auto", align_features=30, feature_min_length=-1)
+
+
 def test_uniform_size_turns_the_sizing_off():
     # An annulus with its circles aligned: by default the unit follows the map's own scale (two sizing rounds)
     # and stretches less; uniform_size=True keeps one unit everywhere, as `--uniform-size`.

@@ -826,7 +826,7 @@ class FieldDesigner(_Cached):
     def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False,
               align_features=None, feature_edges=None, roots=None, auto_cancel=0.0, align_curvature=None,
               split_large_turns=False, max_rounds=8, relax=False, relax_pins=None, relax_cancel=0, relax_max_moves=10000,
-              relax_reach=1, relax_periods=0.0, map_target_faces=None, map_edge_length=None):
+              relax_reach=1, relax_periods=0.0, map_target_faces=None, map_edge_length=None, feature_min_length=None):
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
@@ -846,7 +846,11 @@ class FieldDesigner(_Cached):
         align_features: None, or an angle in degrees: fix the faces beside every interior edge whose
           dihedral angle exceeds it to that edge's direction (as solve --align-features DEG; over
           align_boundary, under fixed=); feature_edges: (n, 2) vertex pairs of more such edges (as a
-          --features file). Result.sharp_edges lists the edges followed.
+          --features file). Result.sharp_edges lists the edges followed. feature_min_length: of the edges
+          align_features finds, those in a chain with a loose end shorter than this (mesh units, along the
+          chain), and pieces less than this across, are not followed (as --feature-min-length; a scan's dashed
+          creases). None: all followed, except that with map_target_faces / map_edge_length those shorter than
+          one unit of the map are left out.
         roots: {face: angle}: where the field's propagation starts per component (default: each
           component's smallest face, angle 0; a component with fixed faces starts at its smallest one).
 
@@ -909,6 +913,13 @@ class FieldDesigner(_Cached):
             if isinstance(align_features, bool) or not isinstance(align_features, _numbers.Real) or not (0 <= align_features <= 180):
                 raise Error(f"align_features: expected None or an angle in degrees in [0, 180], got {align_features!r}")
             degrees = float(align_features)
+        if feature_min_length is not None:
+            if degrees is None:
+                raise Error("feature_min_length needs align_features")
+            if (isinstance(feature_min_length, bool) or not isinstance(feature_min_length, _numbers.Real)
+                    or not _math.isfinite(feature_min_length) or feature_min_length < 0):
+                raise Error(f"feature_min_length must be a number >= 0, not {feature_min_length!r}")
+            feature_min_length = float(feature_min_length)
         edge_pairs = []
         if feature_edges is not None:
             e = _array(feature_edges, "feature_edges")
@@ -955,7 +966,7 @@ class FieldDesigner(_Cached):
             N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), explicit, bool(align_boundary),
             degrees, edge_pairs, root_list, cancel, False, 8, curvature_t, bool(split_large_turns), int(max_rounds),
             bool(relax), pins, int(relax_cancel), int(relax_max_moves), int(relax_reach), float(relax_periods), map_scale[0],
-            map_scale[1])
+            map_scale[1], feature_min_length)
         auto = AutoResult(a, self) if a is not None else None
         designer = self if core is self._d else FieldDesigner._of_core(core, self)
         result = Result(designer, r, auto)

@@ -156,6 +156,77 @@ std::vector<int> sharp_edges(const MatrixX3d& V, const Topology& t, const Geomet
   return out;
 }
 
+std::vector<int> without_short_feature_ends(const MatrixX3d& V, const Topology& t, const std::vector<int>& edges, double min_length,
+                                            std::vector<int>* dropped) {
+  std::vector<char> alive(t.num_edges, 0);
+  for (int e : edges) {
+    if (e < 0 || e >= t.num_edges) throw Error("without_short_feature_ends: edge " + std::to_string(e) + " out of range");
+    alive[e] = 1;
+  }
+  auto other_end = [&](int e, int v) { return t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0); };
+  auto sharp_at = [&](int v) {
+    std::vector<int> out;
+    for (int q = t.vertex_edge_offsets[v]; q < t.vertex_edge_offsets[v + 1]; ++q)
+      if (alive[t.vertex_edges[q]]) out.push_back(t.vertex_edges[q]);
+    return out;
+  };
+  std::vector<int> ends;  // vertices of the edges: where chains may have free ends
+  for (int e : edges) ends.push_back(t.edge_vertices(e, 0)), ends.push_back(t.edge_vertices(e, 1));
+  std::sort(ends.begin(), ends.end());
+  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+  for (bool changed = min_length > 0; changed;) {
+    changed = false;
+    std::vector<int> drop;
+    for (int v : ends) {
+      std::vector<int> at = sharp_at(v);
+      if (at.size() != 1) continue;
+      // Walk the chain from its free end to the next vertex where other than two sharp edges meet.
+      std::vector<int> chain;
+      double length = 0;
+      int e = at[0], w = v;
+      while (true) {
+        chain.push_back(e);
+        const int next = other_end(e, w);
+        length += (V.row(next) - V.row(w)).norm();
+        at = sharp_at(next);
+        if (at.size() != 2 || length >= min_length) break;
+        e = at[0] == e ? at[1] : at[0], w = next;
+      }
+      if (length < min_length) drop.insert(drop.end(), chain.begin(), chain.end());
+    }
+    for (int e : drop) changed |= alive[e] != 0, alive[e] = 0;
+  }
+  // Then every connected piece less than min_length across (the largest distance between two of its vertices):
+  // a small closed network of creases, as where a scan's noise rings a rounded tip. The distance from one vertex
+  // to the farthest, d, bounds it (d ≤ across ≤ 2d); pairs are compared only between those bounds.
+  std::vector<char> seen(t.num_vertices, 0);
+  for (int v : ends) {
+    if (seen[v] || min_length <= 0 || sharp_at(v).empty()) continue;
+    std::vector<int> piece{v}, piece_edges;
+    seen[v] = 1;
+    for (size_t k = 0; k < piece.size(); ++k)
+      for (int e : sharp_at(piece[k])) {
+        const int w = other_end(e, piece[k]);
+        if (t.edge_vertices(e, 0) == piece[k]) piece_edges.push_back(e);  // each edge once, from its first end
+        if (!seen[w]) seen[w] = 1, piece.push_back(w);
+      }
+    double from_first = 0;
+    for (int w : piece) from_first = std::max(from_first, (V.row(w) - V.row(v)).norm());
+    double across = from_first;
+    if (from_first < min_length && 2 * from_first >= min_length)
+      for (size_t a = 0; a < piece.size() && across < min_length; ++a)
+        for (size_t b = a + 1; b < piece.size(); ++b) across = std::max(across, (V.row(piece[a]) - V.row(piece[b])).norm());
+    if (across < min_length)
+      for (int e : piece_edges) alive[e] = 0;
+  }
+  std::vector<int> kept;
+  for (int e : edges) {
+    if (alive[e]) kept.push_back(e);
+    else if (dropped) dropped->push_back(e);
+  }
+  return kept;
+}
+
 FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const Geometry& g, const std::vector<int>& edges, int N) {
   if (N < 1) throw Error("feature_alignment: N = " + std::to_string(N) + " (need N >= 1)");
   // Per face, its feature edges with their direction (p_j − p_i, i < j, in the face's frame) and length.

@@ -24,11 +24,13 @@ void check_face_id(const Topology& t, int f, const char* what) {
                 " faces)");
 }
 
-// The sharp edges of a request on a mesh: those sharper than feature_degrees, and the listed ones.
-std::vector<int> request_sharp_edges(const FieldDesigner& d, const FieldRequest& r) {
+// The sharp edges of a request on a mesh: those sharper than feature_degrees (without the short loose ends when
+// feature_min_length is set; those go to `loose`), and the listed ones.
+std::vector<int> request_sharp_edges(const FieldDesigner& d, const FieldRequest& r, std::vector<int>* loose = nullptr) {
   const Topology& t = d.topology();
   std::vector<int> out;
   if (r.feature_degrees) out = sharp_edges(d.V(), t, d.geometry(), *r.feature_degrees);
+  if (r.feature_min_length) out = without_short_feature_ends(d.V(), t, out, *r.feature_min_length, loose);
   for (int e : r.feature_edges) {
     if (e < 0 || e >= t.num_edges)
       throw Error("feature edges: edge " + std::to_string(e) + " out of range (the mesh has " + std::to_string(t.num_edges) + " edges)");
@@ -49,7 +51,8 @@ std::map<int, double> fixed_on(const FieldDesigner& d, const FieldRequest& r, co
   std::map<int, double> fixed;
   if (r.align_boundary) fixed = boundary_alignment(d.V(), t, d.geometry());
   if (r.features_given()) {
-    const std::vector<int> edges = request_sharp_edges(d, r);
+    std::vector<int> loose;
+    const std::vector<int> edges = request_sharp_edges(d, r, &loose);
     FeatureAlignment a = feature_alignment(d.V(), t, d.geometry(), edges, r.prescription.N);
     int overridden = 0;
     for (auto [f, angle] : a.fixed) {
@@ -60,6 +63,7 @@ std::map<int, double> fixed_on(const FieldDesigner& d, const FieldRequest& r, co
     if (report) {
       for (int e : edges) report->convex_edges += is_convex_edge(d.V(), t, d.geometry(), e);
       report->sharp_edges = edges;
+      report->loose_edges = std::move(loose);
       report->features = std::move(a);
       report->boundary_overridden = overridden;
     }
@@ -310,6 +314,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   const bool own_onto = escalate && request.auto_options.onto_features == 0;
   cancel_for_map(request, designer, edge_length, target_faces);
   const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
+  if (request.feature_degrees && !request.feature_min_length) request.feature_min_length = map_unit(designer, edge_length, target_faces);
   // The map's folded and degenerate faces and wrong windings, and with quads the quad mesh's failed checks.
   auto problems = [&](const MapOutcome& m) {
     const ParamQuality& q = m.param.quality;
