@@ -61,11 +61,16 @@ MapRun run_map(const MapCommand& o, bool quads) {
   run.onto_units = made.onto_units;
   run.onto_flat = made.onto_flat;
   run.quads = std::move(made.quads);
+  run.refined_edges = made.refined_edges;
   return run;
 }
 
 void write_map_obj(const std::string& path, const MapRun& run) {
   const MeshData& mesh = run.loaded.mesh;
+  if (run.out.refined) {
+    write_uv_obj(path, run.out.V, run.out.F, input_corner_uv(run.param, run.map_designer().topology(), run.out.F));
+    return;
+  }
   const Eigen::MatrixXd uv = input_corner_uv(run.param, run.designer->topology(), mesh.F);
   if (const RepairedMesh* repair = run.repaired())
     write_uv_obj(path, run.loaded.input.V, run.loaded.input.F, corner_rows_on_input(*repair, run.loaded.input.F, uv));
@@ -74,7 +79,7 @@ void write_map_obj(const std::string& path, const MapRun& run) {
 }
 
 void write_map_singularities(const std::string& path, const MapRun& run) {
-  write_singularities(path, input_singularities(run.out.prescription.vertex, run.repaired()), 4);
+  write_singularities(path, run.out.refined ? run.out.prescription.vertex : input_singularities(run.out.prescription.vertex, run.repaired()), 4);
 }
 
 nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
@@ -92,6 +97,11 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                                    {"field", {{"verified", run.out.verified}, {"energy", run.out.design.connection.energy}}},
                                    {"param", param_report(param)}};
   if (const RepairedMesh* repair = run.repaired()) report["repair"] = repair_summary_json(*repair);
+  if (run.out.refined)
+    report["refine"] = {{"split_edges", run.refined_edges},
+                        {"vertices", run.out.V.rows()},
+                        {"faces", run.out.F.rows()},
+                        {"parent_face", run.out.parent_face}};
   if (!run.out.sharp_edges.empty()) {
     const FeatureAlignment& a = run.out.constraints.features;
     report["features"] = {{"sharp_edges", run.out.sharp_edges.size()},
@@ -144,6 +154,11 @@ std::string map_summary(const MapCommand& o, const MapRun& run) {
                                                   : loose_edges_line(run.out.constraints.loose_edges.size(), *run.request.feature_min_length)) +
          (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string()) +
          (run.placements > 1 ? placement_line(run) : std::string()) +
+         (run.out.refined ? "refined: " + std::to_string(run.refined_edges) +
+                                " edges whose ends lie on aligned lines split at their midpoints (the map folded beside them): " +
+                                std::to_string(run.out.V.rows()) + " vertices, " + std::to_string(run.out.F.rows()) +
+                                " faces; the map's file holds the refined mesh, the report its faces' input faces (refine.parent_face)\n"
+                          : std::string()) +
          "field: N 4, " + std::to_string(run.param.cones.size()) + " singular vertices, verified\n";
 }
 

@@ -50,7 +50,10 @@ struct MapRun {
   bool onto_flat = false;        // MapOutcome::onto_flat
   bool boundary_aligned_unasked = false;  // quad --auto aligned the boundary without --align-boundary
   std::optional<QuadMesh> quads;  // run_map(…, true): the kept map's quad mesh
+  int refined_edges = 0;          // MapOutcome::refined_edges: the map is on out's refined mesh
   const RepairedMesh* repaired() const { return loaded.repaired(); }
+  // The designer of the mesh the map is on: the refined one, else the input's (repaired).
+  const FieldDesigner& map_designer() const { return out.designer(*designer); }
 };
 
 // Reads the mesh (repaired unless --no-repair), solves the request and makes the map (map_request: with --auto,
@@ -61,9 +64,11 @@ struct MapRun {
 // the boundary is then aligned even without --align-boundary (quads end on it only so).
 MapRun run_map(const MapCommand& command, bool quads = false);
 
-// The map as `param -o` writes it: the input file's mesh (repaired or not) with one vt per corner.
+// The map as `param -o` writes it: the input file's mesh (repaired or not) with one vt per corner; when the map
+// refined the mesh, the refined mesh (the input's vertices first, with their ids; each face's input face in the
+// report's refine.parent_face).
 void write_map_obj(const std::string& path, const MapRun& run);
-// --sing-out: the singularities used, by the input's vertex ids.
+// --sing-out: the singularities used, by the input's vertex ids (the refined mesh's, when the map refined it).
 void write_map_singularities(const std::string& path, const MapRun& run);
 // What both reports hold: the mesh, the singularities (the map's cones), the field, the map (param_report), and
 // repair and relax when they ran; the caller adds its own entries and "seconds".

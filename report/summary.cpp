@@ -132,8 +132,8 @@ std::string relax_summary_line(const RelaxResult& r) {
 
 std::string loose_edges_line(size_t edges, double min_length) {
   std::ostringstream s;
-  s << "features: " << edges << " sharp edges left out, in chains with a loose end shorter than " << std::setprecision(3) << min_length
-    << " (--feature-min-length; report: features.loose_edges)\n";
+  s << "features: " << edges << " sharp edges left out (faces sharp on all three edges, chains with a loose end or pieces shorter than "
+    << std::setprecision(3) << min_length << "; --feature-min-length; report: features.loose_edges)\n";
   return s.str();
 }
 

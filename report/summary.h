@@ -25,7 +25,7 @@ nlohmann::ordered_json repair_summary_json(const RepairedMesh& repaired);
 // candidate solves, time; and its one-line summary.
 nlohmann::ordered_json relax_summary_json(const RelaxResult& relax);
 std::string relax_summary_line(const RelaxResult& relax);
-// The line saying how many sharp edges were left out as short loose ends (FieldRequest::feature_min_length).
+// The line saying how many sharp edges were left out for a map (FieldRequest::feature_min_length).
 std::string loose_edges_line(size_t edges, double min_length);
 
 using Clock = std::chrono::steady_clock;

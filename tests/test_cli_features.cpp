@@ -214,7 +214,8 @@ TEST(CliFeatures, SmallPiecesOfCreasesAreLeftOutOfAMap) {
   j = nlohmann::json::parse(slurp(report));
   EXPECT_EQ(j["features"]["sharp_edges"].get<size_t>(), cube);
   EXPECT_EQ(j["features"]["loose_edges"].get<size_t>(), all - cube);
-  EXPECT_NE(r.out.find("features: " + std::to_string(all - cube) + " sharp edges left out, in chains with a loose end shorter than 0.3"),
+  EXPECT_NE(r.out.find("features: " + std::to_string(all - cube) +
+                       " sharp edges left out (faces sharp on all three edges, chains with a loose end or pieces shorter than 0.3;"),
             std::string::npos)
       << r.out;
   // The map's unit at 200 squares: √(area / 200), above the spike's width.

@@ -196,6 +196,24 @@ TEST(CliQuad, ArmadilloAt1000QuadsIsPlacedAgainUntilTheMapIsClean) {
   expect_quads_at_the_singularities("armadillo.obj", "--auto --target-faces 1000", 2, true);
 }
 
+// A scanned CAD part with its creases at 45° (rocker-arm): 223 sharp edges, most in dashes of one or two edges and
+// knots of faces sharp on all three edges. The map leaves those out (report features.loose_edges) and follows the
+// rest: the quads are at the singularities, and every kept sharp edge lies on an iso-line.
+TEST(CliQuad, RockerArmFollowsItsCreasesWithoutTheirNoise) {
+  TRIVCON_REQUIRE_SHARED();
+  expect_quads_at_the_singularities("rocker-arm.obj", "--auto --align-features 45 --target-faces 3000", 0, true);
+  const std::string report = temp_file("r.json");
+  ASSERT_EQ(run_cli("quad " + test::shared_mesh("rocker-arm.obj") + " --auto --align-features 45 --target-faces 3000 -o " + temp_file("q.obj") +
+                    " --report " + report)
+                .status,
+            0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_GT(j["features"]["loose_edges"].get<int>(), 100);
+  EXPECT_GT(j["features"]["sharp_edges"].get<int>(), 30);
+  EXPECT_EQ(j["param"]["unaligned_edges"], 0);
+  EXPECT_TRUE(j["quad"]["problems"].empty());
+}
+
 // A clean map whose quad mesh fails: bunny at 1,000 quads, three +1/4 around the tail gave one quad turned over
 // against the surface; `quad` places again (pairs cancelled within 2 units) and the quad mesh passes every check.
 TEST(CliQuad, BunnyAt1000QuadsIsPlacedAgainWhenAQuadTurnsOver) {
@@ -299,13 +317,9 @@ TEST(CliQuad, RoundDiskSplitsItsCentreIntoFourCorners) {
   EXPECT_NEAR(static_cast<double>(q.quads.size()), 1000.0, 300.0);
 }
 
-// A 20-sided prism whose caps are fans from one rim vertex (as CAD exports triangulate flat faces: no interior
-// vertex). With its rims as feature lines every cap face is fixed along the rim, the cap's index +1 sits on a
-// rim vertex, and its map folds everywhere: no quad can be traced. The run says so and fails (exit 3) without
-// writing an empty -o (no reader takes a mesh without faces), with the report written; the map keeps the
-// field's scale instead of fitting its cancelled area to the target (which made the unit vanish and the (u, v)
-// beyond 2^30).
-TEST(CliQuad, MapWithoutQuadsIsAnErrorAndNoEmptyFile) {
+// A 20-sided prism (10 stacks, radius 1, height 2.85) whose caps are fans from one rim vertex, as CAD exports
+// triangulate flat faces: no inner vertex. Vertex 0 is the fan's apex at the bottom, vertex 200 at the top.
+Mesh fan_capped_prism() {
   const int n = 20, stacks = 10;
   Mesh m;
   m.V.resize(n * (stacks + 1), 3);
@@ -320,8 +334,56 @@ TEST(CliQuad, MapWithoutQuadsIsAnErrorAndNoEmptyFile) {
   for (int k = 1; k + 1 < n; ++k) faces.emplace_back(0, k, k + 1), faces.emplace_back(stacks * n, stacks * n + k + 1, stacks * n + k);
   m.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
   for (size_t f = 0; f < faces.size(); ++f) m.F.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
-  const std::string mesh = mesh_file(m, "fan_prism.obj"), out = temp_file("fan_prism_q.obj"), report = temp_file("fan_prism.json");
-  const auto r = run_cli("quad " + mesh + " --auto --align-features 30 --target-faces 300 -o " + out + " --report " + report);
+  return m;
+}
+
+// With its rims as feature lines, every face of a fan cap has its three corners on a rim's iso-lines, so the map of
+// the input folds whatever the singularities (the cap's faces between the apex and the rim's far side are flat in
+// (u, v)). quad splits the fans' 2 × 17 inner edges at their midpoints and maps the refined mesh: the cube-like
+// grid of a cylinder (8 corners of valence 3 on the rims), the refined mesh written as the map's file (the
+// input's vertices first, with their ids) and each face's input face in the report.
+TEST(CliQuad, FanCapsAreRefinedWhereTheMapFolds) {
+  const Mesh m = fan_capped_prism();
+  const std::string mesh = mesh_file(m, "fan_prism.obj"), out = temp_file("fan_prism_q.obj"), report = temp_file("fan_prism.json"),
+                    uv = temp_file("fan_prism_uv.obj"), sings = temp_file("fan_prism.sing");
+  const auto r = run_cli("quad " + mesh + " --auto --align-features 30 --target-faces 300 -o " + out + " --report " + report + " --uv-out " + uv +
+                         " --sing-out " + sings);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("refined: 34 edges whose ends lie on aligned lines split at their midpoints (the map folded beside them): 254 vertices, "
+                       "504 faces"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("irregular vertices: 8 (singularities: 8 of valence 3), exactly at the singularities"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j["refine"]["split_edges"], 34);
+  const std::vector<int> parent = j["refine"]["parent_face"];
+  ASSERT_EQ(parent.size(), 504u);
+  for (int f = 0; f < 504; ++f)  // each face keeps its id for its first child; the others are caps' faces (400 on)
+    EXPECT_TRUE(f < 436 ? parent[f] == f : parent[f] >= 400 && parent[f] < 436) << f;
+  EXPECT_TRUE(j["quad"]["problems"].empty());
+  EXPECT_EQ(j["quad"]["euler_characteristic"], 2);
+  EXPECT_EQ(j["param"]["flipped_faces"], 0);
+  EXPECT_EQ(j["param"]["degenerate_faces"], 0);
+  // The map's file: the refined mesh, its first 220 vertices the input's.
+  const MeshData refined = read_mesh(uv);
+  ASSERT_EQ(refined.V.rows(), 254);
+  ASSERT_EQ(refined.F.rows(), 504);
+  EXPECT_EQ((refined.V.topRows(220) - m.V).cwiseAbs().maxCoeff(), 0);
+  EXPECT_EQ(read_corner_uv(uv, refined.F).rows(), 504);
+  for (const auto& [v, index] : test::read_singularity_texts(sings)) {
+    EXPECT_LT(v, 254);
+    EXPECT_EQ(index, "1/4");
+  }
+}
+
+// Singularities of index +1 (one per cap, on the apexes) cannot be mapped without folds, refined or not: no quad
+// can be traced. The run says so and fails (exit 3) without writing an empty -o (no reader takes a mesh without
+// faces), with the report written; the map keeps the field's scale instead of fitting its cancelled area to the
+// target (which made the unit vanish and the (u, v) beyond 2^30).
+TEST(CliQuad, MapWithoutQuadsIsAnErrorAndNoEmptyFile) {
+  const std::string mesh = mesh_file(fan_capped_prism(), "fan_prism.obj"), out = temp_file("fan_prism_q.obj"),
+                    report = temp_file("fan_prism.json");
+  const auto r = run_cli("quad " + mesh + " --sing 0:1 --sing 200:1 --align-features 30 --target-faces 300 -o " + out + " --report " + report);
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("trivcon: error: the map gave no quads ("), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("'" + out + "' not written"), std::string::npos) << r.err;

@@ -242,6 +242,42 @@ TEST(SharpEdges, ShortLooseEndsAndSmallPiecesAreDropped) {
   EXPECT_EQ(without_short_feature_ends(m.V, t, edges, 0.4), sorted_square);
 }
 
+// On an icosahedron with one vertex pulled out, most edges are sharp at 30° and most faces have three: each face
+// that still has three loses its least sharp one, so none is left with three, and each edge dropped was the least
+// sharp of a face whose other two stayed sharp up to then.
+TEST(SharpEdges, FacesSharpOnAllThreeEdgesLoseTheLeastSharp) {
+  Mesh m = make_icosphere(0);
+  m.V.row(0) *= 1.4;
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  const std::vector<int> edges = sharp_edges(m.V, t, designer.geometry(), 30);
+  const std::set<int> sharp(edges.begin(), edges.end());
+  int closed = 0;
+  for (int f = 0; f < t.num_faces; ++f) closed += sharp.count(t.face_edges(f, 0)) + sharp.count(t.face_edges(f, 1)) + sharp.count(t.face_edges(f, 2)) == 3;
+  ASSERT_GT(closed, 5);
+  std::vector<int> dropped;
+  const std::vector<int> kept = without_closed_faces(t, designer.geometry(), edges, &dropped);
+  EXPECT_EQ(kept.size() + dropped.size(), edges.size());
+  EXPECT_LE(dropped.size(), 20u);
+  const std::set<int> alive(kept.begin(), kept.end());
+  for (int f = 0; f < t.num_faces; ++f) EXPECT_LT(alive.count(t.face_edges(f, 0)) + alive.count(t.face_edges(f, 1)) + alive.count(t.face_edges(f, 2)), 3u) << f;
+  for (int e : dropped) {
+    bool least_somewhere = false;
+    for (int side = 0; side < 2; ++side) {
+      const int f = t.edge_faces(e, side);
+      bool least = true;
+      for (int k = 0; k < 3; ++k) least &= dihedral_angle(t, designer.geometry(), t.face_edges(f, k)) >= dihedral_angle(t, designer.geometry(), e);
+      least_somewhere |= least;
+    }
+    EXPECT_TRUE(least_somewhere) << e;
+  }
+  // The cube's faces have at most two: nothing goes.
+  const Mesh cube = make_cube_sphere(4, false);
+  FieldDesigner cd(cube.V, cube.F);
+  const std::vector<int> cube_edges = sharp_edges(cube.V, cd.topology(), cd.geometry(), 30);
+  EXPECT_EQ(without_closed_faces(cd.topology(), cd.geometry(), cube_edges), cube_edges);
+}
+
 // A clean CAD-like part loses nothing: the cube's twelve edges end at junctions, and the block is wider than the
 // length.
 TEST(SharpEdges, ACubesEdgesAllStay) {

@@ -511,6 +511,62 @@ TEST(SubdivideMidpoint, HandlesHighValenceAndRejectsBadIndices) {
   expect_error([&] { subdivide_midpoint(bad); }, {"subdivide_midpoint", "face 7", "out of range"});
 }
 
+// Faces with one, two and three split edges: the same surface and orientation, each new vertex the midpoint of its
+// edge, each face's children in it, ids as documented.
+TEST(SplitEdgesAtMidpoints, KeepsTheSurfaceAndNumbersAsDocumented) {
+  const Mesh m = make_icosphere(1);
+  const MeshReport before = analyse(m);
+  // Face 0's three edges, face 1's edges not shared with face 0, and one more edge elsewhere (given reversed).
+  std::vector<std::pair<int, int>> edges;
+  for (int k = 0; k < 3; ++k) edges.emplace_back(m.F(0, k), m.F(0, (k + 1) % 3));
+  edges.emplace_back(m.F(1, 0), m.F(1, 1));
+  edges.emplace_back(m.F(30, 2), m.F(30, 1));
+  edges.emplace_back(m.F(0, 1), m.F(0, 0));  // a duplicate
+  std::vector<int> parent;
+  const Mesh fine = split_edges_at_midpoints(m, edges, &parent);
+  std::set<std::pair<int, int>> unique;
+  for (auto [i, j] : edges) unique.emplace(std::min(i, j), std::max(i, j));
+  ASSERT_EQ(fine.V.rows(), m.V.rows() + static_cast<Eigen::Index>(unique.size()));
+  EXPECT_TRUE(fine.V.topRows(m.V.rows()) == m.V);
+  int k = 0;
+  for (auto [i, j] : unique) {  // the k-th edge in increasing order has vertex V + k at its midpoint
+    EXPECT_EQ(fine.V.row(m.V.rows() + k), (0.5 * (m.V.row(i) + m.V.row(j))).eval());
+    ++k;
+  }
+  // Every face with s split edges gains s faces.
+  int gained = 0;
+  for (int f = 0; f < m.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) gained += unique.count({std::min(m.F(f, c), m.F(f, (c + 1) % 3)), std::max(m.F(f, c), m.F(f, (c + 1) % 3))}) > 0;
+  ASSERT_EQ(fine.F.rows(), m.F.rows() + gained);
+  const MeshReport after = analyse(fine);
+  expect_well_formed(after, 1);
+  EXPECT_EQ(after.euler_characteristic(), 2);
+  EXPECT_NEAR(after.signed_volume, before.signed_volume, 1e-12);
+  EXPECT_NEAR((after.area_vector - before.area_vector).norm(), 0, 1e-12);
+  // Each child lies in its parent's plane, with the same orientation, and the children's areas sum to the parent's.
+  ASSERT_EQ(parent.size(), static_cast<size_t>(fine.F.rows()));
+  std::vector<Eigen::Vector3d> area(m.F.rows(), Eigen::Vector3d::Zero());
+  for (int f = 0; f < fine.F.rows(); ++f) {
+    ASSERT_TRUE(f < m.F.rows() ? parent[f] == f : parent[f] >= 0 && parent[f] < m.F.rows()) << f;
+    const Eigen::Vector3d a = fine.V.row(fine.F(f, 0)), b = fine.V.row(fine.F(f, 1)), c = fine.V.row(fine.F(f, 2));
+    area[parent[f]] += 0.5 * (b - a).cross(c - a);
+  }
+  for (int f = 0; f < m.F.rows(); ++f) {
+    const Eigen::Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), c = m.V.row(m.F(f, 2));
+    EXPECT_NEAR((area[f] - 0.5 * (b - a).cross(c - a)).norm(), 0, 1e-12) << f;
+  }
+  EXPECT_TRUE(split_edges_at_midpoints(m, {}).F == m.F);
+  expect_error([&] { split_edges_at_midpoints(m, {{0, 0}}); }, {"split_edges_at_midpoints", "(0, 0)", "not an edge"});
+  expect_error([&] { split_edges_at_midpoints(m, {{0, 1000}}); }, {"split_edges_at_midpoints", "(0, 1000)", "not an edge"});
+  int far = 1;
+  while (unique.count({0, far}) || std::any_of(m.F.rowwise().begin(), m.F.rowwise().end(), [&](const auto& row) {
+           return (row.array() == 0).any() && (row.array() == far).any();
+         }))
+    ++far;
+  expect_error([&] { split_edges_at_midpoints(m, {{0, far}}); },
+               {"split_edges_at_midpoints", "(0, " + std::to_string(far) + ")", "is not an edge of a face"});
+}
+
 TEST(Permute, MapsVerticesAndFacesAndKeepsOrientation) {
   const Mesh mesh = make_genus_surface(1, 2);
   std::vector<int> vertex_perm, face_perm;

@@ -66,6 +66,14 @@ std::vector<int> sharp_edges(const MatrixX3d& V, const Topology& topology, const
 std::vector<int> without_short_feature_ends(const MatrixX3d& V, const Topology& topology, const std::vector<int>& edges, double min_length,
                                             std::vector<int>* dropped = nullptr);
 
+// The sharp edges without a face whose three edges are all among them: such a face cannot have all three on
+// integer iso-lines (a map makes it flat), so its least sharp edge (smallest dihedral angle; the larger id of
+// equals) is left out, face after face in increasing id until none is left. A clean CAD part has no such face;
+// a coarse or noisy one has knots of them. Returns the edges kept, increasing; `dropped` (optional) gets the
+// others, increasing.
+std::vector<int> without_closed_faces(const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
+                                      std::vector<int>* dropped = nullptr);
+
 // Reads feature edges: one "i j" (vertex ids, either order) per line, '#' comments and blank lines skipped.
 // Errors name file:line: a malformed line, a vertex id out of range, a pair that is not an edge of the mesh,
 // a boundary edge, an edge listed twice. Returns edge ids in increasing order.

@@ -87,6 +87,15 @@ Mesh split_edges_near_end(const Mesh& mesh, double t, double lift = 0, std::vect
 // split face gains an edge (solve --split-large-turns: the turning around a vertex is spread over more
 // edges). `parent_face` as above. Throws naming a face id out of range.
 Mesh split_faces_at_centroids(const Mesh& mesh, const std::vector<int>& faces, std::vector<int>* parent_face = nullptr);
+// Splits each listed edge (a vertex pair, either order; duplicates ignored) at its midpoint: the midpoint of the
+// k-th edge in increasing (min, max) order is vertex V + k. A face with s ≥ 1 split edges becomes 1 + s faces,
+// the first keeping its index, the others appended face after face in increasing id: one split edge a → b
+// (rotated so) gives (a, m, c), (m, b, c); two, on a → b and b → c, give (m_ab, b, m_bc) and the rest cut
+// along its shorter diagonal; three give the corners' triangles and the middle one. The surface and orientation
+// are kept exactly; faces without a listed edge are unchanged. `parent_face` as above. Throws for a pair that is
+// not an edge of a face, or a vertex id out of range. (trivcon param and quad, where a map folds beside an edge
+// whose two ends lie on aligned lines, as across a flat CAD face triangulated without inner vertices.)
+Mesh split_edges_at_midpoints(const Mesh& mesh, const std::vector<std::pair<int, int>>& edges, std::vector<int>* parent_face = nullptr);
 // Random permutation of vertex ids and of face order (faces keep their orientation, corners
 // rotate cyclically by a random amount); deterministic for a seed on every platform (draws come
 // straight from std::mt19937). `vertex_perm[old] = new`, `face_perm[old] = new` when not null.

@@ -150,6 +150,8 @@ struct MapOutcome {
   double onto_units = 0;   // with automatic placement and sharp edges: the distance singularities were moved onto them from, in units
   bool onto_flat = false;  // and onto sectors where a quad gets a flat corner (AutoOptions::onto_flat_sectors)
   std::optional<QuadMesh> quads;  // with quads = true: the kept map's quad mesh (extract_quads)
+  // Edges split at their midpoints (map_request): then field.refined, V, F and parent_face hold the refined mesh.
+  int refined_edges = 0;
 };
 // The distance, in units of the map, within which cancel_for_map moves ±1/4 singularities onto a feature line, and
 // the farther one of map_request's attempt after the relaxed ones (a singularity in a strip or wedge between
@@ -195,6 +197,11 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // within the goal, or without problems once the placement found was mapped as found and relaxed both ways; the kept map is the one with the fewest
 // problems, then the least stretch beyond the goal (the earliest of equals). `request` is left as the kept one
 // was made.
+// Last, when the kept map has problems and folds beside an edge that is not aligned but whose two ends lie on
+// aligned edges, every such edge is split at its midpoint (split_edges_at_midpoints) and the whole search runs
+// again on the refined mesh (the request moved onto it: fixed directions and roots to every child, listed feature
+// edges by their ends); its map is kept when it has fewer problems, with field.refined, V, F, parent_face and
+// refined_edges set. Not with generator or loop indices, nor after split_large_turns.
 // Throws what solve_request and parametrize throw.
 MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
                        bool quads = false);

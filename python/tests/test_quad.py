@@ -134,6 +134,37 @@ def test_small_pieces_of_creases_are_left_out_of_a_map(cli, tmp_path):
         d.solve(4, "auto", align_features=30, feature_min_length=-1)
 
 
+def fan_capped_prism(n=20, stacks=10):
+    """A prism whose caps are fans from one rim vertex (as CAD exports triangulate flat faces)."""
+    k = np.arange(n)
+    V = np.array([[np.cos(2 * np.pi * i / n), 2.85 * s / stacks, np.sin(2 * np.pi * i / n)] for s in range(stacks + 1) for i in k])
+    F = []
+    for s in range(stacks):
+        for i in k:
+            a, b = s * n + i, s * n + (i + 1) % n
+            F += [[a, a + n, b], [b, a + n, b + n]]
+    for i in range(1, n - 1):
+        F += [[0, i, i + 1], [stacks * n, stacks * n + i + 1, stacks * n + i]]
+    return V, np.array(F)
+
+
+def test_fan_caps_are_refined_as_the_program_refines_them(cli, tmp_path):
+    # The map folds on the fans (their faces' corners all lie on the rims' iso-lines): solve for a map splits the
+    # fans' inner edges as `trivcon quad` does, and the Result belongs to the refined mesh.
+    V, F = fan_capped_prism()
+    r = trivcon.FieldDesigner(V, F).solve(4, "auto", align_features=30, map_target_faces=300)
+    assert r.designer.V.shape == (254, 3) and r.designer.F.shape == (504, 3)
+    assert np.array_equal(r.designer.V[:220], V)
+    assert np.array_equal(r.parent_face[:436], np.arange(436)) and ((r.parent_face[436:] >= 400) & (r.parent_face[436:] < 436)).all()
+    q = r.quad(target_faces=300)
+    assert q.ok and q.quality["euler_characteristic"] == 2 and q.quality["irregular_vertices"] == 8
+    mesh, sing = tmp_path / "prism.obj", tmp_path / "s.txt"
+    trivcon.write_mesh(str(mesh), V, F)
+    cli("quad", mesh, "--auto", "--align-features", 30, "--target-faces", 300, "-o", tmp_path / "q.obj", "--sing-out", sing)
+    program = {int(v): k for v, k in (line.split() for line in sing.read_text().splitlines() if not line.startswith("#"))}
+    assert {v: str(k) for v, k in r.singularities.items()} == program
+
+
 def test_uniform_size_turns_the_sizing_off():
     # An annulus with its circles aligned: by default the unit follows the map's own scale (two sizing rounds)
     # and stretches less; uniform_size=True keeps one unit everywhere, as `--uniform-size`.

@@ -883,7 +883,10 @@ class FieldDesigner(_Cached):
           or its quad mesh fails a check (the scale too coarse for them), or it stretches (mean singular-value
           ratio above 1.5), placed again: relaxed, with pairs cancelled within 2, then 4 units, and those relaxed, the
           cleanest map's kept (this makes the map once or more). Then Result.parametrize/quad at the same scale
-          give what the program gives.
+          give what the program gives. Where that map folds beside edges whose two ends lie on aligned lines (a flat
+          CAD face triangulated from its rim alone), those edges are split at their midpoints and the search runs
+          again on the refined mesh (as quad does): the Result then belongs to the refined mesh, as with
+          split_large_turns (Result.designer, Result.parent_face).
 
         The request means the same as the CLI's and the editor's (the library's trivcon/request.h does it).
         Errors in the prescription raise trivcon.Error with the library's message. The result is
@@ -974,8 +977,9 @@ class FieldDesigner(_Cached):
         if degrees is not None or edge_pairs:
             result.sharp_edges = _frozen(sharp)
         result.relax = RelaxResult(relaxed, N) if relaxed is not None else None
-        if split_large_turns:
+        if split_large_turns or len(parent):
             result.parent_face = _frozen(parent)
+        if split_large_turns:
             result.split_rounds = rounds
             result.split_converged = converged
         return result
@@ -1108,8 +1112,9 @@ class Result(_Cached):
             self.sharp_edges = state["sharp_edges"]
         if "_align_boundary" in state:
             self._align_boundary = state["_align_boundary"]
-        if "parent_face" in state:  # after split_large_turns
+        if "parent_face" in state:  # after split_large_turns, or a map's refinement
             self.parent_face = _frozen(_np.array(state["parent_face"], dtype=_np.int64))
+        if "split_rounds" in state:
             self.split_rounds, self.split_converged = state["split_rounds"], state["split_converged"]
 
     def _exactness(self):

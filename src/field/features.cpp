@@ -227,6 +227,30 @@ std::vector<int> without_short_feature_ends(const MatrixX3d& V, const Topology& 
   return kept;
 }
 
+std::vector<int> without_closed_faces(const Topology& t, const Geometry& g, const std::vector<int>& edges, std::vector<int>* dropped) {
+  std::vector<char> alive(t.num_edges, 0);
+  for (int e : edges) {
+    if (e < 0 || e >= t.num_edges) throw Error("without_closed_faces: edge " + std::to_string(e) + " out of range");
+    alive[e] = 1;
+  }
+  for (int f = 0; f < t.num_faces; ++f) {
+    if (!(alive[t.face_edges(f, 0)] && alive[t.face_edges(f, 1)] && alive[t.face_edges(f, 2)])) continue;
+    int least = t.face_edges(f, 0);
+    for (int k = 1; k < 3; ++k) {
+      const int e = t.face_edges(f, k);
+      const double a = dihedral_angle(t, g, e), b = dihedral_angle(t, g, least);
+      if (a < b || (a == b && e > least)) least = e;
+    }
+    alive[least] = 0;
+  }
+  std::vector<int> kept;
+  for (int e : edges) {
+    if (alive[e]) kept.push_back(e);
+    else if (dropped) dropped->push_back(e);
+  }
+  return kept;
+}
+
 FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const Geometry& g, const std::vector<int>& edges, int N) {
   if (N < 1) throw Error("feature_alignment: N = " + std::to_string(N) + " (need N >= 1)");
   // Per face, its feature edges with their direction (p_j − p_i, i < j, in the face's frame) and length.

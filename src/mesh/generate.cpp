@@ -681,4 +681,74 @@ Mesh split_faces_at_centroids(const Mesh& mesh, const std::vector<int>& faces, s
   return out;
 }
 
+Mesh split_edges_at_midpoints(const Mesh& mesh, const std::vector<std::pair<int, int>>& edges, std::vector<int>* parent_face) {
+  require_valid_faces("split_edges_at_midpoints", mesh);
+  const Eigen::Index num_vertices = mesh.V.rows(), num_faces = mesh.F.rows();
+  std::vector<std::pair<int, int>> list;
+  for (auto [i, j] : edges) {
+    if (i < 0 || j < 0 || i >= num_vertices || j >= num_vertices || i == j)
+      throw Error("split_edges_at_midpoints: (" + std::to_string(i) + ", " + std::to_string(j) + ") is not an edge (mesh has " +
+                  std::to_string(num_vertices) + " vertices)");
+    list.emplace_back(std::min(i, j), std::max(i, j));
+  }
+  std::sort(list.begin(), list.end());
+  list.erase(std::unique(list.begin(), list.end()), list.end());
+  require_size("split_edges_at_midpoints", double(num_vertices) + list.size(), double(num_faces) + 2.0 * list.size());
+  // The midpoint of half-edge k of face f, or −1.
+  auto midpoint = [&](Eigen::Index f, int k) {
+    const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
+    const auto it = std::lower_bound(list.begin(), list.end(), std::make_pair(std::min(a, b), std::max(a, b)));
+    return it != list.end() && *it == std::make_pair(std::min(a, b), std::max(a, b)) ? static_cast<int>(num_vertices + (it - list.begin())) : -1;
+  };
+  std::vector<char> found(list.size(), 0);
+  Mesh out;
+  out.V.resize(num_vertices + static_cast<Eigen::Index>(list.size()), 3);
+  out.V.topRows(num_vertices) = mesh.V;
+  for (size_t k = 0; k < list.size(); ++k)
+    out.V.row(num_vertices + static_cast<Eigen::Index>(k)) = (mesh.V.row(list[k].first) + mesh.V.row(list[k].second)) / 2.0;
+  out.F = mesh.F;
+  std::vector<std::array<int, 3>> appended;
+  std::vector<int> appended_parent;
+  for (Eigen::Index f = 0; f < num_faces; ++f) {
+    std::array<int, 3> m{};
+    int splits = 0;
+    for (int k = 0; k < 3; ++k)
+      if ((m[k] = midpoint(f, k)) >= 0) ++splits, found[m[k] - num_vertices] = 1;
+    if (splits == 0) continue;
+    // Rotate so that half-edge 0 (a → b) is split and, with two splits, half-edge 1 (b → c) too.
+    int r = 0;
+    while (!(m[r] >= 0 && (splits != 2 || m[(r + 1) % 3] >= 0))) ++r;
+    const int a = mesh.F(f, r), b = mesh.F(f, (r + 1) % 3), c = mesh.F(f, (r + 2) % 3);
+    const int ab = m[r], bc = m[(r + 1) % 3], ca = m[(r + 2) % 3];
+    std::vector<std::array<int, 3>> children;
+    if (splits == 1) {
+      children = {{a, ab, c}, {ab, b, c}};
+    } else if (splits == 2) {
+      children = {{ab, b, bc}};
+      // The quadrilateral a, ab, bc, c along its shorter diagonal.
+      if ((out.V.row(ab) - out.V.row(c)).norm() <= (out.V.row(a) - out.V.row(bc)).norm())
+        children.push_back({a, ab, c}), children.push_back({ab, bc, c});
+      else
+        children.push_back({a, ab, bc}), children.push_back({a, bc, c});
+    } else {
+      children = {{a, ab, ca}, {ab, b, bc}, {ca, bc, c}, {ab, bc, ca}};
+    }
+    out.F.row(f) << children[0][0], children[0][1], children[0][2];
+    for (size_t k = 1; k < children.size(); ++k) appended.push_back(children[k]), appended_parent.push_back(static_cast<int>(f));
+  }
+  for (size_t k = 0; k < list.size(); ++k)
+    if (!found[k])
+      throw Error("split_edges_at_midpoints: (" + std::to_string(list[k].first) + ", " + std::to_string(list[k].second) +
+                  ") is not an edge of a face");
+  out.F.conservativeResize(num_faces + static_cast<Eigen::Index>(appended.size()), 3);
+  for (size_t k = 0; k < appended.size(); ++k)
+    out.F.row(num_faces + static_cast<Eigen::Index>(k)) << appended[k][0], appended[k][1], appended[k][2];
+  if (parent_face) {
+    parent_face->resize(out.F.rows());
+    std::iota(parent_face->begin(), parent_face->begin() + num_faces, 0);
+    std::copy(appended_parent.begin(), appended_parent.end(), parent_face->begin() + num_faces);
+  }
+  return out;
+}
+
 }  // namespace trivcon

@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "trivcon/error.h"
+#include "trivcon/generate.h"
 
 namespace trivcon {
 
@@ -24,13 +25,22 @@ void check_face_id(const Topology& t, int f, const char* what) {
                 " faces)");
 }
 
-// The sharp edges of a request on a mesh: those sharper than feature_degrees (without the short loose ends when
-// feature_min_length is set; those go to `loose`), and the listed ones.
+// The sharp edges of a request on a mesh: those sharper than feature_degrees (when feature_min_length is set,
+// without the least sharp edge of each face sharp on all three, nor the short loose ends; those go to `loose`),
+// and the listed ones.
 std::vector<int> request_sharp_edges(const FieldDesigner& d, const FieldRequest& r, std::vector<int>* loose = nullptr) {
   const Topology& t = d.topology();
   std::vector<int> out;
   if (r.feature_degrees) out = sharp_edges(d.V(), t, d.geometry(), *r.feature_degrees);
-  if (r.feature_min_length) out = without_short_feature_ends(d.V(), t, out, *r.feature_min_length, loose);
+  if (r.feature_min_length && *r.feature_min_length > 0) {
+    std::vector<int> closing;
+    out = without_closed_faces(t, d.geometry(), out, loose ? &closing : nullptr);
+    out = without_short_feature_ends(d.V(), t, out, *r.feature_min_length, loose);
+    if (loose) {
+      loose->insert(loose->end(), closing.begin(), closing.end());
+      std::sort(loose->begin(), loose->end());
+    }
+  }
   for (int e : r.feature_edges) {
     if (e < 0 || e >= t.num_edges)
       throw Error("feature edges: edge " + std::to_string(e) + " out of range (the mesh has " + std::to_string(t.num_edges) + " edges)");
@@ -307,19 +317,24 @@ std::vector<int> vertices_near_edges(const FieldDesigner& designer, const std::v
 
 }  // namespace
 
-MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
-                       bool quads) {
+namespace {
+
+// The map's folded and degenerate faces and wrong windings, and with quads the quad mesh's failed checks.
+int map_problems(const MapOutcome& m) {
+  const ParamQuality& q = m.param.quality;
+  return q.flipped_faces + q.degenerate_faces + q.winding_errors + (m.quads ? static_cast<int>(m.quads->quality.problems.size()) : 0);
+}
+
+// map_request's search on one mesh (map_request adds the refinement).
+MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
+                      bool quads) {
   const bool escalate = request.auto_place && request.auto_options.cancel_distance == 0;
   // The distance onto feature lines is map_request's own (per attempt) unless the request gave one.
   const bool own_onto = escalate && request.auto_options.onto_features == 0;
   cancel_for_map(request, designer, edge_length, target_faces);
   const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
   if (request.feature_degrees && !request.feature_min_length) request.feature_min_length = map_unit(designer, edge_length, target_faces);
-  // The map's folded and degenerate faces and wrong windings, and with quads the quad mesh's failed checks.
-  auto problems = [&](const MapOutcome& m) {
-    const ParamQuality& q = m.param.quality;
-    return q.flipped_faces + q.degenerate_faces + q.winding_errors + (m.quads ? static_cast<int>(m.quads->quality.problems.size()) : 0);
-  };
+  const auto problems = map_problems;
   // Its stretch beyond the goal: 0 when the mean singular-value ratio is within kMapDistortionGoal.
   auto stretch = [&](const MapOutcome& m) { return std::max(m.param.quality.mean_distortion, kMapDistortionGoal) - kMapDistortionGoal; };
   auto better = [&](const MapOutcome& a, const MapOutcome& b) {
@@ -490,6 +505,84 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   if (maps == 1) best.first_problems = 0, best.first_distortion = 0;
   request = kept;
   return best;
+}
+
+// The edges a map may have to split (vertex pairs): those not on an integer iso-line whose two ends both lie on
+// aligned edges (the request's sharp edges, and its boundary when aligned); `on_line` gets those vertices.
+std::vector<std::pair<int, int>> map_chords(const FieldDesigner& designer, const FieldRequest& request, double edge_length, double target_faces,
+                                            std::vector<char>& on_line) {
+  const Topology& t = designer.topology();
+  const std::vector<int> aligned =
+      request_param_options(designer, request, request_sharp_edges(designer, request), edge_length, target_faces).aligned_edges;
+  std::vector<char> is_aligned(t.num_edges, 0);
+  on_line.assign(t.num_vertices, 0);
+  for (int e : aligned) is_aligned[e] = 1, on_line[t.edge_vertices(e, 0)] = on_line[t.edge_vertices(e, 1)] = 1;
+  std::vector<std::pair<int, int>> chords;
+  for (int e = 0; e < t.num_edges; ++e)
+    if (!is_aligned[e] && on_line[t.edge_vertices(e, 0)] && on_line[t.edge_vertices(e, 1)]) chords.emplace_back(t.edge_vertices(e, 0), t.edge_vertices(e, 1));
+  return chords;
+}
+
+// `asked` (on `from`) on a refinement `to` of its mesh whose faces lie in `parent` faces (vertices kept): the
+// fixed directions and roots pass to every child (as world vectors: the frames differ), the listed feature edges
+// go by their ends (splitting never cuts them).
+FieldRequest request_on_refined(const FieldRequest& asked, const FieldDesigner& from, const FieldDesigner& to, const std::vector<int>& parent) {
+  FieldRequest r = asked;
+  r.prescription.fixed.clear();
+  r.prescription.path_guide.clear();
+  for (int f = 0; f < static_cast<int>(parent.size()); ++f)
+    if (const auto it = asked.prescription.fixed.find(parent[f]); it != asked.prescription.fixed.end())
+      r.prescription.fixed[f] = to.geometry().angle_in_face(f, from.geometry().direction_in_face(parent[f], it->second));
+  for (auto& [face, angle] : r.roots) angle = to.geometry().angle_in_face(face, from.geometry().direction_in_face(face, angle));
+  r.feature_edges.clear();
+  for (int e : asked.feature_edges) r.feature_edges.push_back(edge_between(to.topology(), from.topology().edge_vertices(e, 0), from.topology().edge_vertices(e, 1)));
+  return r;
+}
+
+}  // namespace
+
+MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
+                       bool quads) {
+  const FieldRequest asked = request;
+  MapOutcome m = map_search(designer, F, request, edge_length, target_faces, quads);
+  // Where the kept map folds beside an edge whose two ends lie on aligned lines (a flat CAD face triangulated from
+  // its rim alone: every triangle of its fan has its corners on the rim's iso-lines, so some are flat in (u, v)
+  // whatever the map), those edges are split at their midpoints and the search runs again on the refined mesh;
+  // its map is kept when it has fewer problems. Not with generator or loop indices (the refined mesh's cycles are
+  // its own) nor split_large_turns (a refinement of its own).
+  if (!m.field.verified || map_problems(m) == 0 || m.field.refined || !asked.prescription.generator.empty() ||
+      !asked.prescription.loop.empty())
+    return m;
+  FieldRequest base = asked;
+  base.feature_min_length = request.feature_min_length;  // as the search set it
+  std::vector<char> on_line;
+  const std::vector<std::pair<int, int>> chords = map_chords(designer, base, edge_length, target_faces, on_line);
+  const Topology& t = designer.topology();
+  std::set<std::pair<int, int>> chord_set(chords.begin(), chords.end());
+  // A face flat or turned over in (u, v) (signed area below 10⁻⁶ unit squares) with a chord among its edges and
+  // its third corner on an aligned line too (a fan's face).
+  const Eigen::MatrixXd& uv = m.param.uv;
+  bool beside = false;
+  for (int f = 0; f < t.num_faces && !beside; ++f) {
+    const Eigen::RowVector2d p = uv.row(3 * f), q = uv.row(3 * f + 1) - p, w = uv.row(3 * f + 2) - p;
+    if ((q(0) * w(1) - q(1) * w(0)) / 2 > 1e-6) continue;
+    for (int k = 0; k < 3 && !beside; ++k) {
+      const int a = t.F(f, k), b = t.F(f, (k + 1) % 3), c = t.F(f, (k + 2) % 3);
+      beside = chord_set.count({std::min(a, b), std::max(a, b)}) > 0 && on_line[c];
+    }
+  }
+  if (!beside) return m;
+  std::vector<int> parent;
+  Mesh refined = split_edges_at_midpoints(Mesh{designer.V(), F}, chords, &parent);
+  auto refined_designer = std::make_unique<FieldDesigner>(refined.V, refined.F, designer.solver_options());
+  FieldRequest r = request_on_refined(base, designer, *refined_designer, parent);
+  MapOutcome n = map_search(*refined_designer, refined.F, r, edge_length, target_faces, quads);
+  if (!n.field.verified || map_problems(n) >= map_problems(m)) return m;
+  n.field.refined = std::move(refined_designer);
+  n.field.V = std::move(refined.V), n.field.F = std::move(refined.F), n.field.parent_face = std::move(parent);
+  n.refined_edges = static_cast<int>(chords.size());
+  request = std::move(r);
+  return n;
 }
 
 }  // namespace trivcon
