@@ -77,7 +77,7 @@ void register_param(CLI::App& app) {
   static ParamCommand o;
   auto* cmd = app.add_subcommand("param", "Seamless integer-grid parametrization of the cross field (N = 4): an OBJ with one vt per corner");
   o.map.add_to(cmd, "unit square (quad)");
-  cmd->add_option("-o,--output", o.output, "OBJ of the input mesh with (u, v) per corner ('f a/ta b/tb c/tc')")->required();
+  cmd->add_option("-o,--output", o.output, "OBJ of the input mesh with (u, v) per corner ('f a/ta b/tb c/tc'); the refined mesh when the map refined it (refined: ...)")->required();
   cmd->add_option("--sing-out", o.sing_out, "Singularity file of the singularities used ('VERTEX INDEX' lines, readable by -s)");
   cmd->add_option("--report", o.report, "JSON report: the field, the map's integers and quality, time per stage");
   cmd->callback([] {

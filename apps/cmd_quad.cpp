@@ -96,7 +96,7 @@ void register_quad(CLI::App& app) {
   auto* cmd = app.add_subcommand("quad", "Quad mesh of the cross field (N = 4): its irregular vertices exactly the singularities");
   o.map.add_to(cmd, "quad");
   cmd->add_option("-o,--output", o.output, "The quad mesh: .ply (binary) or .obj")->required();
-  cmd->add_option("--uv-out", o.uv_out, "OBJ of the input mesh with the map's (u, v) per corner (as `param -o`)");
+  cmd->add_option("--uv-out", o.uv_out, "OBJ of the input mesh with the map's (u, v) per corner (as `param -o`; the refined mesh when the map refined it)");
   cmd->add_option("--sing-out", o.sing_out, "Singularity file of the singularities used ('VERTEX INDEX' lines, readable by -s)");
   cmd->add_option("--report", o.report, "JSON report: the field, the map, the quad mesh's guarantees and quality, time per stage");
   cmd->callback([] {

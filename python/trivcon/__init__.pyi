@@ -159,6 +159,7 @@ class FieldDesigner:
         relax_periods: float = ...,
         map_target_faces: Optional[float] = ...,
         map_edge_length: Optional[float] = ...,
+        feature_min_length: Optional[float] = ...,
     ) -> Result: ...
     def relax(
         self,

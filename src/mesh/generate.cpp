@@ -582,6 +582,25 @@ Mesh permute(const Mesh& mesh, unsigned seed, std::vector<int>* vertex_perm, std
   return out;
 }
 
+namespace {
+
+// Appends the split faces' other children to `out` (whose first `num_faces` faces are the input's, each split one
+// holding its first child) and fills `parent_face` (when not null): the input's faces their own, the appended
+// ones `appended_parent`.
+void append_children(Mesh& out, Eigen::Index num_faces, const std::vector<std::array<int, 3>>& appended,
+                     const std::vector<int>& appended_parent, std::vector<int>* parent_face) {
+  out.F.conservativeResize(num_faces + static_cast<Eigen::Index>(appended.size()), 3);
+  for (size_t k = 0; k < appended.size(); ++k)
+    out.F.row(num_faces + static_cast<Eigen::Index>(k)) << appended[k][0], appended[k][1], appended[k][2];
+  if (parent_face) {
+    parent_face->resize(out.F.rows());
+    std::iota(parent_face->begin(), parent_face->begin() + num_faces, 0);
+    std::copy(appended_parent.begin(), appended_parent.end(), parent_face->begin() + num_faces);
+  }
+}
+
+}  // namespace
+
 Mesh split_edges_near_end(const Mesh& mesh, double t, double lift, std::vector<int>* parent_face) {
   require_valid_faces("split_edges_near_end", mesh);
   require(t >= 0 && t < 1, "split_edges_near_end", "t", t, "0 <= t < 1");
@@ -637,14 +656,7 @@ Mesh split_edges_near_end(const Mesh& mesh, double t, double lift, std::vector<i
       appended.push_back({m, b, c});
       appended_parent.push_back(static_cast<int>(f));
     }
-  out.F.conservativeResize(num_faces + static_cast<Eigen::Index>(appended.size()), 3);
-  for (size_t k = 0; k < appended.size(); ++k)
-    out.F.row(num_faces + static_cast<Eigen::Index>(k)) << appended[k][0], appended[k][1], appended[k][2];
-  if (parent_face) {
-    parent_face->resize(out.F.rows());
-    std::iota(parent_face->begin(), parent_face->begin() + num_faces, 0);
-    std::copy(appended_parent.begin(), appended_parent.end(), parent_face->begin() + num_faces);
-  }
+  append_children(out, num_faces, appended, appended_parent, parent_face);
   return out;
 }
 
@@ -740,14 +752,7 @@ Mesh split_edges_at_midpoints(const Mesh& mesh, const std::vector<std::pair<int,
     if (!found[k])
       throw Error("split_edges_at_midpoints: (" + std::to_string(list[k].first) + ", " + std::to_string(list[k].second) +
                   ") is not an edge of a face");
-  out.F.conservativeResize(num_faces + static_cast<Eigen::Index>(appended.size()), 3);
-  for (size_t k = 0; k < appended.size(); ++k)
-    out.F.row(num_faces + static_cast<Eigen::Index>(k)) << appended[k][0], appended[k][1], appended[k][2];
-  if (parent_face) {
-    parent_face->resize(out.F.rows());
-    std::iota(parent_face->begin(), parent_face->begin() + num_faces, 0);
-    std::copy(appended_parent.begin(), appended_parent.end(), parent_face->begin() + num_faces);
-  }
+  append_children(out, num_faces, appended, appended_parent, parent_face);
   return out;
 }
 
