@@ -156,13 +156,33 @@ std::vector<int> sharp_edges(const MatrixX3d& V, const Topology& t, const Geomet
   return out;
 }
 
-std::vector<int> without_short_feature_ends(const MatrixX3d& V, const Topology& t, const std::vector<int>& edges, double min_length,
-                                            std::vector<int>* dropped) {
+namespace {
+
+// A mask of `edges` (edge ids; `what` names the caller in the error for one out of range).
+std::vector<char> edge_mask(const Topology& t, const std::vector<int>& edges, const char* what) {
   std::vector<char> alive(t.num_edges, 0);
   for (int e : edges) {
-    if (e < 0 || e >= t.num_edges) throw Error("without_short_feature_ends: edge " + std::to_string(e) + " out of range");
+    if (e < 0 || e >= t.num_edges) throw Error(std::string(what) + ": edge " + std::to_string(e) + " out of range");
     alive[e] = 1;
   }
+  return alive;
+}
+
+// `edges` still in the mask, in their order; the others to `dropped` when given.
+std::vector<int> kept_edges(const std::vector<int>& edges, const std::vector<char>& alive, std::vector<int>* dropped) {
+  std::vector<int> kept;
+  for (int e : edges) {
+    if (alive[e]) kept.push_back(e);
+    else if (dropped) dropped->push_back(e);
+  }
+  return kept;
+}
+
+}  // namespace
+
+std::vector<int> without_short_feature_ends(const MatrixX3d& V, const Topology& t, const std::vector<int>& edges, double min_length,
+                                            std::vector<int>* dropped) {
+  std::vector<char> alive = edge_mask(t, edges, "without_short_feature_ends");
   auto other_end = [&](int e, int v) { return t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0); };
   auto sharp_at = [&](int v) {
     std::vector<int> out;
@@ -219,20 +239,11 @@ std::vector<int> without_short_feature_ends(const MatrixX3d& V, const Topology& 
     if (across < min_length)
       for (int e : piece_edges) alive[e] = 0;
   }
-  std::vector<int> kept;
-  for (int e : edges) {
-    if (alive[e]) kept.push_back(e);
-    else if (dropped) dropped->push_back(e);
-  }
-  return kept;
+  return kept_edges(edges, alive, dropped);
 }
 
 std::vector<int> without_closed_faces(const Topology& t, const Geometry& g, const std::vector<int>& edges, std::vector<int>* dropped) {
-  std::vector<char> alive(t.num_edges, 0);
-  for (int e : edges) {
-    if (e < 0 || e >= t.num_edges) throw Error("without_closed_faces: edge " + std::to_string(e) + " out of range");
-    alive[e] = 1;
-  }
+  std::vector<char> alive = edge_mask(t, edges, "without_closed_faces");
   for (int f = 0; f < t.num_faces; ++f) {
     if (!(alive[t.face_edges(f, 0)] && alive[t.face_edges(f, 1)] && alive[t.face_edges(f, 2)])) continue;
     int least = t.face_edges(f, 0);
@@ -243,12 +254,7 @@ std::vector<int> without_closed_faces(const Topology& t, const Geometry& g, cons
     }
     alive[least] = 0;
   }
-  std::vector<int> kept;
-  for (int e : edges) {
-    if (alive[e]) kept.push_back(e);
-    else if (dropped) dropped->push_back(e);
-  }
-  return kept;
+  return kept_edges(edges, alive, dropped);
 }
 
 FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const Geometry& g, const std::vector<int>& edges, int N) {

@@ -333,7 +333,6 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   const bool own_onto = escalate && request.auto_options.onto_features == 0;
   cancel_for_map(request, designer, edge_length, target_faces);
   const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
-  if (request.feature_degrees && !request.feature_min_length) request.feature_min_length = map_unit(designer, edge_length, target_faces);
   const auto problems = map_problems;
   // Its stretch beyond the goal: 0 when the mean singular-value ratio is within kMapDistortionGoal.
   auto stretch = [&](const MapOutcome& m) { return std::max(m.param.quality.mean_distortion, kMapDistortionGoal) - kMapDistortionGoal; };
@@ -543,6 +542,7 @@ FieldRequest request_on_refined(const FieldRequest& asked, const FieldDesigner& 
 
 MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
                        bool quads) {
+  if (request.feature_degrees && !request.feature_min_length) request.feature_min_length = map_unit(designer, edge_length, target_faces);
   const FieldRequest asked = request;
   MapOutcome m = map_search(designer, F, request, edge_length, target_faces, quads);
   // Where the kept map folds beside an edge whose two ends lie on aligned lines (a flat CAD face triangulated from
@@ -553,10 +553,8 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   if (!m.field.verified || map_problems(m) == 0 || m.field.refined || !asked.prescription.generator.empty() ||
       !asked.prescription.loop.empty())
     return m;
-  FieldRequest base = asked;
-  base.feature_min_length = request.feature_min_length;  // as the search set it
   std::vector<char> on_line;
-  const std::vector<std::pair<int, int>> chords = map_chords(designer, base, edge_length, target_faces, on_line);
+  const std::vector<std::pair<int, int>> chords = map_chords(designer, asked, edge_length, target_faces, on_line);
   const Topology& t = designer.topology();
   std::set<std::pair<int, int>> chord_set(chords.begin(), chords.end());
   // A face flat or turned over in (u, v) (signed area below 10⁻⁶ unit squares) with a chord among its edges and
@@ -575,7 +573,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
   std::vector<int> parent;
   Mesh refined = split_edges_at_midpoints(Mesh{designer.V(), F}, chords, &parent);
   auto refined_designer = std::make_unique<FieldDesigner>(refined.V, refined.F, designer.solver_options());
-  FieldRequest r = request_on_refined(base, designer, *refined_designer, parent);
+  FieldRequest r = request_on_refined(asked, designer, *refined_designer, parent);
   MapOutcome n = map_search(*refined_designer, refined.F, r, edge_length, target_faces, quads);
   if (!n.field.verified || map_problems(n) >= map_problems(m)) return m;
   n.field.refined = std::move(refined_designer);
