@@ -128,6 +128,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"folds_rounded", q.folds_rounded},
           {"cones_moved", q.cones_moved},
           {"integers_moved", q.integers_moved},
+          {"integers_descended", q.integers_descended},
           {"segments_opened", q.segments_opened},
           {"untangled_faces", q.untangled_faces},
           {"untangling_regions", q.untangling_regions},

@@ -40,6 +40,10 @@ constexpr double kAlignedEdgeTolerance = 0.5235987755982988;
 // is a quad corner (below π/4, sharp edges meet at a narrow corner whose sector turns, trivcon/features.h).
 constexpr double kAcuteCorner = 0.7853981633974483;
 
+// The goal for a map's mean singular-value ratio (ParamQuality::mean_distortion): above it the map's integers
+// are descended (docs/param.md, "Rounding") and map_request places the singularities again.
+inline constexpr double kMapDistortionGoal = 1.5;
+
 struct ParamOptions {
   double edge_length = 0;   // the quad edge length in the mesh's units (> 0 wins over target_faces)
   double target_faces = 0;  // otherwise: about this many unit squares (edge_length = √(area / target_faces))
@@ -60,6 +64,10 @@ struct ParamOptions {
   // Rounds of sizing before the rounding (docs/param.md, "Sizing"): each lets a face's target size follow the
   // real-valued map's own scale there, smoothed; 0: the field's unit length everywhere.
   int sizing_rounds = 2;
+  // After the rounding, where the map misses a goal (folds, or a mean singular-value ratio above
+  // kMapDistortionGoal): coordinate descent of the energy on the integers (docs/param.md, "Rounding"); false: the
+  // greedy rounding's integers as they are.
+  bool descend_integers = true;
 };
 
 struct ParamQuality {
@@ -73,6 +81,7 @@ struct ParamQuality {
   int folds_rounded = 0;      // folded faces right after the rounding (before stiffening again)
   int cones_moved = 0;        // singularities moved to a neighbouring integer point against a fold or a shared point
   int integers_moved = 0;     // other integers (iso-lines, translations) moved by ±1 against a fold
+  int integers_descended = 0; // integers moved by whole units to lower energy after the rounding (docs/param.md)
   int segments_opened = 0;    // aligned edges between two integer points the rounding would have collapsed
   int untangled_faces = 0;    // folded or degenerate faces opened by the local untangling (docs/param.md)
   int untangling_regions = 0; // regions untangled (each kept only when the map had fewer folds after it)

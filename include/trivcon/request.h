@@ -158,8 +158,6 @@ struct MapOutcome {
 // two feature lines, where the map has one unit across it, has no integer point off both lines).
 inline constexpr double kMapOntoFeatures = 1.5;
 inline constexpr double kMapOntoFeaturesFar = 2;
-// The mean singular-value ratio of a map (ParamQuality::mean_distortion) above which map_request places again.
-inline constexpr double kMapDistortionGoal = 1.5;
 // The weight of the periods (RelaxOptions::period_weight) in map_request's second relaxed attempt.
 inline constexpr double kMapPeriodWeight = 3;
 // The reach (RelaxOptions::reach) of map_request's relaxed attempts.

@@ -596,6 +596,13 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     const double smax = qq + rr, smin = std::abs(qq - rr);
     return smin > 0 ? smax / smin : std::numeric_limits<double>::infinity();
   };
+  // The area-weighted mean of that ratio over the faces not folded (ParamQuality::mean_distortion's sense).
+  auto mean_ratio = [&]() {
+    double sum = 0, mapped = 0;
+    for (int f = 0; f < nF; ++f)
+      if (const double ratio = distortion(f); !folded(f) && std::isfinite(ratio)) sum += face_area[f] * ratio, mapped += face_area[f];
+    return mapped > 0 ? sum / mapped : 0.0;
+  };
   // Stiffening (MIQ, Bommes et al. 2009, §5): while faces fold, each face weighs more by its distortion, so that
   // it keeps its shape and the distortion spreads over its neighbours; a folded face counts as very distorted.
   // Before the rounding (on the real-valued map, so that the integers are chosen on a map without folds) and
@@ -828,6 +835,65 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     r[j] = 1;
     return solver->solve(r);
   };
+  // Descent on the integers: the greedy rounding fixes each integer on the map of its round, before the later
+  // ones; held at the end, one often lies a whole unit or more from its best value. The energy along a change t
+  // of fixed integer j (the others held, the reals solved again) is E(y + t g_j) = E + t ρ_j + ½ t² c_j, with
+  // g_j the response to a unit change, c_j = g_jᵀK g_j (which depends on which unknowns are fixed, not on their
+  // values) and ρ = K y − b (its free rows are 0, so ρ_j is the whole slope; a step s of j adds s K g_j).
+  // Coordinate descent: the step of the largest decrease, round(−ρ_j / c_j), is taken, ρ updated, and so on
+  // while one decreases the energy. A step is refused when it leaves more folded faces or closes an aligned
+  // edge (keep_segments_open's sense). It costs a solve per integer taking part: only where the rounded map
+  // misses a goal (folds, or a mean singular-value ratio above kMapDistortionGoal), and at most 64 integers
+  // (those of the largest |ρ_j| / K_jj, a bound from below on |ρ_j| / c_j).
+  if (options.descend_integers && (count_folds() > 0 || mean_ratio() > kMapDistortionGoal)) {
+    Eigen::VectorXd slope = K * y - b;
+    std::vector<std::pair<double, int>> order;
+    for (int j : integer_free) order.emplace_back(-std::abs(slope[j]) / K.coeff(j, j), j);
+    std::sort(order.begin(), order.end());
+    order.resize(std::min<size_t>(order.size(), 64));
+    std::vector<int> candidates;
+    std::vector<double> curvature;
+    for (const auto& [bound, j] : order) {
+      check_cancelled();
+      const Eigen::VectorXd gj = response(j);
+      if (const double c = gj.dot(K * gj); c > 0) candidates.push_back(j), curvature.push_back(c);
+    }
+    std::vector<char> refused(candidates.size(), 0);
+    for (int moves = 0; moves < 2 * static_cast<int>(candidates.size()); ++moves) {
+      int pick = -1;
+      double pick_step = 0, largest = 1e-12;
+      for (size_t k = 0; k < candidates.size(); ++k) {
+        if (refused[k]) continue;
+        const double rho = slope[candidates[k]], step = std::round(-rho / curvature[k]);
+        if (const double decrease = -(step * rho + 0.5 * step * step * curvature[k]); step != 0 && decrease > largest)
+          pick = static_cast<int>(k), pick_step = step, largest = decrease;
+      }
+      if (pick < 0) break;
+      check_cancelled();
+      const int j = candidates[pick];
+      bool open = true;
+      for (int k : segments_of[j]) {
+        double length = 0;
+        for (auto [i, coefficient] : segments[k].terms) length += coefficient * (value[i] + (i == j ? pick_step : 0.0));
+        open &= (segments[k].real > 0 ? length : -length) > 0.5;
+      }
+      const int folds = count_folds();
+      const Eigen::VectorXd y0 = y, gj = response(j);
+      if (open) {
+        y = y0 + pick_step * gj;
+        corner_uv();
+      }
+      if (!open || count_folds() > folds) {
+        refused[pick] = 1;
+        y = y0;
+        corner_uv();
+        continue;
+      }
+      value[j] += pick_step;
+      slope += pick_step * (K * gj);
+      ++q.integers_descended;
+    }
+  }
   std::vector<char> tried(nCone, 0);
   // At most this many singularities tried (two solves each): on a map folded at large (far more singularities
   // than the target's squares can separate) the search would otherwise cost a solve pair per singularity.
