@@ -877,13 +877,15 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         for (auto [i, coefficient] : segments[k].terms) length += coefficient * (value[i] + (i == j ? pick_step : 0.0));
         open &= (segments[k].real > 0 ? length : -length) > 0.5;
       }
+      if (!open) {
+        refused[pick] = 1;
+        continue;
+      }
       const int folds = count_folds();
       const Eigen::VectorXd y0 = y, gj = response(j);
-      if (open) {
-        y = y0 + pick_step * gj;
-        corner_uv();
-      }
-      if (!open || count_folds() > folds) {
+      y = y0 + pick_step * gj;
+      corner_uv();
+      if (count_folds() > folds) {
         refused[pick] = 1;
         y = y0;
         corner_uv();
