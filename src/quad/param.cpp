@@ -843,14 +843,14 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // Coordinate descent: the step of the largest decrease, round(−ρ_j / c_j), is taken, ρ updated, and so on
   // while one decreases the energy. A step is refused when it leaves more folded faces or closes an aligned
   // edge (keep_segments_open's sense). It costs a solve per integer taking part: only where the rounded map
-  // misses a goal (folds, or a mean singular-value ratio above kMapDistortionGoal), and at most 64 integers
+  // misses a goal (folds, or a mean singular-value ratio above kMapDistortionGoal), and at most 32 integers
   // (those of the largest |ρ_j| / K_jj, a bound from below on |ρ_j| / c_j).
   if (options.descend_integers && (count_folds() > 0 || mean_ratio() > kMapDistortionGoal)) {
     Eigen::VectorXd slope = K * y - b;
     std::vector<std::pair<double, int>> order;
     for (int j : integer_free) order.emplace_back(-std::abs(slope[j]) / K.coeff(j, j), j);
     std::sort(order.begin(), order.end());
-    order.resize(std::min<size_t>(order.size(), 64));
+    order.resize(std::min<size_t>(order.size(), 32));
     std::vector<int> candidates;
     std::vector<double> curvature;
     for (const auto& [bound, j] : order) {
