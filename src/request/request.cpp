@@ -333,11 +333,10 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   const bool own_onto = escalate && request.auto_options.onto_features == 0;
   cancel_for_map(request, designer, edge_length, target_faces);
   const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
-  const auto problems = map_problems;
   // Its stretch beyond the goal: 0 when the mean singular-value ratio is within kMapDistortionGoal.
   auto stretch = [&](const MapOutcome& m) { return std::max(m.param.quality.mean_distortion, kMapDistortionGoal) - kMapDistortionGoal; };
   auto better = [&](const MapOutcome& a, const MapOutcome& b) {
-    return problems(a) != problems(b) ? problems(a) < problems(b) : stretch(a) < stretch(b);
+    return map_problems(a) != map_problems(b) ? map_problems(a) < map_problems(b) : stretch(a) < stretch(b);
   };
   // The attempts: the placement found; the same relaxed (trivcon/relax.h: the field's energy is lower where
   // the singularities sit as the surface's curvature and the aligned lines ask, and a map of a field with less
@@ -456,7 +455,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     m.onto_units = own_onto ? attempt.onto : 0.0;
     m.onto_flat = own_onto && attempt.flat;
     if (tried == 1 || better(m, best)) {
-      const int first = tried == 1 ? problems(m) : best.first_problems;
+      const int first = tried == 1 ? map_problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
       if (tried > 1 && screen) rank_runner(std::move(best), kept);
       best = std::move(m);
@@ -467,7 +466,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     }
     // Past the goal only the first placement is relaxed: once its attempts are made, a map without problems ends
     // the search.
-    if (problems(best) == 0 && (stretch(best) == 0 || tried >= same_placement)) break;
+    if (map_problems(best) == 0 && (stretch(best) == 0 || tried >= same_placement)) break;
   }
   // A screened map's retries, resumed from its first maps (at the edge length and at the field's unit size); the
   // designer holds that field's fixed faces.
@@ -479,13 +478,13 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     m.param = std::move(param);
   };
   int retried = 0;
-  if (screen && best.field.verified && problems(best) > 0) {
+  if (screen && best.field.verified && map_problems(best) > 0) {
     retry(best, kept);
     ++retried;
     // Ranked without their retries, a runner-up may still be the one they mend: theirs follow, in rank, until a
     // map has no problems.
     for (auto& [m, r] : runners) {
-      if (problems(best) == 0) break;
+      if (map_problems(best) == 0) break;
       retry(m, r);
       ++retried;
       if (better(m, best)) {
