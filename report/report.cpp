@@ -130,6 +130,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"integers_moved", q.integers_moved},
           {"integers_descended", q.integers_descended},
           {"segments_opened", q.segments_opened},
+          {"turned_boundary_points", q.turned_boundary_points},
           {"untangled_faces", q.untangled_faces},
           {"untangling_regions", q.untangling_regions},
           {"rewound_regions", q.rewound_regions},

@@ -441,6 +441,63 @@ TEST(Quad, DiskAndGridsEndOnTheirAlignedBoundary) {
   }
 }
 
+// The unit square, n × n cells (two triangles each), with a slit along x = 1/2 from the bottom side up to
+// y = tip / n: the points on the slit below its tip are doubled, the cells left of it using one copy and those right of
+// it the other (a seam of two patches left unwelded, as in the Utah teapot's file).
+Mesh slit_square(int n, int tip) {
+  Mesh m;
+  const int stride = n + 1, half = n / 2;
+  std::vector<Eigen::Vector3d> points;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) points.emplace_back(double(x) / n, double(y) / n, 0);
+  std::map<int, int> copy;  // grid point on the slit below the tip → its copy, used by the cells right of it
+  for (int y = 0; y < tip; ++y) {
+    copy[y * stride + half] = static_cast<int>(points.size());
+    points.push_back(points[y * stride + half]);
+  }
+  auto id = [&](int x, int y, bool right_of_slit) {
+    const int p = y * stride + x;
+    return right_of_slit && copy.count(p) ? copy[p] : p;
+  };
+  std::vector<Eigen::Vector3i> faces;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const bool right = x >= half;
+      faces.emplace_back(id(x, y, right), id(x + 1, y, right), id(x + 1, y + 1, right));
+      faces.emplace_back(id(x, y, right), id(x + 1, y + 1, right), id(x, y + 1, right));
+    }
+  m.V.resize(static_cast<int>(points.size()), 3);
+  for (int i = 0; i < m.V.rows(); ++i) m.V.row(i) = points[i].transpose();
+  m.F.resize(static_cast<int>(faces.size()), 3);
+  for (int i = 0; i < m.F.rows(); ++i) m.F.row(i) = faces[i].transpose();
+  return m;
+}
+
+// The slit's tip is a boundary point where the aligned boundary turns back on itself: both its edges keep u
+// constant, so the alignment makes only u whole there. The map makes v whole too (a turned boundary point), so the
+// tip is a quad vertex and the slit's two sides end there; with v left fractional, the iso-line through the tip
+// went on past it on one side only and the traces from the two sides did not meet.
+TEST(Quad, SlitTipIsAQuadVertex) {
+  const Mesh m = slit_square(20, 8);
+  FieldRequest req;
+  req.align_boundary = true;
+  req.auto_place = true;
+  ParamOptions o;
+  o.edge_length = 1 / 7.3;  // the tip 2/5 of the way up: about 2.9 units, not whole by itself
+  const Pipeline r = run(m, req, o);
+  EXPECT_EQ(r.param.quality.turned_boundary_points, 1);
+  ASSERT_EQ(r.param.quality.flipped_faces, 0) << param_warning(r.param);
+  EXPECT_EQ(r.quads.quality.unmatched_traces, 0);
+  expect_clean(r, "slit square");
+  const Counts c = count(r.quads.V, r.quads.Q);
+  EXPECT_EQ(c.boundary_loops, 1);
+  EXPECT_EQ(c.euler(), 1);
+  // The tip (grid point (10, 8)) is a quad vertex: the map puts it on an integer point.
+  const int tip = 8 * 21 + 10;
+  EXPECT_EQ(std::count(r.quads.vertex_cone.data(), r.quads.vertex_cone.data() + r.quads.vertex_cone.size(), tip), 1)
+      << "no quad vertex at the slit's tip";
+}
+
 // A sphere exported unwelded (unwelded_sphere): each pole a row of points at one place, the seam a boundary loop
 // along both its sides. The map puts each pole row on one integer point (docs/param.md), and the quad mesh has one
 // vertex there, not one per point of the row; the boundary's last direction at the seam's end beside a pole, whose

@@ -853,3 +853,42 @@ TEST(TopologySharedMeshes, BrokenMeshesReportTheFirstProblem) {
 
 }  // namespace
 }  // namespace trivcon
+
+namespace trivcon {
+namespace {
+
+// vertex_fan: every face at the vertex once, each sharing with the next the edge from the vertex's previous corner
+// to it; at a boundary vertex the first face's edge out of the vertex and the last face's edge into it are on the
+// boundary.
+TEST(Topology, VertexFanIsOrderedCounterClockwise) {
+  const Mesh m = make_disk(4, 7);
+  const Topology t = build_topology(m.F, static_cast<int>(m.V.rows()));
+  std::vector<int> fan;
+  int boundary = 0, interior = 0;
+  for (int v = 0; v < t.num_vertices; ++v) {
+    vertex_fan(t, v, fan);
+    std::vector<int> sorted = fan, expected(t.vertex_faces.begin() + t.vertex_face_offsets[v],
+                                            t.vertex_faces.begin() + t.vertex_face_offsets[v + 1]);
+    std::sort(sorted.begin(), sorted.end());
+    std::sort(expected.begin(), expected.end());
+    ASSERT_EQ(sorted, expected) << "vertex " << v;
+    for (size_t i = 0; i + 1 < fan.size(); ++i) {
+      const int e = t.face_edges(fan[i], (t.corner_of(fan[i], v) + 2) % 3);
+      EXPECT_TRUE(t.edge_faces(e, 0) == fan[i + 1] || t.edge_faces(e, 1) == fan[i + 1]) << "vertex " << v;
+    }
+    if (t.is_boundary_vertex(v)) {
+      ++boundary;
+      EXPECT_TRUE(t.is_boundary_edge(t.face_edges(fan.front(), t.corner_of(fan.front(), v)))) << "vertex " << v;
+      EXPECT_TRUE(t.is_boundary_edge(t.face_edges(fan.back(), (t.corner_of(fan.back(), v) + 2) % 3))) << "vertex " << v;
+    } else {
+      ++interior;
+      const int e = t.face_edges(fan.back(), (t.corner_of(fan.back(), v) + 2) % 3);
+      EXPECT_TRUE(t.edge_faces(e, 0) == fan.front() || t.edge_faces(e, 1) == fan.front()) << "vertex " << v << ": the fan closes";
+    }
+  }
+  EXPECT_GT(boundary, 0);
+  EXPECT_GT(interior, 0);
+}
+
+}  // namespace
+}  // namespace trivcon

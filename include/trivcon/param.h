@@ -99,6 +99,7 @@ struct ParamQuality {
   double max_cone_offset = 0;          // distance of a singular vertex's (u, v) from the nearest integer point
   double max_cone_angle_error = 0;     // |Σ (u, v) corner angles − 2π(1 − k)| at singular vertices, radians
   int aligned_edges = 0, unaligned_edges = 0;
+  int turned_boundary_points = 0;      // slit tips: boundary vertices where the aligned boundary turns back, made whole
   double max_alignment_error = 0;      // distance of an aligned edge's constant coordinate from a whole number
   double mean_distortion = 0;          // area-weighted mean of σ_max / σ_min of the map's Jacobian over the faces
                                        // neither flipped nor degenerate (those, counted above, would swamp it)

@@ -77,6 +77,11 @@ struct Topology {
 // The edge joining vertices i and j (either order), or −1 (also for ids out of range): one scan of i's edges.
 int edge_between(const Topology& topology, int i, int j);
 
+// The faces around vertex v, counter-clockwise (each face's edge from v's previous corner to v leads to the next),
+// into `out`. At a boundary vertex the fan starts with the face whose edge from v to its next corner is on the
+// boundary and ends with the face whose edge into v is; around an interior vertex it starts anywhere.
+void vertex_fan(const Topology& topology, int v, std::vector<int>& out);
+
 // Builds connectivity in O(V + F) (expected) and validates; throws trivcon::Error on the first
 // problem found. `num_vertices` is V (vertex ids must be in [0, V)).
 Topology build_topology(const MatrixX3i& F, int num_vertices);

@@ -385,4 +385,30 @@ int edge_between(const Topology& t, int i, int j) {
   return -1;
 }
 
+void vertex_fan(const Topology& t, int v, std::vector<int>& out) {
+  out.clear();
+  const int begin = t.vertex_face_offsets[v], end = t.vertex_face_offsets[v + 1];
+  if (begin == end) return;
+  const int degree = end - begin;
+  auto across = [&](int f, int k) {  // the face across f's edge k, −1 at the boundary
+    const int e = t.face_edges(f, k);
+    return t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
+  };
+  int f = t.vertex_faces[begin];
+  if (t.is_boundary_vertex(v)) {
+    for (int k = 0; k < degree; ++k) {  // clockwise: across the edge from v to its next corner
+      const int g = across(f, t.corner_of(f, v));
+      if (g < 0) break;
+      f = g;
+    }
+  }
+  const int first = f;
+  for (int k = 0; k < degree; ++k) {  // counter-clockwise: across the edge from v's previous corner to v
+    out.push_back(f);
+    const int g = across(f, (t.corner_of(f, v) + 2) % 3);
+    if (g < 0 || g == first) break;
+    f = g;
+  }
+}
+
 }  // namespace trivcon

@@ -177,32 +177,16 @@ class Extractor {
 };
 
 // The faces around each vertex, counter-clockwise; a boundary vertex's start with the face whose edge from the
-// vertex to its next corner is on the boundary.
+// vertex to its next corner is on the boundary (vertex_fan).
 void Extractor::build_fans() {
   const int nV = t_.num_vertices;
   fan_offsets_.assign(nV + 1, 0);
   fan_faces_.reserve(3 * static_cast<size_t>(t_.num_faces));
+  std::vector<int> fan;
   for (int v = 0; v < nV; ++v) {
     fan_offsets_[v] = static_cast<int>(fan_faces_.size());
-    const int begin = t_.vertex_face_offsets[v], end = t_.vertex_face_offsets[v + 1];
-    if (begin == end) continue;
-    const int degree = end - begin;
-    int f = t_.vertex_faces[begin];
-    if (t_.is_boundary_vertex(v)) {
-      for (int k = 0; k < degree; ++k) {  // clockwise: across the edge from v to its next corner
-        const int g = other_face(t_.face_edges(f, t_.corner_of(f, v)), f);
-        if (g < 0) break;
-        f = g;
-      }
-    }
-    const int first = f;
-    for (int k = 0; k < degree; ++k) {
-      fan_faces_.push_back(f);
-      fan_corners_.push_back(t_.corner_of(f, v));
-      const int g = other_face(t_.face_edges(f, (t_.corner_of(f, v) + 2) % 3), f);
-      if (g < 0 || g == first) break;
-      f = g;
-    }
+    vertex_fan(t_, v, fan);
+    for (int f : fan) fan_faces_.push_back(f), fan_corners_.push_back(t_.corner_of(f, v));
   }
   fan_offsets_[nV] = static_cast<int>(fan_faces_.size());
   joined_.resize(nV);

@@ -385,9 +385,50 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   }
   std::sort(out.aligned_edges.begin(), out.aligned_edges.end());
   out.aligned_edges.erase(std::unique(out.aligned_edges.begin(), out.aligned_edges.end()), out.aligned_edges.end());
+  // Turned boundary points: a boundary vertex whose two boundary edges are aligned with the same coordinate
+  // constant while the boundary turns back on itself in (u, v) (the tip of a slit: a seam of patches left
+  // unwelded, a crack). The aligned edges make only that coordinate whole; the other is free, yet the point is a
+  // corner of the quads (the slit's two sides part there), so it is made whole too: one more integer. The turn
+  // between the two edges, in quarter turns, is read from the combed frames: the direction of the fan's first
+  // edge (leaving the vertex) and of its last (coming back to it), carried across the fan's cut edges by their
+  // rotations; it is 0 mod 4 at a slit's tip and 2 mod 4 where the boundary runs straight on.
+  std::vector<std::array<int, 3>> turned_points;  // (vertex, face, the coordinate made whole in face's wedge)
+  {
+    auto quarter_of = [&](int f, int k) {  // direction code of half-edge k of f in f's chart: 0 = +u, 1 = +v, ...
+      const long long q = std::llround((g.half_edge_angle(f, k) - theta[f]) / (kPi / 2));
+      return static_cast<int>(((q % 4) + 4) % 4);
+    };
+    std::vector<char> aligned_in_face(3 * static_cast<size_t>(nF), 0);
+    for (const auto& [e, f] : aligned)
+      for (int k = 0; k < 3; ++k)
+        if (t.face_edges(f, k) == e) aligned_in_face[3 * f + k] = 1;
+    std::vector<int> fan;
+    for (int v = 0; v < nV; ++v) {
+      if (!t.is_boundary_vertex(v)) continue;
+      vertex_fan(t, v, fan);
+      if (fan.empty()) continue;
+      const int first = fan.front(), last = fan.back(), k_first = t.corner_of(first, v);
+      int turn = 0;  // quarter turns from the first face's chart to the last's, over the fan's cut edges
+      for (size_t i = 0; i + 1 < fan.size(); ++i) {
+        const int e = t.face_edges(fan[i], (t.corner_of(fan[i], v) + 2) % 3);
+        if (cut[e]) turn += fan[i + 1] == t.edge_faces(e, 1) ? out.rotation[e] : -out.rotation[e];
+      }
+      const int k_last = (t.corner_of(last, v) + 2) % 3;
+      if (!t.is_boundary_edge(t.face_edges(first, k_first)) || !t.is_boundary_edge(t.face_edges(last, k_last))) continue;
+      if (!aligned_in_face[3 * first + k_first] || !aligned_in_face[3 * last + k_last]) continue;
+      const int c_first = constant_coordinate(t.face_edges(first, k_first), first);
+      const int c_last = constant_coordinate(t.face_edges(last, k_last), last);
+      if (c_first < 0 || c_last < 0) continue;
+      // The last edge's direction from v, in the first face's chart.
+      const int d_first = quarter_of(first, k_first), d_last = quarter_of(last, k_last) + 2 - turn;
+      if ((((d_last - d_first) % 4) + 4) % 4 == 0) turned_points.push_back({v, first, 1 - c_first});
+    }
+  }
+  q.turned_boundary_points = static_cast<int>(turned_points.size());
   const int nCone = static_cast<int>(out.cones.size()), nAligned = static_cast<int>(aligned.size()), nCut = static_cast<int>(out.cut_edges.size());
-  const int cone0 = 2 * W, aligned0 = cone0 + 2 * nCone, cut0 = aligned0 + nAligned;
-  Elimination elim(2 * W, 2 * nCone + nAligned + 2 * nCut);
+  const int nTurned = static_cast<int>(turned_points.size());
+  const int cone0 = 2 * W, aligned0 = cone0 + 2 * nCone, cut0 = aligned0 + nAligned, turned0 = cut0 + 2 * nCut;
+  Elimination elim(2 * W, 2 * nCone + nAligned + 2 * nCut + nTurned);
   for (int i = 0; i < nCone; ++i) {
     const int v = out.cones[i];
     const int f = t.vertex_faces[t.vertex_face_offsets[v]];
@@ -412,6 +453,10 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         elim.add(row);
       }
     }
+  }
+  for (int i = 0; i < nTurned; ++i) {
+    const auto [v, f, c] = turned_points[i];
+    elim.add({{2 * wedge_at(f, v) + c, 1.0}, {turned0 + i, -1.0}});
   }
   q.non_unimodular = elim.non_unimodular();
 
