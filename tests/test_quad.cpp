@@ -498,6 +498,44 @@ TEST(Quad, SlitTipIsAQuadVertex) {
       << "no quad vertex at the slit's tip";
 }
 
+// The unit square, n × n cells, without the cells [lo, hi)² (a square hole).
+Mesh square_with_hole(int n, int lo, int hi) {
+  Mesh m;
+  const int stride = n + 1;
+  m.V.resize(stride * stride, 3);
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) m.V.row(y * stride + x) << double(x) / n, double(y) / n, 0;
+  std::vector<Eigen::Vector3i> faces;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      if (x >= lo && x < hi && y >= lo && y < hi) continue;
+      const int a = y * stride + x;
+      faces.emplace_back(a, a + 1, a + stride + 1);
+      faces.emplace_back(a, a + stride + 1, a + stride);
+    }
+  m.F.resize(static_cast<int>(faces.size()), 3);
+  for (int i = 0; i < m.F.rows(); ++i) m.F.row(i) = faces[i].transpose();
+  return m;
+}
+
+// A hole about half a unit wide: rounded by itself, its sides' iso-lines could meet (the hole a point, or a slit
+// whose two sides are one quad edge). Its width and height are kept at least a unit, so the quads keep the loop.
+TEST(Quad, HoleSmallerThanASquareStaysOpen) {
+  const Mesh m = square_with_hole(30, 14, 16);  // the hole 1/15 wide: 0.53 units at 8 units across
+  FieldRequest req;
+  req.align_boundary = true;
+  req.auto_place = true;
+  ParamOptions o;
+  o.edge_length = 1.0 / 8;
+  const Pipeline r = run(m, req, o);
+  ASSERT_EQ(r.param.quality.flipped_faces, 0) << param_warning(r.param);
+  EXPECT_GE(r.param.quality.segments_opened, 1);
+  expect_clean(r, "square with a small hole");
+  const Counts c = count(r.quads.V, r.quads.Q);
+  EXPECT_EQ(c.boundary_loops, 2);
+  EXPECT_EQ(c.euler(), 0);
+}
+
 // A sphere exported unwelded (unwelded_sphere): each pole a row of points at one place, the seam a boundary loop
 // along both its sides. The map puts each pole row on one integer point (docs/param.md), and the quad mesh has one
 // vertex there, not one per point of the row; the boundary's last direction at the seam's end beside a pole, whose

@@ -14,6 +14,7 @@
 #include <array>
 #include <limits>
 #include <map>
+#include <set>
 #include <memory>
 #include <cmath>
 #include <numeric>
@@ -766,31 +767,106 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   struct Segment {
     std::vector<std::pair<int, double>> terms;  // free unknown, coefficient: the (along) length
     double real = 0;                           // in the real-valued map
+    double least = 1;                          // the fewest units it keeps
+    std::vector<char> held;                    // per term: never the one changed to open it (empty: none held)
   };
   std::vector<Segment> segments;
   std::vector<std::vector<int>> segments_of(nY);  // per free integer, the segments it enters
   {
+    // Coordinate c of wedge w, as free unknowns, added to acc with `sign`.
     auto along_row = [&](int w, int c, std::map<int, double>& acc, double sign) {
-      bool whole = true;
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * w + c); it; ++it) {
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * w + c); it; ++it)
         acc[static_cast<int>(it.col())] += sign * it.value();
-        whole &= is_integer[it.col()] != 0;
+    };
+    // Kept when its terms are all integers and the real-valued map gives it a sign.
+    auto add_segment = [&](const std::map<int, double>& acc, double least, const std::set<int>& held = {}) {
+      Segment seg;
+      seg.least = least;
+      for (auto [j, coefficient] : acc) {
+        if (std::abs(coefficient) <= 1e-12) continue;
+        if (!is_integer[j]) return;
+        seg.terms.emplace_back(j, coefficient), seg.real += coefficient * y[j];
+        if (!held.empty()) seg.held.push_back(held.count(j) ? 1 : 0);
       }
-      return whole;
+      if (seg.terms.empty() || std::abs(seg.real) < 1e-6) return;
+      for (auto [j, coefficient] : seg.terms) segments_of[j].push_back(static_cast<int>(segments.size()));
+      segments.push_back(std::move(seg));
     };
     for (int i = 0; i < nAligned; ++i) {
       const auto [e, f] = aligned[i];
-      const int c = 1 - aligned_coordinate[i];
-      std::map<int, double> acc;
-      const bool a = along_row(wedge_at(f, t.edge_vertices(e, 0)), c, acc, -1.0);
-      const bool bb = along_row(wedge_at(f, t.edge_vertices(e, 1)), c, acc, 1.0);
-      if (!a || !bb) continue;
-      Segment seg;
-      for (auto [j, coefficient] : acc)
-        if (std::abs(coefficient) > 1e-12) seg.terms.emplace_back(j, coefficient), seg.real += coefficient * y[j];
-      if (seg.terms.empty() || std::abs(seg.real) < 1e-6) continue;
-      for (auto [j, coefficient] : seg.terms) segments_of[j].push_back(static_cast<int>(segments.size()));
-      segments.push_back(std::move(seg));
+      const int c = aligned_coordinate[i];
+      std::map<int, double> along;  // the edge's own length in the other coordinate
+      along_row(wedge_at(f, t.edge_vertices(e, 0)), 1 - c, along, -1.0);
+      along_row(wedge_at(f, t.edge_vertices(e, 1)), 1 - c, along, 1.0);
+      add_segment(along, 1);
+    }
+    // A boundary loop's extent: its width and height in (u, v) are kept at least one unit the same way, so that a
+    // hole smaller than a square does not round to a point or to a slit one unit long (whose two sides would be
+    // one quad edge: the quad mesh would close it). The loop is developed into the chart of its first edge's
+    // face: each boundary edge's (u, v) difference, turned by the quarter turns of the cut edges crossed so far in
+    // the fans between consecutive edges. A loop that closes there (no net turn, and back to its start within half
+    // a unit: a hole in a disk, not the rim of a cylinder) gives two segments, from its least to its greatest u
+    // and v (kept when both ends are integers, on aligned sides). A slit (one extent 0 whatever the integers: its
+    // sides share their ends) keeps two units along: with one, its two sides would be one quad edge.
+    std::vector<int> fan;
+    for (const std::vector<int>& loop : t.boundary_loops) {
+      const int n = static_cast<int>(loop.size());
+      if (n < 3) continue;
+      std::vector<std::array<std::map<int, double>, 2>> step(n);  // the developed (u, v) difference along edge i
+      std::vector<Eigen::Vector2d> at(n + 1, Eigen::Vector2d::Zero());  // the developed point at vertex i, real map
+      int turn = 0;
+      bool ok = true;
+      for (int i = 0; i < n && ok; ++i) {
+        const int a = loop[i], c = loop[(i + 1) % n];
+        const int e = edge_between(t, a, c);
+        const int f = e >= 0 ? (t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1)) : -1;
+        vertex_fan(t, c, fan);
+        if (f < 0 || fan.empty() || fan.back() != f) {
+          ok = false;
+          break;
+        }
+        std::array<std::map<int, double>, 2>& d = step[i];
+        for (int k = 0; k < 2; ++k) {
+          along_row(wedge_at(f, a), k, d[k], -1.0);
+          along_row(wedge_at(f, c), k, d[k], 1.0);
+        }
+        for (int r = ((turn % 4) + 4) % 4; r > 0; --r) {  // J (u, v) = (−v, u)
+          std::swap(d[0], d[1]);
+          for (auto& term : d[0]) term.second = -term.second;
+        }
+        at[i + 1] = at[i];
+        for (int k = 0; k < 2; ++k)
+          for (auto [j, x] : d[k]) at[i + 1][k] += x * y[j];
+        // Into the next edge's chart: its face starts c's fan, this edge's face ends it.
+        for (size_t s = 0; s + 1 < fan.size(); ++s) {
+          const int cross = t.face_edges(fan[s], (t.corner_of(fan[s], c) + 2) % 3);
+          if (cut[cross]) turn += fan[s + 1] == t.edge_faces(cross, 1) ? out.rotation[cross] : -out.rotation[cross];
+        }
+      }
+      if (!ok || ((turn % 4) + 4) % 4 != 0 || at[n].lpNorm<Eigen::Infinity>() > 0.5) continue;
+      std::array<std::map<int, double>, 2> extent;
+      bool empty[2];
+      for (int k = 0; k < 2; ++k) {
+        int lo = 0, hi = 0;
+        for (int i = 1; i < n; ++i) {
+          if (at[i][k] < at[lo][k]) lo = i;
+          if (at[i][k] > at[hi][k]) hi = i;
+        }
+        for (int i = lo; i != hi; i = (i + 1) % n)
+          for (auto [j, x] : step[i][k]) extent[k][j] += x;
+        empty[k] = std::all_of(extent[k].begin(), extent[k].end(), [](const auto& term) { return std::abs(term.second) <= 1e-12; });
+      }
+      // The loop's closure (the translations of the cuts it crosses, 0 in a hole's) is not what opens it: changed,
+      // the hole's image would tear open at a cut instead.
+      std::array<std::map<int, double>, 2> sum;
+      for (int i = 0; i < n; ++i)
+        for (int k = 0; k < 2; ++k)
+          for (auto [j, x] : step[i][k]) sum[k][j] += x;
+      std::set<int> closure;
+      for (int k = 0; k < 2; ++k)
+        for (auto [j, x] : sum[k])
+          if (std::abs(x) > 1e-12) closure.insert(j);
+      for (int k = 0; k < 2; ++k) add_segment(extent[k], empty[1 - k] ? 2 : 1, closure);
     }
   }
   // After a round's integers are given values: every segment now whole that the round completed, and that would be
@@ -807,18 +883,42 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       double length = 0;
       bool whole = true;
       for (auto [i, coefficient] : seg.terms) whole &= fixed[i] != 0, length += coefficient * value[i];
-      if (!whole || (seg.real > 0 ? length : -length) > 0.5) continue;  // at least one unit in the real map's sense
+      if (!whole || (seg.real > 0 ? length : -length) > seg.least - 0.5) continue;  // in the real map's sense
       int pick = -1;
       double pick_coefficient = 0;
-      for (auto [i, coefficient] : seg.terms)
-        if (std::abs(std::abs(coefficient) - 1) < 1e-9 && (pick < 0 || segments_of[i].size() < segments_of[pick].size()))
+      for (size_t m = 0; m < seg.terms.size(); ++m) {
+        const auto [i, coefficient] = seg.terms[m];
+        if (std::abs(std::abs(coefficient) - 1) < 1e-9 && (seg.held.empty() || !seg.held[m]) &&
+            (pick < 0 || segments_of[i].size() < segments_of[pick].size()))
           pick = i, pick_coefficient = coefficient;
+      }
       if (pick < 0) continue;
-      value[pick] += ((seg.real > 0 ? 1.0 : -1.0) - length) * pick_coefficient;  // the length becomes ±1
+      value[pick] += ((seg.real > 0 ? seg.least : -seg.least) - length) * pick_coefficient;  // the length becomes ±least
       ++q.segments_opened;
       for (int other : segments_of[pick])
         if (other != k) queue.push_back(other);
     }
+  };
+  // Whether changing fixed integers j1 by d1 and j2 by d2 would close a segment open before (as
+  // keep_segments_open means it): the moves after the rounding (the descent, the singularities' and the other
+  // integers' local searches) refuse those.
+  auto closes_segment = [&](int j1, double d1, int j2 = -1, double d2 = 0) {
+    auto closes = [&](int k) {
+      const Segment& seg = segments[k];
+      double before = 0, after = 0;
+      for (auto [i, coefficient] : seg.terms) {
+        before += coefficient * value[i];
+        after += coefficient * (value[i] + (i == j1 ? d1 : 0.0) + (i == j2 ? d2 : 0.0));
+      }
+      const double sign = seg.real > 0 ? 1.0 : -1.0;
+      return sign * before > seg.least - 0.5 && !(sign * after > seg.least - 0.5);
+    };
+    for (int k : segments_of[j1])
+      if (closes(k)) return true;
+    if (j2 >= 0)
+      for (int k : segments_of[j2])
+        if (closes(k)) return true;
+    return false;
   };
   std::vector<int> left = integer_free;
   while (!left.empty()) {
@@ -916,13 +1016,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       if (pick < 0) break;
       check_cancelled();
       const int j = candidates[pick];
-      bool open = true;
-      for (int k : segments_of[j]) {
-        double length = 0;
-        for (auto [i, coefficient] : segments[k].terms) length += coefficient * (value[i] + (i == j ? pick_step : 0.0));
-        open &= (segments[k].real > 0 ? length : -length) > 0.5;
-      }
-      if (!open) {
+      if (closes_segment(j, pick_step)) {
         refused[pick] = 1;
         continue;
       }
@@ -960,6 +1054,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     Eigen::Vector2d step(0, 0);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy) {
+        if (closes_segment(ju, dx, jv, dy)) continue;
         y = y0 + dx * gu + dy * gv;
         corner_uv();
         const std::pair<int, double> score{count_folds() + (ring_is_bad(v) ? 1 : 0), energy(dx, dy)};
@@ -993,6 +1088,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         const Eigen::VectorXd y0 = y, gj = response(j);
         int fewest = count_folds(), step = 0;
         for (int d : {-1, 1}) {
+          if (closes_segment(j, d)) continue;
           y = y0 + d * gj;
           corner_uv();
           if (const int folds = count_folds(); folds < fewest) fewest = folds, step = d;
@@ -1229,7 +1325,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         std::vector<std::tuple<int, double, int, int>> order;
         for (int dx = -1; dx <= 1; ++dx)
           for (int dy = -1; dy <= 1; ++dy) {
-            if (dx == 0 && dy == 0) continue;
+            if ((dx == 0 && dy == 0) || closes_segment(ju, dx, jv, dy)) continue;
             y = y0 + dx * gu + dy * gv;
             corner_uv();
             order.emplace_back(count_folds(), energy(dx, dy), dx, dy);
