@@ -441,11 +441,19 @@ TEST(Quad, DiskAndGridsEndOnTheirAlignedBoundary) {
   }
 }
 
+Mesh mesh_of(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3i>& faces) {
+  Mesh m;
+  m.V.resize(static_cast<int>(points.size()), 3);
+  for (int i = 0; i < m.V.rows(); ++i) m.V.row(i) = points[i].transpose();
+  m.F.resize(static_cast<int>(faces.size()), 3);
+  for (int i = 0; i < m.F.rows(); ++i) m.F.row(i) = faces[i].transpose();
+  return m;
+}
+
 // The unit square, n × n cells (two triangles each), with a slit along x = 1/2 from the bottom side up to
 // y = tip / n: the points on the slit below its tip are doubled, the cells left of it using one copy and those right of
 // it the other (a seam of two patches left unwelded, as in the Utah teapot's file).
 Mesh slit_square(int n, int tip) {
-  Mesh m;
   const int stride = n + 1, half = n / 2;
   std::vector<Eigen::Vector3d> points;
   for (int y = 0; y <= n; ++y)
@@ -466,11 +474,7 @@ Mesh slit_square(int n, int tip) {
       faces.emplace_back(id(x, y, right), id(x + 1, y, right), id(x + 1, y + 1, right));
       faces.emplace_back(id(x, y, right), id(x + 1, y + 1, right), id(x, y + 1, right));
     }
-  m.V.resize(static_cast<int>(points.size()), 3);
-  for (int i = 0; i < m.V.rows(); ++i) m.V.row(i) = points[i].transpose();
-  m.F.resize(static_cast<int>(faces.size()), 3);
-  for (int i = 0; i < m.F.rows(); ++i) m.F.row(i) = faces[i].transpose();
-  return m;
+  return mesh_of(points, faces);
 }
 
 // The slit's tip is a boundary point where the aligned boundary turns back on itself: both its edges keep u
@@ -500,11 +504,10 @@ TEST(Quad, SlitTipIsAQuadVertex) {
 
 // The unit square, n × n cells, without the cells [lo, hi)² (a square hole).
 Mesh square_with_hole(int n, int lo, int hi) {
-  Mesh m;
   const int stride = n + 1;
-  m.V.resize(stride * stride, 3);
+  std::vector<Eigen::Vector3d> points;
   for (int y = 0; y <= n; ++y)
-    for (int x = 0; x <= n; ++x) m.V.row(y * stride + x) << double(x) / n, double(y) / n, 0;
+    for (int x = 0; x <= n; ++x) points.emplace_back(double(x) / n, double(y) / n, 0);
   std::vector<Eigen::Vector3i> faces;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
@@ -513,9 +516,7 @@ Mesh square_with_hole(int n, int lo, int hi) {
       faces.emplace_back(a, a + 1, a + stride + 1);
       faces.emplace_back(a, a + stride + 1, a + stride);
     }
-  m.F.resize(static_cast<int>(faces.size()), 3);
-  for (int i = 0; i < m.F.rows(); ++i) m.F.row(i) = faces[i].transpose();
-  return m;
+  return mesh_of(points, faces);
 }
 
 // A hole about half a unit wide: rounded by itself, its sides' iso-lines could meet (the hole a point, or a slit

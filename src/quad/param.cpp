@@ -393,6 +393,16 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // between the two edges, in quarter turns, is read from the combed frames: the direction of the fan's first
   // edge (leaving the vertex) and of its last (coming back to it), carried across the fan's cut edges by their
   // rotations; it is 0 mod 4 at a slit's tip and 2 mod 4 where the boundary runs straight on.
+  // Quarter turns from the chart of the first face of v's fan (vertex_fan) to its last, over its cut edges: a
+  // direction code c in the first face's chart is c + turn in the last's.
+  auto fan_turn = [&](int v, const std::vector<int>& fan) {
+    int turn = 0;
+    for (size_t i = 0; i + 1 < fan.size(); ++i) {
+      const int e = t.face_edges(fan[i], (t.corner_of(fan[i], v) + 2) % 3);
+      if (cut[e]) turn += fan[i + 1] == t.edge_faces(e, 1) ? out.rotation[e] : -out.rotation[e];
+    }
+    return turn;
+  };
   std::vector<std::array<int, 3>> turned_points;  // (vertex, face, the coordinate made whole in face's wedge)
   {
     auto quarter_of = [&](int f, int k) {  // direction code of half-edge k of f in f's chart: 0 = +u, 1 = +v, ...
@@ -409,11 +419,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       vertex_fan(t, v, fan);
       if (fan.empty()) continue;
       const int first = fan.front(), last = fan.back(), k_first = t.corner_of(first, v);
-      int turn = 0;  // quarter turns from the first face's chart to the last's, over the fan's cut edges
-      for (size_t i = 0; i + 1 < fan.size(); ++i) {
-        const int e = t.face_edges(fan[i], (t.corner_of(fan[i], v) + 2) % 3);
-        if (cut[e]) turn += fan[i + 1] == t.edge_faces(e, 1) ? out.rotation[e] : -out.rotation[e];
-      }
+      const int turn = fan_turn(v, fan);
       const int k_last = (t.corner_of(last, v) + 2) % 3;
       if (!t.is_boundary_edge(t.face_edges(first, k_first)) || !t.is_boundary_edge(t.face_edges(last, k_last))) continue;
       if (!aligned_in_face[3 * first + k_first] || !aligned_in_face[3 * last + k_last]) continue;
@@ -837,11 +843,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         at[i + 1] = at[i];
         for (int k = 0; k < 2; ++k)
           for (auto [j, x] : d[k]) at[i + 1][k] += x * y[j];
-        // Into the next edge's chart: its face starts c's fan, this edge's face ends it.
-        for (size_t s = 0; s + 1 < fan.size(); ++s) {
-          const int cross = t.face_edges(fan[s], (t.corner_of(fan[s], c) + 2) % 3);
-          if (cut[cross]) turn += fan[s + 1] == t.edge_faces(cross, 1) ? out.rotation[cross] : -out.rotation[cross];
-        }
+        turn += fan_turn(c, fan);  // into the next edge's chart: its face starts c's fan, this edge's face ends it
       }
       if (!ok || ((turn % 4) + 4) % 4 != 0 || at[n].lpNorm<Eigen::Infinity>() > 0.5) continue;
       std::array<std::map<int, double>, 2> extent;
