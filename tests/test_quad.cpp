@@ -537,6 +537,27 @@ TEST(Quad, HoleSmallerThanASquareStaysOpen) {
   EXPECT_EQ(c.euler(), 0);
 }
 
+// The same hole at a fifth of a unit, kept a unit wide: the map's own check looks at the rings of the boundary
+// vertices between aligned edges too (their angle against the turn between the edges), so a hole's corner that
+// winds wrong is a winding error of the map, not only a trace of the quads that does not come back.
+TEST(Quad, MapCheckSeesABoundaryRingThatWindsWrong) {
+  const Mesh m = square_with_hole(30, 14, 16);
+  FieldRequest req;
+  req.align_boundary = true;
+  req.auto_place = true;
+  for (double h : {1.0 / 8, 0.2, 0.3}) {
+    ParamOptions o;
+    o.edge_length = h;
+    const Pipeline r = run(m, req, o);
+    const QuadQuality& q = r.quads.quality;
+    const ParamQuality& p = r.param.quality;
+    const int map_problems = p.flipped_faces + p.degenerate_faces + p.winding_errors;
+    if (q.unmatched_traces > 0 || q.failed_traces > 0)
+      EXPECT_GT(map_problems, 0) << "edge length " << h << ": the quads fail where the map says it has no problem";
+    if (h == 1.0 / 8) EXPECT_EQ(map_problems, 0);
+  }
+}
+
 // A sphere exported unwelded (unwelded_sphere): each pole a row of points at one place, the seam a boundary loop
 // along both its sides. The map puts each pole row on one integer point (docs/param.md), and the quad mesh has one
 // vertex there, not one per point of the row; the boundary's last direction at the seam's end beside a pole, whose

@@ -90,7 +90,8 @@ struct ParamQuality {
   int degenerate_faces = 0;   // faces whose (u, v) triangle has (nearly) zero area
   int collapsed_faces = 0;    // faces with an edge of length 0 on the surface, not turned over (not counted above)
   // Interior vertices whose (u, v) corner angles do not sum to 2π(1 − k) (k the index, 0 off the cones): where
-  // the quad mesh gets a vertex of another valence than the singularities say (0 expected).
+  // the quad mesh gets a vertex of another valence than the singularities say; and boundary vertices between two
+  // aligned boundary edges whose angles do not sum to the turn between the edges (0 expected; docs/param.md).
   int winding_errors = 0;
   int attempts = 1;           // maps made (ParamOptions::retries); the one kept is described here
   int first_factorizations = 0;  // the first map's factorizations (the retries' budget counts against them)

@@ -404,6 +404,10 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     return turn;
   };
   std::vector<std::array<int, 3>> turned_points;  // (vertex, face, the coordinate made whole in face's wedge)
+  // Per boundary vertex whose two boundary edges are aligned: the (u, v) angle between them in quarter turns
+  // (their turn modulo 4, with the whole turns of the surface's own angle there), else −1. Its ring must sum to
+  // it, as an interior ring to 2π(1 − k): `winds_wrong` below.
+  std::vector<int> boundary_quarters(nV, -1);
   {
     auto quarter_of = [&](int f, int k) {  // direction code of half-edge k of f in f's chart: 0 = +u, 1 = +v, ...
       const long long q = std::llround((g.half_edge_angle(f, k) - theta[f]) / (kPi / 2));
@@ -428,7 +432,12 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       if (c_first < 0 || c_last < 0) continue;
       // The last edge's direction from v, in the first face's chart.
       const int d_first = quarter_of(first, k_first), d_last = quarter_of(last, k_last) + 2 - turn;
-      if ((((d_last - d_first) % 4) + 4) % 4 == 0) turned_points.push_back({v, first, 1 - c_first});
+      const int turn_class = (((d_last - d_first) % 4) + 4) % 4;
+      if (turn_class == 0) turned_points.push_back({v, first, 1 - c_first});
+      double angle = 0;
+      for (int f : fan) angle += g.corner_angles(f, t.corner_of(f, v));
+      const int quarters = turn_class + 4 * static_cast<int>(std::lround((angle / (kPi / 2) - turn_class) / 4));
+      boundary_quarters[v] = quarters > 0 ? quarters : turn_class + 4;
     }
   }
   q.turned_boundary_points = static_cast<int>(turned_points.size());
@@ -1125,9 +1134,13 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // would give the quad mesh a vertex of another valence (or one more irregular vertex).
   std::vector<double> expected_angle(nV, 2 * kPi);
   for (int i = 0; i < nCone; ++i) expected_angle[out.cones[i]] = 2 * kPi * (1 - out.cone_index[i] / 4.0);
+  for (int v = 0; v < nV; ++v)
+    if (boundary_quarters[v] > 0) expected_angle[v] = boundary_quarters[v] * kPi / 2;
   // With every integer whole, a ring's angles sum to 2π(1 − k) up to whole turns (the transitions rotate by
   // quarter turns that add up to the index): the test tells whole turns apart, the rough atan2 is enough.
-  auto winds_wrong = [&](int v) { return t.is_interior_vertex(v) && std::abs(uv_angle_sum(v, true) - expected_angle[v]) > 1; };
+  // At a boundary vertex between aligned edges, the same with the angle between them.
+  auto checks_winding = [&](int v) { return t.is_interior_vertex(v) || boundary_quarters[v] > 0; };
+  auto winds_wrong = [&](int v) { return checks_winding(v) && std::abs(uv_angle_sum(v, true) - expected_angle[v]) > 1; };
   auto cone_winds_wrong = [&](int i) { return winds_wrong(out.cones[i]); };
   // The folded faces and the interior vertices winding wrong, over the whole map or over a part of it (faces and
   // vertices given): a change of the map that moves only some faces compares the badness of those faces and of
@@ -1448,9 +1461,10 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       q.max_cone_offset = std::max({q.max_cone_offset, whole_offset(out.uv(3 * f + k, 0)), whole_offset(out.uv(3 * f + k, 1))});
     }
   }
-  // Every interior vertex's angle sum against 2π(1 − k), once: the cones' errors and the windings.
+  // Every interior vertex's angle sum against 2π(1 − k), once: the cones' errors and the windings (and at the
+  // boundary vertices between aligned edges, against the angle between them).
   for (int v = 0; v < nV; ++v) {
-    if (!t.is_interior_vertex(v)) continue;
+    if (!checks_winding(v)) continue;
     const double error = std::abs(uv_angle_sum(v) - expected_angle[v]);
     if (singular[v]) q.max_cone_angle_error = std::max(q.max_cone_angle_error, error);
     q.winding_errors += error > 1e-6;
