@@ -441,6 +441,14 @@ TEST(Quad, DiskAndGridsEndOnTheirAlignedBoundary) {
   }
 }
 
+// Singularities placed automatically, every boundary edge aligned (as `quad --auto` does).
+FieldRequest aligned_boundary_auto() {
+  FieldRequest req;
+  req.align_boundary = true;
+  req.auto_place = true;
+  return req;
+}
+
 Mesh mesh_of(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3i>& faces) {
   Mesh m;
   m.V.resize(static_cast<int>(points.size()), 3);
@@ -483,9 +491,7 @@ Mesh slit_square(int n, int tip) {
 // went on past it on one side only and the traces from the two sides did not meet.
 TEST(Quad, SlitTipIsAQuadVertex) {
   const Mesh m = slit_square(20, 8);
-  FieldRequest req;
-  req.align_boundary = true;
-  req.auto_place = true;
+  const FieldRequest req = aligned_boundary_auto();
   ParamOptions o;
   o.edge_length = 1 / 7.3;  // the tip 2/5 of the way up: about 2.9 units, not whole by itself
   const Pipeline r = run(m, req, o);
@@ -523,9 +529,7 @@ Mesh square_with_hole(int n, int lo, int hi) {
 // whose two sides are one quad edge). Its width and height are kept at least a unit, so the quads keep the loop.
 TEST(Quad, HoleSmallerThanASquareStaysOpen) {
   const Mesh m = square_with_hole(30, 14, 16);  // the hole 1/15 wide: 0.53 units at 8 units across
-  FieldRequest req;
-  req.align_boundary = true;
-  req.auto_place = true;
+  const FieldRequest req = aligned_boundary_auto();
   ParamOptions o;
   o.edge_length = 1.0 / 8;
   const Pipeline r = run(m, req, o);
@@ -542,9 +546,7 @@ TEST(Quad, HoleSmallerThanASquareStaysOpen) {
 // winds wrong is a winding error of the map, not only a trace of the quads that does not come back.
 TEST(Quad, MapCheckSeesABoundaryRingThatWindsWrong) {
   const Mesh m = square_with_hole(30, 14, 16);
-  FieldRequest req;
-  req.align_boundary = true;
-  req.auto_place = true;
+  const FieldRequest req = aligned_boundary_auto();
   for (double h : {1.0 / 8, 0.2, 0.3}) {
     ParamOptions o;
     o.edge_length = h;
