@@ -816,6 +816,51 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       along_row(wedge_at(f, t.edge_vertices(e, 1)), 1 - c, along, 1.0);
       add_segment(along, 1);
     }
+    // A face whose three corners all sit on whole values of one coordinate (each on an aligned line, or a
+    // singularity's point: the face between two feature lines less than a unit apart, or beside a singularity
+    // next to one) would be degenerate were those values equal: its extent in that coordinate, from its least to
+    // its greatest corner in the real-valued map, keeps a unit. Likewise an edge whose two ends are both integer
+    // points (a singularity beside a corner of the feature lines) would have length 0: its extent in the
+    // coordinate where the real-valued map has it longer keeps a unit. Each such pair of lines or points once.
+    std::set<std::vector<std::pair<int, double>>> extents;
+    auto add_extent = [&](const std::map<int, double>& to, const std::map<int, double>& from) {
+      std::map<int, double> extent = to;
+      for (auto [j, coefficient] : from) extent[j] -= coefficient;
+      std::vector<std::pair<int, double>> key;
+      for (auto [j, coefficient] : extent)
+        if (std::abs(coefficient) > 1e-12) key.emplace_back(j, coefficient);
+      if (!key.empty() && extents.insert(key).second) add_segment(extent, 1);
+    };
+    for (int f = 0; f < nF; ++f) {
+      if (folded(f)) continue;  // the real-valued map's order of its corners is no guide there
+      std::array<std::array<std::map<int, double>, 2>, 3> corner;
+      std::array<std::array<double, 2>, 3> real{};
+      std::array<std::array<bool, 2>, 3> whole;
+      for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 2; ++c) {
+          along_row(wedge[3 * f + k], c, corner[k][c], 1.0);
+          whole[k][c] = true;
+          for (auto [j, coefficient] : corner[k][c]) whole[k][c] = whole[k][c] && is_integer[j], real[k][c] += coefficient * y[j];
+        }
+      for (int c = 0; c < 2; ++c) {
+        if (!whole[0][c] || !whole[1][c] || !whole[2][c]) continue;
+        int lo = 0, hi = 0;
+        for (int k = 1; k < 3; ++k) {
+          if (real[k][c] < real[lo][c]) lo = k;
+          if (real[k][c] > real[hi][c]) hi = k;
+        }
+        add_extent(corner[hi][c], corner[lo][c]);
+      }
+      for (int k = 0; k < 3; ++k) {
+        const int a = k, b = (k + 1) % 3;
+        if (!whole[a][0] || !whole[a][1] || !whole[b][0] || !whole[b][1]) continue;
+        const int c = std::abs(real[b][0] - real[a][0]) >= std::abs(real[b][1] - real[a][1]) ? 0 : 1;
+        if (real[b][c] >= real[a][c])
+          add_extent(corner[b][c], corner[a][c]);
+        else
+          add_extent(corner[a][c], corner[b][c]);
+      }
+    }
     // A boundary loop's extent: its width and height in (u, v) are kept at least one unit the same way, so that a
     // hole smaller than a square does not round to a point or to a slit one unit long (whose two sides would be
     // one quad edge: the quad mesh would close it). The loop is developed into the chart of its first edge's
@@ -905,7 +950,11 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
           pick = i, pick_coefficient = coefficient;
       }
       if (pick < 0) continue;
-      value[pick] += ((seg.real > 0 ? seg.least : -seg.least) - length) * pick_coefficient;  // the length becomes ±least
+      // The length becomes ±least; not when that moves the integer more than two units from its rounding (the
+      // segments disagree: a map folded at large, whose signs are no guide).
+      const double opened = value[pick] + ((seg.real > 0 ? seg.least : -seg.least) - length) * pick_coefficient;
+      if (std::abs(opened - std::round(y[pick])) > 2) continue;
+      value[pick] = opened;
       ++q.segments_opened;
       for (int other : segments_of[pick])
         if (other != k) queue.push_back(other);
@@ -1047,33 +1096,68 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       ++q.integers_descended;
     }
   }
+  // The free integers that move a singularity's point by a whole unit in u and in v (its handles, −1 for none):
+  // each coordinate's own integer, or for a singularity on an aligned line the line's across it (the move
+  // shifts the whole line) and its own along it, whichever the elimination kept; none for a coordinate that is
+  // a sum of several integers (a line's value through a cut's translation).
+  struct Handles {
+    int u = -1, v = -1;
+    Eigen::VectorXd gu, gv;  // the solution's response to a unit change of each (0 without a handle)
+    bool movable() const { return u >= 0 || v >= 0; }
+  };
+  auto cone_handles = [&](int k) {
+    Handles h;
+    for (int c = 0; c < 2; ++c) {
+      const Terms terms = elim.resolve(cone0 + 2 * k + c);
+      if (terms.size() == 1 && std::abs(std::abs(terms[0].second) - 1) < 1e-12) (c == 0 ? h.u : h.v) = free_index[terms[0].first];
+    }
+    if (h.v == h.u) h.v = -1;
+    return h;
+  };
+  // The responses (a solve each, with the current factorization): the solution is affine in the two values.
+  auto respond = [&](Handles& h) {
+    h.gu = h.u >= 0 ? response(h.u) : Eigen::VectorXd::Zero(nY);
+    h.gv = h.v >= 0 ? response(h.v) : Eigen::VectorXd::Zero(nY);
+  };
+  // The steps (dx, dy) a singularity's point may take: ±1 in each coordinate with a handle.
+  auto steps = [](const Handles& h) {
+    std::vector<std::pair<int, int>> out;
+    for (int dx = h.u >= 0 ? -1 : 0; dx <= (h.u >= 0 ? 1 : 0); ++dx)
+      for (int dy = h.v >= 0 ? -1 : 0; dy <= (h.v >= 0 ? 1 : 0); ++dy) out.emplace_back(dx, dy);
+    return out;
+  };
+  auto closes_step = [&](const Handles& h, int dx, int dy) { return h.u >= 0 ? closes_segment(h.u, dx, h.v, dy) : closes_segment(h.v, dy); };
+  auto take_step = [&](const Handles& h, int dx, int dy) {
+    if (h.u >= 0) value[h.u] += dx;
+    if (h.v >= 0) value[h.v] += dy;
+  };
   std::vector<char> tried(nCone, 0);
   // At most this many singularities tried (two solves each): on a map folded at large (far more singularities
   // than the target's squares can separate) the search would otherwise cost a solve pair per singularity.
   int searches_left = 64 + nV / 500;
   for (int k = 0; k < nCone && searches_left > 0; ++k) {
     const int v = out.cones[k];
-    if (tried[k] || !ring_is_bad(v) || elim.eliminated(cone0 + 2 * k) || elim.eliminated(cone0 + 2 * k + 1)) continue;
+    if (tried[k] || !ring_is_bad(v)) continue;
+    Handles h = cone_handles(k);
+    if (!h.movable()) continue;
     tried[k] = 1;
     --searches_left;
-    const int ju = free_index[cone0 + 2 * k], jv = free_index[cone0 + 2 * k + 1];
-    const double u0 = value[ju], v0 = value[jv];
     // The solution is affine in the two values: y + dx·g_u + dy·g_v, with g_j the response to a unit change of
     // fixed value j (two solves with the current factorization, instead of one per candidate).
-    const Eigen::VectorXd y0 = y, gu = response(ju), gv = response(jv);
-    const EnergyAlong energy = energy_along(y0, gu, gv);
+    respond(h);
+    const Eigen::VectorXd y0 = y;
+    const EnergyAlong energy = energy_along(y0, h.gu, h.gv);
     std::pair<int, double> best{std::numeric_limits<int>::max(), std::numeric_limits<double>::infinity()};
     Eigen::Vector2d step(0, 0);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy) {
-        if (closes_segment(ju, dx, jv, dy)) continue;
-        y = y0 + dx * gu + dy * gv;
-        corner_uv();
-        const std::pair<int, double> score{count_folds() + (ring_is_bad(v) ? 1 : 0), energy(dx, dy)};
-        if (score < best) best = score, step = Eigen::Vector2d(dx, dy);
-      }
-    y = y0 + step.x() * gu + step.y() * gv;
-    value[ju] = u0 + step.x(), value[jv] = v0 + step.y();
+    for (auto [dx, dy] : steps(h)) {
+      if (closes_step(h, dx, dy)) continue;
+      y = y0 + dx * h.gu + dy * h.gv;
+      corner_uv();
+      const std::pair<int, double> score{count_folds() + (ring_is_bad(v) ? 1 : 0), energy(dx, dy)};
+      if (score < best) best = score, step = Eigen::Vector2d(dx, dy);
+    }
+    y = y0 + step.x() * h.gu + step.y() * h.gv;
+    take_step(h, static_cast<int>(step.x()), static_cast<int>(step.y()));
     corner_uv();
     if (step.squaredNorm() > 0) ++q.cones_moved;
     k = -1;  // a move changes the others' rings: look again from the first untried one
@@ -1331,33 +1415,34 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       for (int v : ring)
         if (const int c = cone_of[v]; c >= 0 && !cone_tried[c]) near.push_back(c);
       for (int c : near) {
-        if (cone_tried[c] || elim.eliminated(cone0 + 2 * c) || elim.eliminated(cone0 + 2 * c + 1)) continue;  // its point is not free
+        if (cone_tried[c]) continue;
+        Handles h = cone_handles(c);
+        if (!h.movable()) continue;  // its point is not free
         cone_tried[c] = 1;
         check_cancelled();
-        const int ju = free_index[cone0 + 2 * c], jv = free_index[cone0 + 2 * c + 1];
-        const Eigen::VectorXd y0 = y, gu = response(ju), gv = response(jv);
-        const EnergyAlong energy = energy_along(y0, gu, gv);
+        respond(h);
+        const Eigen::VectorXd y0 = y;
+        const EnergyAlong energy = energy_along(y0, h.gu, h.gv);
         const Badness before = badness();
         std::vector<std::tuple<int, double, int, int>> order;
-        for (int dx = -1; dx <= 1; ++dx)
-          for (int dy = -1; dy <= 1; ++dy) {
-            if ((dx == 0 && dy == 0) || closes_segment(ju, dx, jv, dy)) continue;
-            y = y0 + dx * gu + dy * gv;
-            corner_uv();
-            order.emplace_back(count_folds(), energy(dx, dy), dx, dy);
-          }
+        for (auto [dx, dy] : steps(h)) {
+          if ((dx == 0 && dy == 0) || closes_step(h, dx, dy)) continue;
+          y = y0 + dx * h.gu + dy * h.gv;
+          corner_uv();
+          order.emplace_back(count_folds(), energy(dx, dy), dx, dy);
+        }
         std::sort(order.begin(), order.end());
         bool kept = false;
         for (size_t k = 0; k < std::min(candidates, order.size()) && !kept; ++k) {
           const auto [folds, e, dx, dy] = order[k];
-          y = y0 + dx * gu + dy * gv;
+          y = y0 + dx * h.gu + dy * h.gv;
           corner_uv();
           for (int rings : {4, 8}) {
             untangle_around({out.cones[c]}, rings, restart);
             if (!restart || badness().total() < before.total()) break;
           }
           if (badness().better_than(before)) {
-            value[ju] += dx, value[jv] += dy;
+            take_step(h, dx, dy);
             ++q.cones_moved;
             kept = true;
           }
