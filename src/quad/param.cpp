@@ -833,15 +833,21 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     };
     for (int f = 0; f < nF; ++f) {
       if (folded(f)) continue;  // the real-valued map's order of its corners is no guide there
-      std::array<std::array<std::map<int, double>, 2>, 3> corner;
       std::array<std::array<double, 2>, 3> real{};
       std::array<std::array<bool, 2>, 3> whole;
+      int whole_corners = 0;
       for (int k = 0; k < 3; ++k)
         for (int c = 0; c < 2; ++c) {
-          along_row(wedge[3 * f + k], c, corner[k][c], 1.0);
           whole[k][c] = true;
-          for (auto [j, coefficient] : corner[k][c]) whole[k][c] = whole[k][c] && is_integer[j], real[k][c] += coefficient * y[j];
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * wedge[3 * f + k] + c); it; ++it)
+            whole[k][c] = whole[k][c] && is_integer[it.col()], real[k][c] += it.value() * y[it.col()];
+          whole_corners += whole[k][c];
         }
+      if (whole_corners < 3) continue;  // most faces: no extent to keep
+      std::array<std::array<std::map<int, double>, 2>, 3> corner;
+      for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 2; ++c)
+          if (whole[k][c]) along_row(wedge[3 * f + k], c, corner[k][c], 1.0);
       for (int c = 0; c < 2; ++c) {
         if (!whole[0][c] || !whole[1][c] || !whole[2][c]) continue;
         int lo = 0, hi = 0;
