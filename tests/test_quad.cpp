@@ -586,6 +586,41 @@ TEST(Quad, CoinWallThinnerThanASquareKeepsAUnit) {
   EXPECT_EQ(c.euler(), 2);
 }
 
+// A line of aligned edges and a spur of one more leaving it at a narrow corner inside one triangle keep the same
+// coordinate constant there (the field runs along both within kAlignedEdgeTolerance): both edges lie on one
+// iso-line through their shared corner, so the triangle is a segment in (u, v) whatever the integers (3holes
+// with its sharp edges at 40° had one). The spur, whose far end is on no other aligned edge, is left free
+// (counted unaligned) and the triangle keeps its shape. A flat square, 12 × 12 cells, its boundary aligned (the
+// field runs along x); the line is the row y = 6, the spur the diagonal from (4, 6) to (5, 7) with (5, 7)
+// lowered to y = 6.3 (a corner of 16.7°).
+TEST(Quad, SpurAtANarrowCornerInOneTriangleIsLeftFree) {
+  const int n = 12, stride = n + 1;
+  std::vector<Eigen::Vector3d> points;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) points.emplace_back(double(x) / n, double(y) / n, 0);
+  points[7 * stride + 5].y() = 6.3 / n;
+  std::vector<Eigen::Vector3i> faces;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const int p = y * stride + x;
+      faces.emplace_back(p, p + 1, p + stride + 1);
+      faces.emplace_back(p, p + stride + 1, p + stride);
+    }
+  const Mesh m = mesh_of(points, faces);
+  const Topology t = build_topology(m.F, static_cast<int>(m.V.rows()));
+  ParamOptions o;
+  o.edge_length = 1.0 / 6;
+  for (int x = 0; x < n; ++x) o.aligned_edges.push_back(edge_between(t, 6 * stride + x, 6 * stride + x + 1));
+  const int spur = edge_between(t, 6 * stride + 4, 7 * stride + 5);
+  o.aligned_edges.push_back(spur);
+  const Pipeline r = run(m, aligned_boundary_auto(), o);
+  const ParamQuality& p = r.param.quality;
+  EXPECT_EQ(p.unaligned_edges, 1);
+  EXPECT_FALSE(std::binary_search(r.param.aligned_edges.begin(), r.param.aligned_edges.end(), spur));
+  ASSERT_EQ(p.flipped_faces + p.degenerate_faces, 0) << param_warning(r.param);
+  expect_clean(r, "square with a spur at a narrow corner");
+}
+
 // A sphere exported unwelded (unwelded_sphere): each pole a row of points at one place, the seam a boundary loop
 // along both its sides. The map puts each pole row on one integer point (docs/param.md), and the quad mesh has one
 // vertex there, not one per point of the row; the boundary's last direction at the seam's end beside a pole, whose

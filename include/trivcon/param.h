@@ -49,7 +49,8 @@ struct ParamOptions {
   double target_faces = 0;  // otherwise: about this many unit squares (edge_length = √(area / target_faces))
   // Edges to put on integer iso-lines (topology edge ids): boundary edges (align_boundary) and sharp edges.
   // An edge is aligned in each face beside it whose field runs along it or across it (within
-  // kAlignedEdgeTolerance); the others are counted in ParamQuality::unaligned_edges.
+  // kAlignedEdgeTolerance); the others are counted in ParamQuality::unaligned_edges, as is a spur that meets a
+  // line inside one triangle with the same coordinate constant (that triangle would be a segment; docs/param.md).
   std::vector<int> aligned_edges;
   // Greedy rounding: each round fixes the integers nearest to whole numbers, this fraction of those left (at
   // least one), then re-solves.

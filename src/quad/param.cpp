@@ -386,6 +386,55 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   }
   std::sort(out.aligned_edges.begin(), out.aligned_edges.end());
   out.aligned_edges.erase(std::unique(out.aligned_edges.begin(), out.aligned_edges.end()), out.aligned_edges.end());
+  // A face with two edges aligned with the same coordinate constant (two feature lines meeting at a narrow
+  // corner inside one triangle, where the field's sector there has no quarter turn) is a segment in (u, v)
+  // whatever the integers: both edges lie on one iso-line through the corner they share, and so does the third
+  // corner. Where one of the two edges is the only aligned edge at its other end (a feature line's loose end,
+  // as a short spur of sharp edges beside a longer line), it is left free (and counted unaligned), and that end
+  // leaves the iso-line so that the face keeps its shape; of two such edges the shorter. A boundary edge stays
+  // aligned (off its iso-line the quads' traces would leave the surface there).
+  {
+    std::vector<int> aligned_at(nV, 0);
+    for (int e : out.aligned_edges) ++aligned_at[t.edge_vertices(e, 0)], ++aligned_at[t.edge_vertices(e, 1)];
+    std::vector<char> freed(nE, 0);
+    std::vector<std::array<int, 2>> in_face(nF, {-1, -1});  // per face and coordinate: an aligned edge in it
+    // The length of e if freeing it opens the face (its end other than `shared` on no other aligned edge), else ∞.
+    auto worth_freeing = [&](int e, int shared) {
+      const int end = t.edge_vertices(e, 0) == shared ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+      if (t.is_boundary_edge(e) || aligned_at[end] != 1) return std::numeric_limits<double>::infinity();
+      return (V.row(t.edge_vertices(e, 0)) - V.row(t.edge_vertices(e, 1))).norm();
+    };
+    for (size_t i = 0; i < aligned.size(); ++i) {
+      const auto [e, g] = aligned[i];
+      // The edge's alignment holds in the chart of each face beside it that shares its ends' wedges.
+      for (int side = 0; side < 2; ++side) {
+        const int f = t.edge_faces(e, side);
+        if (f < 0 || (f != g && cut[e])) continue;
+        bool collapsed_face = false;  // a face with an edge of length 0 is a segment by construction (below)
+        for (int k = 0; k < 3; ++k) collapsed_face |= zero_length_edge(V, t, t.face_edges(f, k));
+        if (collapsed_face) continue;
+        int& other = in_face[f][aligned_coordinate[i]];
+        if (other < 0 || other == e) {
+          other = e;
+          continue;
+        }
+        int shared = -1;  // the corner the two edges share
+        for (int a = 0; a < 2; ++a)
+          for (int b = 0; b < 2; ++b)
+            if (t.edge_vertices(e, a) == t.edge_vertices(other, b)) shared = t.edge_vertices(e, a);
+        const double le = worth_freeing(e, shared), lo = worth_freeing(other, shared);
+        if (std::isfinite(le) || std::isfinite(lo)) freed[le <= lo ? e : other] = 1;
+      }
+    }
+    size_t kept = 0;
+    for (size_t i = 0; i < aligned.size(); ++i)
+      if (!freed[aligned[i].first]) aligned[kept] = aligned[i], aligned_coordinate[kept] = aligned_coordinate[i], ++kept;
+    aligned.resize(kept), aligned_coordinate.resize(kept);
+    for (int e : out.aligned_edges)
+      if (freed[e]) --q.aligned_edges, ++q.unaligned_edges;
+    out.aligned_edges.erase(std::remove_if(out.aligned_edges.begin(), out.aligned_edges.end(), [&](int e) { return freed[e] != 0; }),
+                            out.aligned_edges.end());
+  }
   // Turned boundary points: a boundary vertex whose two boundary edges are aligned with the same coordinate
   // constant while the boundary turns back on itself in (u, v) (the tip of a slit: a seam of patches left
   // unwelded, a crack). The aligned edges make only that coordinate whole; the other is free, yet the point is a
