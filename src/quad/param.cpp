@@ -833,6 +833,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     std::vector<std::pair<int, double>> terms;  // free unknown, coefficient: the (along) length
     double real = 0;                           // in the real-valued map
     double least = 1;                          // the fewest units it keeps
+    bool either_sign = false;                  // kept from 0 only, not from turning (a face's extent)
     std::vector<char> held;                    // per term: never the one changed to open it (empty: none held)
   };
   std::vector<Segment> segments;
@@ -844,9 +845,10 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         acc[static_cast<int>(it.col())] += sign * it.value();
     };
     // Kept when its terms are all integers and the real-valued map gives it a sign.
-    auto add_segment = [&](const std::map<int, double>& acc, double least, const std::set<int>& held = {}) {
+    auto add_segment = [&](const std::map<int, double>& acc, double least, const std::set<int>& held = {}, bool either_sign = false) {
       Segment seg;
       seg.least = least;
+      seg.either_sign = either_sign;
       for (auto [j, coefficient] : acc) {
         if (std::abs(coefficient) <= 1e-12) continue;
         if (!is_integer[j]) return;
@@ -868,9 +870,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     // A face whose three corners all sit on whole values of one coordinate (each on an aligned line, or a
     // singularity's point: the face between two feature lines less than a unit apart, or beside a singularity
     // next to one) would be degenerate were those values equal: its extent in that coordinate, from its least to
-    // its greatest corner in the real-valued map, keeps a unit. Likewise an edge whose two ends are both integer
-    // points (a singularity beside a corner of the feature lines) would have length 0: its extent in the
-    // coordinate where the real-valued map has it longer keeps a unit. Each such pair of lines or points once.
+    // its greatest corner in the real-valued map, is kept from 0 (either sign: the corners may swap, as long as
+    // they do not meet). Each such pair of lines or points once.
     std::set<std::vector<std::pair<int, double>>> extents;
     auto add_extent = [&](const std::map<int, double>& to, const std::map<int, double>& from) {
       std::map<int, double> extent = to;
@@ -878,7 +879,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       std::vector<std::pair<int, double>> key;
       for (auto [j, coefficient] : extent)
         if (std::abs(coefficient) > 1e-12) key.emplace_back(j, coefficient);
-      if (!key.empty() && extents.insert(key).second) add_segment(extent, 1);
+      if (!key.empty() && extents.insert(key).second) add_segment(extent, 1, {}, true);
     };
     for (int f = 0; f < nF; ++f) {
       if (folded(f)) continue;  // the real-valued map's order of its corners is no guide there
@@ -905,15 +906,6 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
           if (real[k][c] > real[hi][c]) hi = k;
         }
         add_extent(corner[hi][c], corner[lo][c]);
-      }
-      for (int k = 0; k < 3; ++k) {
-        const int a = k, b = (k + 1) % 3;
-        if (!whole[a][0] || !whole[a][1] || !whole[b][0] || !whole[b][1]) continue;
-        const int c = std::abs(real[b][0] - real[a][0]) >= std::abs(real[b][1] - real[a][1]) ? 0 : 1;
-        if (real[b][c] >= real[a][c])
-          add_extent(corner[b][c], corner[a][c]);
-        else
-          add_extent(corner[a][c], corner[b][c]);
       }
     }
     // A boundary loop's extent: its width and height in (u, v) are kept at least one unit the same way, so that a
@@ -995,7 +987,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       double length = 0;
       bool whole = true;
       for (auto [i, coefficient] : seg.terms) whole &= fixed[i] != 0, length += coefficient * value[i];
-      if (!whole || (seg.real > 0 ? length : -length) > seg.least - 0.5) continue;  // in the real map's sense
+      if (!whole || (seg.either_sign ? std::abs(length) : seg.real > 0 ? length : -length) > seg.least - 0.5) continue;  // in the real map's sense
       int pick = -1;
       double pick_coefficient = 0;
       for (size_t m = 0; m < seg.terms.size(); ++m) {
@@ -1027,6 +1019,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         after += coefficient * (value[i] + (i == j1 ? d1 : 0.0) + (i == j2 ? d2 : 0.0));
       }
       const double sign = seg.real > 0 ? 1.0 : -1.0;
+      if (seg.either_sign) return std::abs(before) > seg.least - 0.5 && !(std::abs(after) > seg.least - 0.5);
       return sign * before > seg.least - 0.5 && !(sign * after > seg.least - 0.5);
     };
     for (int k : segments_of[j1])
