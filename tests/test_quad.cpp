@@ -565,8 +565,8 @@ TEST(Quad, MapCheckSeesABoundaryRingThatWindsWrong) {
 
 // A coin: a capped cylinder of radius 1 whose wall (one face tall, its rims sharp) is a quarter of a unit high at
 // 100 squares. The singularities move onto the rims; the wall's faces then have every corner on a rim's iso-line
-// or on a singularity's point, and each such face's extent is kept a unit. Without that, the rounding left the
-// map's mean singular-value ratio at 1.85.
+// or on a singularity's point, and each such face's extent is kept from 0 (a unit when a round makes it 0).
+// Without that, the rounding left the map's mean singular-value ratio at 1.85.
 TEST(Quad, CoinWallThinnerThanASquareKeepsAUnit) {
   const Mesh m = make_capped_cylinder(8, 48, 1, 0.06);
   FieldRequest req;
