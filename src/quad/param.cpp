@@ -393,6 +393,11 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // as a short spur of sharp edges beside a longer line), it is left free (and counted unaligned), and that end
   // leaves the iso-line so that the face keeps its shape; of two such edges the shorter. A boundary edge stays
   // aligned (off its iso-line the quads' traces would leave the surface there).
+  // A face with two corners at one point of the surface (an edge of length 0) has no shape to keep: with that
+  // edge aligned (above) it maps to a segment, of area 0 by construction.
+  std::vector<char> collapsed(nF, 0);
+  for (int f = 0; f < nF; ++f)
+    for (int k = 0; k < 3; ++k) collapsed[f] |= zero_length_edge(V, t, t.face_edges(f, k));
   {
     std::vector<int> aligned_at(nV, 0);
     for (int e : out.aligned_edges) ++aligned_at[t.edge_vertices(e, 0)], ++aligned_at[t.edge_vertices(e, 1)];
@@ -409,10 +414,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       // The edge's alignment holds in the chart of each face beside it that shares its ends' wedges.
       for (int side = 0; side < 2; ++side) {
         const int f = t.edge_faces(e, side);
-        if (f < 0 || (f != g && cut[e])) continue;
-        bool collapsed_face = false;  // a face with an edge of length 0 is a segment by construction (below)
-        for (int k = 0; k < 3; ++k) collapsed_face |= zero_length_edge(V, t, t.face_edges(f, k));
-        if (collapsed_face) continue;
+        if (f < 0 || (f != g && cut[e]) || collapsed[f]) continue;
         int& other = in_face[f][aligned_coordinate[i]];
         if (other < 0 || other == e) {
           other = e;
@@ -668,11 +670,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   auto uv_area = [&](int f) {
     return signed_area(out.uv.row(3 * f).transpose(), out.uv.row(3 * f + 1).transpose(), out.uv.row(3 * f + 2).transpose());
   };
-  // A face with two corners at one point of the surface (an edge of length 0) has no shape to keep: with that
-  // edge aligned (above) it maps to a segment, of area 0 by construction. Not a fold unless turned over.
-  std::vector<char> collapsed(nF, 0);
-  for (int f = 0; f < nF; ++f)
-    for (int k = 0; k < 3; ++k) collapsed[f] |= zero_length_edge(V, t, t.face_edges(f, k));
+  // (A face with two corners at one point of the surface, `collapsed` above, maps to a segment by construction:
+  // not a fold unless turned over.)
   auto folded = [&](int f) {
     const double a = uv_area(f), tolerance = 1e-12 * face_area[f] * s * s;
     return !(a > tolerance) && !(collapsed[f] && !(a < -tolerance));
