@@ -586,6 +586,49 @@ TEST(Quad, CoinWallThinnerThanASquareKeepsAUnit) {
   EXPECT_EQ(c.euler(), 2);
 }
 
+// Two singularities on one feature line less than a unit apart, with no point between them whole along the line:
+// the rounding put both on one integer and the faces along the line between them folded (on a plate with 27
+// holes, the −1/4 moved onto its outer rim, 9 flipped faces). The line's length between them keeps its sign and a
+// unit. An L-shaped sheet, its crease sharp and its boundary aligned, a unit 5 cells: a +1/4 and a −1/4 on the
+// crease 2 cells apart (0.4 of a unit). Without it, the local search after the rounding pulled them apart
+// again, but the map's mean singular-value ratio was 2.66.
+TEST(Quad, SingularitiesOnOneFeatureLineCloserThanAUnitKeepOne) {
+  const int n = 30, stride = n + 1, crease = n / 2;
+  std::vector<Eigen::Vector3d> points;
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x)
+      points.emplace_back(double(x) / n, double(std::min(y, crease)) / n, double(std::max(y - crease, 0)) / n);
+  std::vector<Eigen::Vector3i> faces;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const int p = y * stride + x;
+      faces.emplace_back(p, p + 1, p + stride + 1);
+      faces.emplace_back(p, p + stride + 1, p + stride);
+    }
+  const Mesh m = mesh_of(points, faces);
+  FieldRequest req;
+  req.align_boundary = true;
+  req.feature_degrees = 30;
+  const std::array<int, 2> cones{crease * stride + 14, crease * stride + 16};
+  req.prescription.vertex[cones[0]] = 1;
+  req.prescription.vertex[cones[1]] = -1;
+  ParamOptions o;
+  o.edge_length = 1.0 / 6;
+  const Pipeline r = run(m, req, o, true);
+  ASSERT_TRUE(r.outcome.verified);
+  const ParamQuality& p = r.param.quality;
+  ASSERT_EQ(p.flipped_faces + p.degenerate_faces + p.winding_errors, 0) << param_warning(r.param);
+  EXPECT_EQ(p.unaligned_edges, 0);
+  EXPECT_GE(p.segments_opened, 1);
+  EXPECT_LE(p.mean_distortion, 1.8);
+  expect_clean(r, "L-shaped sheet with two singularities on its crease");
+  // Each singularity its own quad vertex (not one point for both).
+  std::map<int, int> at_cone;
+  for (int v = 0; v < static_cast<int>(r.quads.vertex_cone.size()); ++v)
+    if (req.prescription.vertex.count(r.quads.vertex_cone[v])) ++at_cone[r.quads.vertex_cone[v]];
+  EXPECT_EQ(at_cone, (std::map<int, int>{{cones[0], 1}, {cones[1], 1}}));
+}
+
 // A line of aligned edges and a spur of one more leaving it at a narrow corner inside one triangle keep the same
 // coordinate constant there (the field runs along both within kAlignedEdgeTolerance): both edges lie on one
 // iso-line through their shared corner, so the triangle is a segment in (u, v) whatever the integers (3holes

@@ -83,7 +83,8 @@ struct ParamQuality {
   int cones_moved = 0;        // singularities moved to a neighbouring integer point against a fold or a shared point
   int integers_moved = 0;     // other integers (iso-lines, translations) moved by ±1 against a fold
   int integers_descended = 0; // integers moved by whole units to lower energy after the rounding (docs/param.md)
-  int segments_opened = 0;    // aligned edges between two integer points the rounding would have collapsed
+  int segments_opened = 0;    // lengths between integer points (aligned edges and chains of them, loop and face
+                              // extents) the rounding would have collapsed, kept a unit (docs/param.md)
   int untangled_faces = 0;    // folded or degenerate faces opened by the local untangling (docs/param.md)
   int untangling_regions = 0; // regions untangled (each kept only when the map had fewer folds after it)
   int rewound_regions = 0;    // of those, regions untangled again from their least squares against a wrong winding

@@ -866,6 +866,59 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       along_row(wedge_at(f, t.edge_vertices(e, 1)), 1 - c, along, 1.0);
       add_segment(along, 1);
     }
+    // The same along a chain of aligned edges between two such points with points between that are not whole
+    // along it (two singularities moved onto one feature line a unit or so apart, a singularity and a corner): the
+    // chain's length along keeps its sign and a unit, or the rounding puts both ends on one integer and the faces
+    // along the chain fold. The chain is followed within one chart (each point between two of its edges in one
+    // wedge, the same coordinate constant), where the lengths of its edges add up to its ends' difference; a
+    // point where more than one aligned edge goes on ends it unkept.
+    {
+      auto whole_along = [&](int w, int c) {
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * w + c); it; ++it)
+          if (!is_integer[it.col()]) return false;
+        return true;
+      };
+      std::vector<std::vector<int>> entries_at(nV);
+      for (int i = 0; i < nAligned; ++i)
+        for (int end = 0; end < 2; ++end) entries_at[t.edge_vertices(aligned[i].first, end)].push_back(i);
+      std::set<std::vector<std::pair<int, double>>> chains;
+      for (int i = 0; i < nAligned; ++i)
+        for (int end = 0; end < 2; ++end) {
+          const int c = aligned_coordinate[i];
+          const int a = t.edge_vertices(aligned[i].first, end);
+          const int wa = wedge_at(aligned[i].second, a);
+          if (!whole_along(wa, 1 - c)) continue;
+          int at = i, from = a;
+          for (int steps = 0; steps < nV; ++steps) {
+            const auto [e, f] = aligned[at];
+            const int to = t.edge_vertices(e, 0) == from ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+            const int w = wedge_at(f, to);
+            if (whole_along(w, 1 - c)) {
+              if (steps == 0 || to == a) break;  // one edge: its own segment above
+              std::map<int, double> along;
+              along_row(wa, 1 - c, along, -1.0);
+              along_row(w, 1 - c, along, 1.0);
+              std::vector<std::pair<int, double>> key;
+              for (auto [j, coefficient] : along)
+                if (std::abs(coefficient) > 1e-12) key.emplace_back(j, coefficient);
+              if (!key.empty() && key.front().second < 0)
+                for (auto& term : key) term.second = -term.second;
+              if (!key.empty() && chains.insert(key).second) add_segment(along, 1);
+              break;
+            }
+            int next = -1;
+            bool unique = true;
+            for (int j : entries_at[to]) {
+              const int other = aligned[j].first;
+              if (other == e || aligned_coordinate[j] != c || wedge_at(aligned[j].second, to) != w) continue;
+              if (next >= 0 && aligned[next].first != other) unique = false;
+              next = j;
+            }
+            if (next < 0 || !unique) break;
+            at = next, from = to;
+          }
+        }
+    }
     // A face whose three corners all sit on whole values of one coordinate (each on an aligned line, or a
     // singularity's point: the face between two feature lines less than a unit apart, or beside a singularity
     // next to one) would be degenerate were those values equal: its extent in that coordinate, from its least to
