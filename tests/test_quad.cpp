@@ -458,6 +458,19 @@ Mesh mesh_of(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen
   return m;
 }
 
+// The (n + 1)² points (row y, column x at y (n + 1) + x) as a grid of n × n cells, each cut along its diagonal.
+Mesh grid_of(int n, const std::vector<Eigen::Vector3d>& points) {
+  const int stride = n + 1;
+  std::vector<Eigen::Vector3i> faces;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const int p = y * stride + x;
+      faces.emplace_back(p, p + 1, p + stride + 1);
+      faces.emplace_back(p, p + stride + 1, p + stride);
+    }
+  return mesh_of(points, faces);
+}
+
 // The unit square, n × n cells (two triangles each), with a slit along x = 1/2 from the bottom side up to
 // y = tip / n: the points on the slit below its tip are doubled, the cells left of it using one copy and those right of
 // it the other (a seam of two patches left unwelded, as in the Utah teapot's file).
@@ -598,14 +611,7 @@ TEST(Quad, SingularitiesOnOneFeatureLineCloserThanAUnitKeepOne) {
   for (int y = 0; y <= n; ++y)
     for (int x = 0; x <= n; ++x)
       points.emplace_back(double(x) / n, double(std::min(y, crease)) / n, double(std::max(y - crease, 0)) / n);
-  std::vector<Eigen::Vector3i> faces;
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) {
-      const int p = y * stride + x;
-      faces.emplace_back(p, p + 1, p + stride + 1);
-      faces.emplace_back(p, p + stride + 1, p + stride);
-    }
-  const Mesh m = mesh_of(points, faces);
+  const Mesh m = grid_of(n, points);
   FieldRequest req;
   req.align_boundary = true;
   req.feature_degrees = 30;
@@ -642,14 +648,7 @@ TEST(Quad, SpurAtANarrowCornerInOneTriangleIsLeftFree) {
   for (int y = 0; y <= n; ++y)
     for (int x = 0; x <= n; ++x) points.emplace_back(double(x) / n, double(y) / n, 0);
   points[7 * stride + 5].y() = 6.3 / n;
-  std::vector<Eigen::Vector3i> faces;
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x) {
-      const int p = y * stride + x;
-      faces.emplace_back(p, p + 1, p + stride + 1);
-      faces.emplace_back(p, p + stride + 1, p + stride);
-    }
-  const Mesh m = mesh_of(points, faces);
+  const Mesh m = grid_of(n, points);
   const Topology t = build_topology(m.F, static_cast<int>(m.V.rows()));
   ParamOptions o;
   o.edge_length = 1.0 / 6;
