@@ -858,6 +858,13 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       for (auto [j, coefficient] : seg.terms) segments_of[j].push_back(static_cast<int>(segments.size()));
       segments.push_back(std::move(seg));
     };
+    // A length's nonzero terms: the key under which the chains and the face extents are each listed once.
+    auto terms_of = [](const std::map<int, double>& acc) {
+      std::vector<std::pair<int, double>> key;
+      for (auto [j, coefficient] : acc)
+        if (std::abs(coefficient) > 1e-12) key.emplace_back(j, coefficient);
+      return key;
+    };
     for (int i = 0; i < nAligned; ++i) {
       const auto [e, f] = aligned[i];
       const int c = aligned_coordinate[i];
@@ -898,9 +905,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
               std::map<int, double> along;
               along_row(wa, 1 - c, along, -1.0);
               along_row(w, 1 - c, along, 1.0);
-              std::vector<std::pair<int, double>> key;
-              for (auto [j, coefficient] : along)
-                if (std::abs(coefficient) > 1e-12) key.emplace_back(j, coefficient);
+              std::vector<std::pair<int, double>> key = terms_of(along);
               if (!key.empty() && key.front().second < 0)
                 for (auto& term : key) term.second = -term.second;
               if (!key.empty() && chains.insert(key).second) add_segment(along, 1);
@@ -928,9 +933,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     auto add_extent = [&](const std::map<int, double>& to, const std::map<int, double>& from) {
       std::map<int, double> extent = to;
       for (auto [j, coefficient] : from) extent[j] -= coefficient;
-      std::vector<std::pair<int, double>> key;
-      for (auto [j, coefficient] : extent)
-        if (std::abs(coefficient) > 1e-12) key.emplace_back(j, coefficient);
+      const std::vector<std::pair<int, double>> key = terms_of(extent);
       if (!key.empty() && extents.insert(key).second) add_segment(extent, 1, {}, true);
     };
     for (int f = 0; f < nF; ++f) {
