@@ -188,6 +188,7 @@ nlohmann::ordered_json quad_report(const QuadMesh& quads) {
             {"abandoned_traces", q.abandoned_traces},
             {"unmatched_traces", q.unmatched_traces},
             {"non_quad_faces", q.non_quad_faces},
+            {"filled_faces", q.filled_faces},
             {"open_faces", q.open_faces},
             {"unused_vertices", q.unused_vertices},
             {"unclosed_vertices", q.unclosed_vertices},

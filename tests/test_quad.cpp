@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <functional>
 #include <cmath>
@@ -19,6 +20,7 @@
 #include "trivcon/param.h"
 #include "trivcon/quad.h"
 #include "trivcon/request.h"
+#include "quad/fill.h"
 #include "quad/relax.h"
 #include "support.h"
 
@@ -844,6 +846,56 @@ TEST(Quad, FoldsAreReportedNotHidden) {
   const QuadMesh g = extract_quads(*r.designer, garbage);
   EXPECT_FALSE(g.quality.problems.empty());
   EXPECT_GT(g.quality.dropped_points + g.quality.failed_traces + g.quality.unmatched_traces, 0);
+}
+
+// The fill (src/quad/fill.h): the four quads around a vertex taken out leave an octagon, as the traces that
+// fail around a fold leave larger faces; it is filled with four quads around one new vertex on the surface, whose
+// spokes go to the corners that lost theirs (every valence right again), also when a spur (an edge into the
+// face and back, to a vertex in no other face) is in the walk.
+TEST(Quad, FacesLeftByFailedTracesAreFilledWithQuads) {
+  const Mesh m = make_torus(48, 16);
+  ParamOptions o;
+  o.target_faces = 300;
+  const Pipeline r = run(m, {}, o);
+  ASSERT_TRUE(r.quads.quality.problems.empty()) << quad_warning(r.quads);
+  const int x = r.quads.Q(0, 0);
+  for (bool spur : {false, true}) {
+    QuadMesh q = r.quads;
+    std::vector<int> gone;
+    std::map<int, std::array<int, 2>> path;  // a → (b, c) of each quad (x, a, b, c) around x
+    for (int i = 0; i < q.Q.rows(); ++i)
+      for (int k = 0; k < 4; ++k)
+        if (q.Q(i, k) == x) gone.push_back(i), path[q.Q(i, (k + 1) % 4)] = {q.Q(i, (k + 2) % 4), q.Q(i, (k + 3) % 4)};
+    ASSERT_EQ(gone.size(), 4u);
+    std::vector<int> octagon;
+    for (int a = path.begin()->first; octagon.size() < 8; a = path.at(a)[1]) octagon.push_back(a), octagon.push_back(path.at(a)[0]);
+    ASSERT_EQ(octagon.front(), path.begin()->first);
+    if (spur) octagon.insert(octagon.begin() + 1, {x, octagon[0]});
+    Eigen::MatrixX4i kept(q.Q.rows() - 4, 4);
+    for (int i = 0, j = 0; i < q.Q.rows(); ++i)
+      if (std::find(gone.begin(), gone.end(), i) == gone.end()) kept.row(j++) = q.Q.row(i);
+    q.Q = kept;
+    q.other_faces = {octagon};
+    const Eigen::Vector3d was = r.quads.V.row(x).transpose();
+    ASSERT_EQ(quad::fill_faces(*r.designer, r.param, q), 1) << (spur ? "spur" : "octagon");
+    EXPECT_TRUE(q.other_faces.empty());
+    // x was in no face: it is gone, the new vertex last.
+    EXPECT_EQ(q.V.rows(), r.quads.V.rows());
+    EXPECT_EQ(q.Q.rows(), r.quads.Q.rows());
+    EXPECT_LT((q.V.row(q.V.rows() - 1).transpose() - was).norm(), 0.1 * (r.quads.V.row(octagon[0]) - r.quads.V.row(x)).norm());
+    const MatrixX3d& V = r.designer->V();
+    const MatrixX3i& F = r.designer->topology().F;
+    for (int i = 0; i < q.V.rows(); ++i) {
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) p += q.vertex_barycentric(i, k) * V.row(F(q.vertex_face[i], k)).transpose();
+      EXPECT_LT((p - q.V.row(i).transpose()).norm(), 1e-9) << "vertex " << i;
+    }
+    check_quads(*r.designer, r.param, q);
+    EXPECT_TRUE(q.quality.problems.empty()) << quad_warning(q);
+    EXPECT_EQ(q.quality.irregular_vertices, 0);
+    EXPECT_EQ(q.quality.euler_characteristic, 0);
+    EXPECT_GT(q.quality.min_scaled_jacobian, 0.5);
+  }
 }
 
 // check_quads on its own: a quad mesh with one quad removed has a hole the input does not have.

@@ -19,7 +19,8 @@
 // - Edges: the traces that come back (from p to q, and from q to p); a trace that fails or ends elsewhere is no
 //   edge. Quads: Q's rows are counter-clockwise seen from the side Topology::F's faces are oriented to (the
 //   input's orientation where the topology did not re-orient it). Faces of that graph that are not quads are
-//   not in Q: they are listed in other_faces and reported.
+//   filled with quads around a new vertex where they have an even number of sides (QuadOptions::fill_faces;
+//   such a vertex has vertex_cone −1); the others are not in Q: they are listed in other_faces. Both reported.
 // - Boundary: quad edges along the input's boundary exist only where the boundary lies on integer iso-lines
 //   (ParamOptions::aligned_edges holding the boundary edges); elsewhere traces leave the surface and are
 //   reported.
@@ -39,6 +40,10 @@ struct QuadOptions {
   // Move the vertices of inverted or nearly inverted quads on the surface (docs/quad.md, "Relaxation"): quads
   // whose worst corner's sine about the surface's normal is below this; 0 or less: no relaxation.
   double relax_below = 0.2;
+  // Fill the faces of the traced graph that are not quads and have an even number of sides (around the map's
+  // folds) with quads around one new vertex each (docs/quad.md, "Faces", Filling): the mesh is then all quads
+  // where it can be, and the valences there, which are not the map's, are reported by the check.
+  bool fill_faces = true;
 };
 
 struct QuadQuality {
@@ -55,6 +60,7 @@ struct QuadQuality {
   int unclosed_vertices = 0;       // input vertices whose (u, v) does not come back to itself around its fan
   int map_folds = 0;               // the map's flipped and degenerate faces (ParamQuality), for the warning
   int relaxed_vertices = 0;        // vertices moved on the surface to undo inverted or nearly inverted quads
+  int filled_faces = 0;            // of the non-quad faces: filled with quads around a new vertex (QuadOptions::fill_faces)
   std::vector<int> problem_faces;  // up to 10 input faces where points were dropped or traces failed
   // Of the quad mesh (check_quads).
   int quads = 0, vertices = 0, edges = 0, boundary_loops = 0, components = 0, euler_characteristic = 0;
@@ -88,8 +94,8 @@ struct QuadMesh {
   Eigen::VectorXi vertex_face;         // face of Topology::F each vertex lies in
   Eigen::MatrixXd vertex_barycentric;  // V × 3: its barycentric coordinates there (Topology::F's corner order)
   Eigen::VectorXi vertex_cone;         // the input vertex it sits on (a cone, or any vertex on an integer point), else −1
-  // Faces of the traced graph that are not quads (vertex ids, counter-clockwise). On a closed surface Q and these
-  // run each side of every edge once, also where the map folds (where faces are often not quads).
+  // Faces of the traced graph that are not quads and were not filled (vertex ids, counter-clockwise). On a closed
+  // surface Q and these run each side of every edge once, also where the map folds (where faces are often not quads).
   std::vector<std::vector<int>> other_faces;
   QuadQuality quality;
 };

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "linalg/timing.h"
+#include "quad/fill.h"
 #include "quad/relax.h"
 #include "trivcon/error.h"
 
@@ -872,6 +873,16 @@ QuadMesh Extractor::run() {
 QuadMesh extract_quads(const FieldDesigner& designer, const Parametrization& param, const QuadOptions& options) {
   Extractor extractor(designer, param, options);
   QuadMesh out = extractor.run();
+  if (options.fill_faces && !out.other_faces.empty()) {
+    const auto t0 = linalg::Clock::now();
+    const int filled = quad::fill_faces(designer, param, out);
+    out.quality.filled_faces = filled;
+    if (filled > 0)
+      for (std::string& s : out.quality.problems)
+        if (s.find(" faces of the traced graph are not quads") != std::string::npos)
+          s += ": " + std::to_string(filled) + " of them filled with quads around one new vertex each";
+    out.quality.seconds_extract += linalg::seconds_since(t0);
+  }
   if (options.relax_below > 0) {
     const auto t0 = linalg::Clock::now();
     out.quality.relaxed_vertices = quad::relax_quads(designer, param, out, options.relax_below);

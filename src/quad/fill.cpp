@@ -1,0 +1,163 @@
+// SPDX-License-Identifier: MIT
+#include "quad/fill.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <limits>
+#include <map>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "quad/surface_grid.h"
+
+namespace trivcon::quad {
+
+int fill_faces(const FieldDesigner& designer, const Parametrization& param, QuadMesh& quads) {
+  if (quads.other_faces.empty()) return 0;
+  const Topology& t = designer.topology();
+  const MatrixX3d& Vin = designer.V();
+  const int nV = static_cast<int>(quads.V.rows());
+  if (quads.vertex_face.size() != nV || quads.vertex_barycentric.rows() != nV || quads.vertex_cone.size() != nV) return 0;
+  // Each vertex's neighbours in the traced graph (quads and other faces), and the valence it should have.
+  std::vector<std::set<int>> neighbours(nV);
+  auto add_face = [&](const int* ids, size_t k) {
+    for (size_t j = 0; j < k; ++j) {
+      const int a = ids[j], b = ids[(j + 1) % k];
+      neighbours[a].insert(b), neighbours[b].insert(a);
+    }
+  };
+  for (int i = 0; i < quads.Q.rows(); ++i) {
+    const int ids[4] = {quads.Q(i, 0), quads.Q(i, 1), quads.Q(i, 2), quads.Q(i, 3)};
+    add_face(ids, 4);
+  }
+  for (const auto& face : quads.other_faces) add_face(face.data(), face.size());
+  std::map<int, int> cone_index;
+  for (size_t i = 0; i < param.cones.size() && i < param.cone_index.size(); ++i) cone_index[param.cones[i]] = param.cone_index[i];
+  auto wanted = [&](int v) {
+    const int c = quads.vertex_cone[v];
+    const auto it = c >= 0 ? cone_index.find(c) : cone_index.end();
+    return 4 - (it == cone_index.end() ? 0 : it->second);
+  };
+  // The worst corner of a quad: the sine of its angle about the quad's normal (the diagonals' cross product).
+  auto worst_corner = [](const std::array<Eigen::Vector3d, 4>& p) {
+    const Eigen::Vector3d n = (p[2] - p[0]).cross(p[3] - p[1]);
+    if (!(n.norm() > 0)) return -1.0;
+    double worst = 1;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d a = p[(k + 1) % 4] - p[k], b = p[(k + 3) % 4] - p[k];
+      const double lengths = a.norm() * b.norm();
+      worst = std::min(worst, lengths > 0 ? a.cross(b).dot(n.normalized()) / lengths : -1.0);
+    }
+    return worst;
+  };
+
+  SurfaceGrid grid(Vin, t.F, 1000LL * (static_cast<long long>(quads.other_faces.size()) + t.num_faces) + 10000000);
+  std::vector<std::vector<int>> kept;
+  std::vector<std::array<int, 4>> added;
+  std::vector<Eigen::Vector3d> points, barycentric;
+  std::vector<int> faces;
+  int filled = 0;
+  for (std::vector<int> face : quads.other_faces) {
+    // A trace that ended nowhere can leave an edge into the face and back (… a, b, a …): that spur goes.
+    for (bool spur = true; spur && face.size() >= 3;) {
+      spur = false;
+      const size_t n = face.size();
+      for (size_t j = 0; j < n && !spur; ++j)
+        if (face[j] == face[(j + 2) % n]) {
+          const size_t tip = (j + 1) % n, back = (j + 2) % n;
+          neighbours[face[j]].erase(face[tip]), neighbours[face[tip]].erase(face[j]);
+          std::vector<int> rest;
+          for (size_t i = 0; i < n; ++i)
+            if (i != tip && i != back) rest.push_back(face[i]);
+          face = std::move(rest);
+          spur = true;
+        }
+    }
+    const int k = static_cast<int>(face.size());
+    const bool simple = std::set<int>(face.begin(), face.end()).size() == face.size();
+    if (k < 6 || k % 2 != 0 || !simple) {
+      kept.push_back(face);
+      continue;
+    }
+    // The new vertex: the surface's point nearest the corners' mean, on the component of the first corner (no
+    // further from the mean than the nearest corner, which lies on the surface).
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int v : face) mean += quads.V.row(v).transpose();
+    mean /= k;
+    double limit = std::numeric_limits<double>::infinity();
+    for (int v : face) limit = std::min(limit, (quads.V.row(v).transpose() - mean).norm());
+    const int component = t.face_component[quads.vertex_face[face[0]]];
+    const int found = grid.nearest(mean, limit, component, t.face_component).first;
+    if (found < 0) {
+      kept.push_back(face);
+      continue;
+    }
+    Eigen::Vector3d bary;
+    const Eigen::Vector3d c = closest_on_triangle(mean, Vin.row(t.F(found, 0)), Vin.row(t.F(found, 1)), Vin.row(t.F(found, 2)), &bary);
+    int best_parity = 0, best_valences = -1;
+    double best_corner = -std::numeric_limits<double>::infinity();
+    for (int parity = 0; parity < 2; ++parity) {
+      int valences = 0;
+      double corner = 1;
+      for (int j = 0; j < k; ++j) {
+        const int v = face[j];
+        valences += static_cast<int>(neighbours[v].size()) + ((j - parity) % 2 == 0 ? 1 : 0) == wanted(v);
+      }
+      for (int j = parity; j < k; j += 2)
+        corner = std::min(corner, worst_corner({c, quads.V.row(face[j]).transpose(), quads.V.row(face[(j + 1) % k]).transpose(),
+                                                quads.V.row(face[(j + 2) % k]).transpose()}));
+      if (valences > best_valences || (valences == best_valences && corner > best_corner))
+        best_parity = parity, best_valences = valences, best_corner = corner;
+    }
+    const int id = nV + static_cast<int>(points.size());
+    points.push_back(c), barycentric.push_back(bary), faces.push_back(found);
+    for (int j = best_parity; j < k; j += 2) added.push_back({id, face[j], face[(j + 1) % k], face[(j + 2) % k]});
+    ++filled;
+  }
+  if (filled == 0) return 0;
+  const int nAdd = static_cast<int>(points.size()), nQ = static_cast<int>(quads.Q.rows());
+  quads.V.conservativeResize(nV + nAdd, 3);
+  quads.vertex_face.conservativeResize(nV + nAdd);
+  quads.vertex_barycentric.conservativeResize(nV + nAdd, 3);
+  quads.vertex_cone.conservativeResize(nV + nAdd);
+  for (int i = 0; i < nAdd; ++i) {
+    quads.V.row(nV + i) = points[i].transpose();
+    quads.vertex_face[nV + i] = faces[i];
+    quads.vertex_barycentric.row(nV + i) = barycentric[i].transpose();
+    quads.vertex_cone[nV + i] = -1;
+  }
+  quads.Q.conservativeResize(nQ + static_cast<int>(added.size()), 4);
+  for (size_t i = 0; i < added.size(); ++i) quads.Q.row(nQ + static_cast<int>(i)) << added[i][0], added[i][1], added[i][2], added[i][3];
+  quads.other_faces = std::move(kept);
+  // The tips of the spurs taken out may be in no face now: they go, and the rest are numbered anew in order.
+  std::vector<int> index(quads.V.rows(), -1);
+  for (int i = 0; i < quads.Q.rows(); ++i)
+    for (int k = 0; k < 4; ++k) index[quads.Q(i, k)] = 0;
+  for (const auto& face : quads.other_faces)
+    for (int v : face) index[v] = 0;
+  int used = 0;
+  for (int& i : index)
+    if (i == 0) i = used++;
+  if (used < quads.V.rows()) {
+    for (int v = 0; v < static_cast<int>(index.size()); ++v)
+      if (index[v] >= 0) {
+        quads.V.row(index[v]) = quads.V.row(v);
+        quads.vertex_face[index[v]] = quads.vertex_face[v];
+        quads.vertex_barycentric.row(index[v]) = quads.vertex_barycentric.row(v);
+        quads.vertex_cone[index[v]] = quads.vertex_cone[v];
+      }
+    quads.V.conservativeResize(used, 3);
+    quads.vertex_face.conservativeResize(used);
+    quads.vertex_barycentric.conservativeResize(used, 3);
+    quads.vertex_cone.conservativeResize(used);
+    for (int i = 0; i < quads.Q.rows(); ++i)
+      for (int k = 0; k < 4; ++k) quads.Q(i, k) = index[quads.Q(i, k)];
+    for (auto& face : quads.other_faces)
+      for (int& v : face) v = index[v];
+  }
+  return filled;
+}
+
+}  // namespace trivcon::quad
