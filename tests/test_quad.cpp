@@ -851,7 +851,8 @@ TEST(Quad, FoldsAreReportedNotHidden) {
 // The fill (src/quad/fill.h): the four quads around a vertex taken out leave an octagon, as the traces that
 // fail around a fold leave larger faces; it is filled with four quads around one new vertex on the surface, whose
 // spokes go to the corners that lost theirs (every valence right again), also when a spur (an edge into the
-// face and back, to a vertex in no other face) is in the walk.
+// face and back, to a vertex in no other face) is in the walk, and when the octagon is two faces of 5 and 7
+// sides split by a path through the old vertex (merged, the path's rest a spur).
 TEST(Quad, FacesLeftByFailedTracesAreFilledWithQuads) {
   const Mesh m = make_torus(48, 16);
   ParamOptions o;
@@ -859,7 +860,7 @@ TEST(Quad, FacesLeftByFailedTracesAreFilledWithQuads) {
   const Pipeline r = run(m, {}, o);
   ASSERT_TRUE(r.quads.quality.problems.empty()) << quad_warning(r.quads);
   const int x = r.quads.Q(0, 0);
-  for (bool spur : {false, true}) {
+  for (std::string shape : {"octagon", "spur", "odd pair"}) {
     QuadMesh q = r.quads;
     std::vector<int> gone;
     std::map<int, std::array<int, 2>> path;  // a → (b, c) of each quad (x, a, b, c) around x
@@ -870,14 +871,18 @@ TEST(Quad, FacesLeftByFailedTracesAreFilledWithQuads) {
     std::vector<int> octagon;
     for (int a = path.begin()->first; octagon.size() < 8; a = path.at(a)[1]) octagon.push_back(a), octagon.push_back(path.at(a)[0]);
     ASSERT_EQ(octagon.front(), path.begin()->first);
-    if (spur) octagon.insert(octagon.begin() + 1, {x, octagon[0]});
     Eigen::MatrixX4i kept(q.Q.rows() - 4, 4);
     for (int i = 0, j = 0; i < q.Q.rows(); ++i)
       if (std::find(gone.begin(), gone.end(), i) == gone.end()) kept.row(j++) = q.Q.row(i);
     q.Q = kept;
     q.other_faces = {octagon};
+    if (shape == "spur") q.other_faces[0].insert(q.other_faces[0].begin() + 1, {x, octagon[0]});
+    if (shape == "odd pair")  // octagon[0] a neighbour of x, octagon[3] a diagonal one
+      q.other_faces = {{octagon[0], octagon[1], octagon[2], octagon[3], x},
+                       {octagon[3], octagon[4], octagon[5], octagon[6], octagon[7], octagon[0], x}};
     const Eigen::Vector3d was = r.quads.V.row(x).transpose();
-    ASSERT_EQ(quad::fill_faces(*r.designer, r.param, q), 1) << (spur ? "spur" : "octagon");
+    ASSERT_EQ(quad::fill_faces(*r.designer, r.param, q), 1) << shape;
+    SCOPED_TRACE(shape);
     EXPECT_TRUE(q.other_faces.empty());
     // x was in no face: it is gone, the new vertex last.
     EXPECT_EQ(q.V.rows(), r.quads.V.rows());

@@ -59,8 +59,10 @@ int fill_faces(const FieldDesigner& designer, const Parametrization& param, Quad
   std::vector<Eigen::Vector3d> points, barycentric;
   std::vector<int> faces;
   int filled = 0;
-  for (std::vector<int> face : quads.other_faces) {
-    // A trace that ended nowhere can leave an edge into the face and back (… a, b, a …): that spur goes.
+  // A trace that ended nowhere can leave an edge into a face and back (… a, b, a …): such spurs go. Returns the
+  // edges taken out of `neighbours`.
+  auto strip_spurs = [&](std::vector<int>& face) {
+    std::vector<std::pair<int, int>> out;
     for (bool spur = true; spur && face.size() >= 3;) {
       spur = false;
       const size_t n = face.size();
@@ -68,6 +70,7 @@ int fill_faces(const FieldDesigner& designer, const Parametrization& param, Quad
         if (face[j] == face[(j + 2) % n]) {
           const size_t tip = (j + 1) % n, back = (j + 2) % n;
           neighbours[face[j]].erase(face[tip]), neighbours[face[tip]].erase(face[j]);
+          out.emplace_back(face[j], face[tip]);
           std::vector<int> rest;
           for (size_t i = 0; i < n; ++i)
             if (i != tip && i != back) rest.push_back(face[i]);
@@ -75,9 +78,52 @@ int fill_faces(const FieldDesigner& designer, const Parametrization& param, Quad
           spur = true;
         }
     }
+    return out;
+  };
+  std::vector<std::vector<int>> walks = quads.other_faces;
+  for (std::vector<int>& face : walks) strip_spurs(face);
+  auto is_simple = [](const std::vector<int>& face) { return std::set<int>(face.begin(), face.end()).size() == face.size(); };
+  // Two faces with an odd number of sides and an edge in common become one with an even number without it (and
+  // without the spurs that leaves), when that one has no repeated vertex (the first such edge of each, in order).
+  {
+    std::map<std::pair<int, int>, int> side;  // (a, b) → the odd face running a → b
+    for (size_t i = 0; i < walks.size(); ++i)
+      if (walks[i].size() % 2 == 1 && is_simple(walks[i]))
+        for (size_t j = 0; j < walks[i].size(); ++j) side[{walks[i][j], walks[i][(j + 1) % walks[i].size()]}] = static_cast<int>(i);
+    std::vector<char> merged(walks.size(), 0);
+    for (size_t i = 0; i < walks.size(); ++i) {
+      const std::vector<int>& a = walks[i];
+      if (merged[i] || a.size() % 2 == 0 || !is_simple(a)) continue;
+      for (size_t j = 0; j < a.size(); ++j) {
+        const int u = a[j], v = a[(j + 1) % a.size()];
+        const auto it = side.find({v, u});
+        if (it == side.end() || it->second == static_cast<int>(i) || merged[it->second] || walks[it->second].size() % 2 == 0) continue;
+        const std::vector<int>& b = walks[it->second];
+        // a from v round to u, then b from after u round to before v.
+        std::vector<int> both;
+        for (size_t m = 0; m < a.size(); ++m) both.push_back(a[(j + 1 + m) % a.size()]);
+        const size_t at = std::find(b.begin(), b.end(), u) - b.begin();
+        for (size_t m = 1; m + 1 < b.size(); ++m) both.push_back(b[(at + m) % b.size()]);
+        // (Where the two share a path of several edges, the rest of it is a spur now.)
+        const std::vector<std::pair<int, int>> taken = strip_spurs(both);
+        if (!is_simple(both) || both.size() % 2 != 0) {
+          for (auto [p, q] : taken) neighbours[p].insert(q), neighbours[q].insert(p);
+          continue;
+        }
+        neighbours[u].erase(v), neighbours[v].erase(u);
+        merged[it->second] = 1;
+        walks[i] = std::move(both);
+        break;
+      }
+    }
+    std::vector<std::vector<int>> left;
+    for (size_t i = 0; i < walks.size(); ++i)
+      if (!merged[i]) left.push_back(std::move(walks[i]));
+    walks = std::move(left);
+  }
+  for (const std::vector<int>& face : walks) {
     const int k = static_cast<int>(face.size());
-    const bool simple = std::set<int>(face.begin(), face.end()).size() == face.size();
-    if (k < 6 || k % 2 != 0 || !simple) {
+    if (k < 6 || k % 2 != 0 || !is_simple(face)) {
       kept.push_back(face);
       continue;
     }
