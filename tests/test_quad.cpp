@@ -147,6 +147,17 @@ double farthest_vertex(const Pipeline& r) {
   return worst;
 }
 
+// Each quad vertex is where its face and barycentric coordinates say.
+void expect_located(const FieldDesigner& designer, const QuadMesh& q) {
+  const MatrixX3d& V = designer.V();
+  const MatrixX3i& F = designer.topology().F;
+  for (int i = 0; i < q.V.rows(); ++i) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) p += q.vertex_barycentric(i, k) * V.row(F(q.vertex_face[i], k)).transpose();
+    EXPECT_LT((p - q.V.row(i).transpose()).norm(), 1e-9) << "vertex " << i;
+  }
+}
+
 // Quads whose normal points away from the input's outward normal at the nearest input face to their centre.
 int inverted(const Pipeline& r) {
   const MatrixX3d& V = r.designer->V();
@@ -888,13 +899,7 @@ TEST(Quad, FacesLeftByFailedTracesAreFilledWithQuads) {
     EXPECT_EQ(q.V.rows(), r.quads.V.rows());
     EXPECT_EQ(q.Q.rows(), r.quads.Q.rows());
     EXPECT_LT((q.V.row(q.V.rows() - 1).transpose() - was).norm(), 0.1 * (r.quads.V.row(octagon[0]) - r.quads.V.row(x)).norm());
-    const MatrixX3d& V = r.designer->V();
-    const MatrixX3i& F = r.designer->topology().F;
-    for (int i = 0; i < q.V.rows(); ++i) {
-      Eigen::Vector3d p = Eigen::Vector3d::Zero();
-      for (int k = 0; k < 3; ++k) p += q.vertex_barycentric(i, k) * V.row(F(q.vertex_face[i], k)).transpose();
-      EXPECT_LT((p - q.V.row(i).transpose()).norm(), 1e-9) << "vertex " << i;
-    }
+    expect_located(*r.designer, q);
     check_quads(*r.designer, r.param, q);
     EXPECT_TRUE(q.quality.problems.empty()) << quad_warning(q);
     EXPECT_EQ(q.quality.irregular_vertices, 0);
@@ -955,14 +960,7 @@ TEST(Quad, RelaxationUndoesAnInvertedQuad) {
   EXPECT_EQ(inverted(r), 0);
   EXPECT_TRUE(q.Q == Q);
   EXPECT_LT(farthest_vertex(r), 1e-9);
-  // Each vertex is where its face and barycentric coordinates say.
-  const MatrixX3d& V = r.designer->V();
-  const MatrixX3i& F = r.designer->topology().F;
-  for (int i = 0; i < q.V.rows(); ++i) {
-    Eigen::Vector3d p = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) p += q.vertex_barycentric(i, k) * V.row(F(q.vertex_face[i], k)).transpose();
-    EXPECT_LT((p - q.V.row(i).transpose()).norm(), 1e-9) << "vertex " << i;
-  }
+  expect_located(*r.designer, q);
   q.quality = {};
   check_quads(*r.designer, r.param, q);
   EXPECT_TRUE(q.quality.problems.empty()) << quad_warning(q);
