@@ -908,6 +908,41 @@ TEST(Quad, FacesLeftByFailedTracesAreFilledWithQuads) {
   }
 }
 
+// A hexagon (two quads beside each other taken out) is split by the diagonal that was their common edge: the two
+// quads come back, no vertex is added, every valence is right.
+TEST(Quad, HexagonIsSplitByADiagonal) {
+  const Mesh m = make_torus(48, 16);
+  ParamOptions o;
+  o.target_faces = 300;
+  const Pipeline r = run(m, {}, o);
+  ASSERT_TRUE(r.quads.quality.problems.empty()) << quad_warning(r.quads);
+  QuadMesh q = r.quads;
+  const int a = q.Q(0, 1), b = q.Q(0, 2);  // quad 0's edge a → b; the quad across it runs b → a
+  int other = -1, at = -1;
+  for (int i = 1; i < q.Q.rows() && other < 0; ++i)
+    for (int k = 0; k < 4; ++k)
+      if (q.Q(i, k) == b && q.Q(i, (k + 1) % 4) == a) other = i, at = k;
+  ASSERT_GE(other, 0);
+  // Quad 0 from b round to a, then the other from after a round to before b.
+  const std::vector<int> hexagon{b, q.Q(0, 3), q.Q(0, 0), a, q.Q(other, (at + 2) % 4), q.Q(other, (at + 3) % 4)};
+  Eigen::MatrixX4i kept(q.Q.rows() - 2, 4);
+  for (int i = 0, j = 0; i < q.Q.rows(); ++i)
+    if (i != 0 && i != other) kept.row(j++) = q.Q.row(i);
+  q.Q = kept;
+  q.other_faces = {hexagon};
+  ASSERT_EQ(quad::fill_faces(*r.designer, r.param, q), 1);
+  EXPECT_TRUE(q.other_faces.empty());
+  EXPECT_EQ(q.V.rows(), r.quads.V.rows());
+  EXPECT_EQ(q.Q.rows(), r.quads.Q.rows());
+  bool rejoined = false;
+  for (int i = 0; i < q.Q.rows(); ++i)
+    for (int k = 0; k < 4; ++k) rejoined = rejoined || (q.Q(i, k) == a && q.Q(i, (k + 3) % 4) == b) || (q.Q(i, k) == b && q.Q(i, (k + 3) % 4) == a);
+  EXPECT_TRUE(rejoined);
+  check_quads(*r.designer, r.param, q);
+  EXPECT_TRUE(q.quality.problems.empty()) << quad_warning(q);
+  EXPECT_EQ(q.quality.irregular_vertices, 0);
+}
+
 // check_quads on its own: a quad mesh with one quad removed has a hole the input does not have.
 TEST(Quad, CheckFindsAHole) {
   const Mesh m = make_torus(48, 16);

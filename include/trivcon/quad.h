@@ -41,8 +41,9 @@ struct QuadOptions {
   // whose worst corner's sine about the surface's normal is below this; 0 or less: no relaxation.
   double relax_below = 0.2;
   // Fill the faces of the traced graph that are not quads and have an even number of sides (around the map's
-  // folds) with quads around one new vertex each (docs/quad.md, "Faces", Filling): the mesh is then all quads
-  // where it can be, and the valences there, which are not the map's, are reported by the check.
+  // folds) with quads around one new vertex each, or a hexagon with a diagonal (docs/quad.md, "Faces",
+  // Filling): the mesh is then all quads where it can be, and the valences there, which are not the map's, are
+  // reported by the check.
   bool fill_faces = true;
 };
 

@@ -880,7 +880,7 @@ QuadMesh extract_quads(const FieldDesigner& designer, const Parametrization& par
     if (filled > 0)
       for (std::string& s : out.quality.problems)
         if (s.find(" faces of the traced graph are not quads") != std::string::npos)
-          s += ": " + std::to_string(filled) + " of them filled with quads around one new vertex each";
+          s += ": " + std::to_string(filled) + " of them filled with quads (docs/quad.md, \"Faces\")";
     out.quality.seconds_extract += linalg::seconds_since(t0);
   }
   if (options.relax_below > 0) {

@@ -80,6 +80,9 @@ int fill_faces(const FieldDesigner& designer, const Parametrization& param, Quad
     }
     return out;
   };
+  // A vertex's valence: its neighbours, and the spokes of the fans filled so far.
+  std::vector<int> spokes(nV, 0);
+  auto valence = [&](int v) { return static_cast<int>(neighbours[v].size()) + spokes[v]; };
   std::vector<std::vector<int>> walks = quads.other_faces;
   for (std::vector<int>& face : walks) strip_spurs(face);
   auto is_simple = [](const std::vector<int>& face) { return std::set<int>(face.begin(), face.end()).size() == face.size(); };
@@ -149,7 +152,7 @@ int fill_faces(const FieldDesigner& designer, const Parametrization& param, Quad
       double corner = 1;
       for (int j = 0; j < k; ++j) {
         const int v = face[j];
-        valences += static_cast<int>(neighbours[v].size()) + ((j - parity) % 2 == 0 ? 1 : 0) == wanted(v);
+        valences += valence(v) + ((j - parity) % 2 == 0 ? 1 : 0) == wanted(v);
       }
       for (int j = parity; j < k; j += 2)
         corner = std::min(corner, worst_corner({c, quads.V.row(face[j]).transpose(), quads.V.row(face[(j + 1) % k]).transpose(),
@@ -157,9 +160,33 @@ int fill_faces(const FieldDesigner& designer, const Parametrization& param, Quad
       if (valences > best_valences || (valences == best_valences && corner > best_corner))
         best_parity = parity, best_valences = valences, best_corner = corner;
     }
-    const int id = nV + static_cast<int>(points.size());
-    points.push_back(c), barycentric.push_back(bary), faces.push_back(found);
-    for (int j = best_parity; j < k; j += 2) added.push_back({id, face[j], face[(j + 1) % k], face[(j + 2) % k]});
+    // A hexagon may instead be two quads split by a diagonal v_i v_{i+3} (no new vertex, whose valence 3 would
+    // not be the map's): taken when it leaves fewer corners with the wrong valence than the fan leaves vertices,
+    // or as many and a better worst corner; never along an edge that exists already.
+    int best_diagonal = -1;
+    if (k == 6) {
+      int fewest = k - best_valences + 1;  // the fan's: its corners and its new vertex
+      double corner_then = best_corner;
+      for (int i = 0; i < 3; ++i) {
+        const int a = face[i], b = face[i + 3];
+        if (neighbours[a].count(b)) continue;
+        int wrong = 0;
+        for (int j = 0; j < k; ++j) wrong += valence(face[j]) + (j == i || j == i + 3 ? 1 : 0) != wanted(face[j]);
+        auto at = [&](int j) { return Eigen::Vector3d(quads.V.row(face[(i + j) % k]).transpose()); };
+        const double corner = std::min(worst_corner({at(0), at(1), at(2), at(3)}), worst_corner({at(3), at(4), at(5), at(0)}));
+        if (wrong < fewest || (wrong == fewest && corner > corner_then)) fewest = wrong, corner_then = corner, best_diagonal = i;
+      }
+    }
+    if (best_diagonal >= 0) {
+      const int i = best_diagonal;
+      added.push_back({face[i], face[i + 1], face[i + 2], face[i + 3]});
+      added.push_back({face[i + 3], face[(i + 4) % k], face[(i + 5) % k], face[i]});
+      neighbours[face[i]].insert(face[i + 3]), neighbours[face[i + 3]].insert(face[i]);
+    } else {
+      const int id = nV + static_cast<int>(points.size());
+      points.push_back(c), barycentric.push_back(bary), faces.push_back(found);
+      for (int j = best_parity; j < k; j += 2) added.push_back({id, face[j], face[(j + 1) % k], face[(j + 2) % k]}), ++spokes[face[j]];
+    }
     ++filled;
   }
   if (filled == 0) return 0;

@@ -8,10 +8,12 @@
 // point nearest the mean of its corners, and the m quads (c, v_j, v_{j+1}, v_{j+2}) for j = p, p + 2, …: c has
 // valence m (4 for an octagon), and every second corner one edge more. Of the two choices of p, the one giving
 // more corners their valence (4 − n at a cone of index n/4, 4 elsewhere) is taken, then the one whose worst new
-// corner (the sine of its angle about the quad's normal) is larger. Faces with an odd number of sides, a repeated
-// vertex, or no surface point found stay in other_faces; vertices left in no face go. The quad mesh stays closed
-// where it was (the faces replaced are disks of the traced graph), with χ unchanged; the valences the fill gives
-// are not the map's, and check_quads reports them.
+// corner (the sine of its angle about the quad's normal) is larger. A hexagon is split by a diagonal instead
+// (two quads, no new vertex) when that leaves fewer vertices with the wrong valence, or as many and a better
+// worst corner. Faces with an odd number of sides, a repeated vertex, or no surface point found stay in
+// other_faces; vertices left in no face go. The quad mesh stays closed where it was (the faces replaced are disks
+// of the traced graph), with χ unchanged; the valences the fill gives are not the map's, and check_quads reports
+// them.
 #pragma once
 #include "trivcon/design.h"
 #include "trivcon/quad.h"
