@@ -49,6 +49,21 @@ Pipeline run(const Mesh& m, FieldRequest r, ParamOptions o, bool align_sharp = f
   return out;
 }
 
+// The 48 × 16 torus's map at 300 squares and its quads (a regular grid): the start of the tests that break one.
+Pipeline torus_grid() {
+  ParamOptions o;
+  o.target_faces = 300;
+  return run(make_torus(48, 16), {}, o);
+}
+
+// Q without the rows in `gone`.
+Eigen::MatrixX4i without_quads(const Eigen::MatrixX4i& Q, const std::vector<int>& gone) {
+  Eigen::MatrixX4i kept(Q.rows() - static_cast<Eigen::Index>(gone.size()), 4);
+  for (int i = 0, j = 0; i < Q.rows(); ++i)
+    if (std::find(gone.begin(), gone.end(), i) == gone.end()) kept.row(j++) = Q.row(i);
+  return kept;
+}
+
 // What (V, Q) say on their own.
 struct Counts {
   int vertices = 0, edges = 0, faces = 0, boundary_loops = 0;
@@ -389,10 +404,7 @@ TEST(Quad, CubeSphereWithItsCornersPrescribed) {
 }
 
 TEST(Quad, TorusIsARegularGrid) {
-  const Mesh m = make_torus(48, 16);
-  ParamOptions o;
-  o.target_faces = 300;
-  const Pipeline r = run(m, {}, o);
+  const Pipeline r = torus_grid();
   ASSERT_TRUE(r.param.cones.empty());
   expect_clean(r, "torus");
   const Counts c = count(r.quads.V, r.quads.Q);
@@ -803,10 +815,7 @@ TEST(Quad, SeveralComponents) {
 
 // A map with folds: the extraction ends, and says what failed instead of hiding it.
 TEST(Quad, FoldsAreReportedNotHidden) {
-  const Mesh m = make_torus(48, 16);
-  ParamOptions o;
-  o.target_faces = 300;
-  Pipeline r = run(m, {}, o);
+  Pipeline r = torus_grid();
   // Push one vertex's (u, v) (every corner of it alike, so the map stays seamless off the cut) far over its ring.
   const Topology& t = r.designer->topology();
   for (int v : {100, 400}) {
@@ -865,10 +874,7 @@ TEST(Quad, FoldsAreReportedNotHidden) {
 // face and back, to a vertex in no other face) is in the walk, and when the octagon is two faces of 5 and 7
 // sides split by a path through the old vertex (merged, the path's rest a spur).
 TEST(Quad, FacesLeftByFailedTracesAreFilledWithQuads) {
-  const Mesh m = make_torus(48, 16);
-  ParamOptions o;
-  o.target_faces = 300;
-  const Pipeline r = run(m, {}, o);
+  const Pipeline r = torus_grid();
   ASSERT_TRUE(r.quads.quality.problems.empty()) << quad_warning(r.quads);
   const int x = r.quads.Q(0, 0);
   for (std::string shape : {"octagon", "spur", "odd pair"}) {
@@ -882,10 +888,7 @@ TEST(Quad, FacesLeftByFailedTracesAreFilledWithQuads) {
     std::vector<int> octagon;
     for (int a = path.begin()->first; octagon.size() < 8; a = path.at(a)[1]) octagon.push_back(a), octagon.push_back(path.at(a)[0]);
     ASSERT_EQ(octagon.front(), path.begin()->first);
-    Eigen::MatrixX4i kept(q.Q.rows() - 4, 4);
-    for (int i = 0, j = 0; i < q.Q.rows(); ++i)
-      if (std::find(gone.begin(), gone.end(), i) == gone.end()) kept.row(j++) = q.Q.row(i);
-    q.Q = kept;
+    q.Q = without_quads(q.Q, gone);
     q.other_faces = {octagon};
     if (shape == "spur") q.other_faces[0].insert(q.other_faces[0].begin() + 1, {x, octagon[0]});
     if (shape == "odd pair")  // octagon[0] a neighbour of x, octagon[3] a diagonal one
@@ -911,10 +914,7 @@ TEST(Quad, FacesLeftByFailedTracesAreFilledWithQuads) {
 // A hexagon (two quads beside each other taken out) is split by the diagonal that was their common edge: the two
 // quads come back, no vertex is added, every valence is right.
 TEST(Quad, HexagonIsSplitByADiagonal) {
-  const Mesh m = make_torus(48, 16);
-  ParamOptions o;
-  o.target_faces = 300;
-  const Pipeline r = run(m, {}, o);
+  const Pipeline r = torus_grid();
   ASSERT_TRUE(r.quads.quality.problems.empty()) << quad_warning(r.quads);
   QuadMesh q = r.quads;
   const int a = q.Q(0, 1), b = q.Q(0, 2);  // quad 0's edge a → b; the quad across it runs b → a
@@ -925,10 +925,7 @@ TEST(Quad, HexagonIsSplitByADiagonal) {
   ASSERT_GE(other, 0);
   // Quad 0 from b round to a, then the other from after a round to before b.
   const std::vector<int> hexagon{b, q.Q(0, 3), q.Q(0, 0), a, q.Q(other, (at + 2) % 4), q.Q(other, (at + 3) % 4)};
-  Eigen::MatrixX4i kept(q.Q.rows() - 2, 4);
-  for (int i = 0, j = 0; i < q.Q.rows(); ++i)
-    if (i != 0 && i != other) kept.row(j++) = q.Q.row(i);
-  q.Q = kept;
+  q.Q = without_quads(q.Q, {0, other});
   q.other_faces = {hexagon};
   ASSERT_EQ(quad::fill_faces(*r.designer, r.param, q), 1);
   EXPECT_TRUE(q.other_faces.empty());
@@ -945,10 +942,7 @@ TEST(Quad, HexagonIsSplitByADiagonal) {
 
 // check_quads on its own: a quad mesh with one quad removed has a hole the input does not have.
 TEST(Quad, CheckFindsAHole) {
-  const Mesh m = make_torus(48, 16);
-  ParamOptions o;
-  o.target_faces = 300;
-  const Pipeline r = run(m, {}, o);
+  const Pipeline r = torus_grid();
   QuadMesh q = r.quads;
   ASSERT_TRUE(q.quality.problems.empty()) << quad_warning(q);
   q.Q = q.Q.topRows(q.Q.rows() - 1).eval();
@@ -973,10 +967,7 @@ TEST(Quad, CheckFindsAHole) {
 // turned over; relaxing moves it back out, on the surface, without touching the connectivity or the others'
 // places more than around it.
 TEST(Quad, RelaxationUndoesAnInvertedQuad) {
-  const Mesh m = make_torus(48, 16);
-  ParamOptions o;
-  o.target_faces = 300;
-  Pipeline r = run(m, {}, o);
+  Pipeline r = torus_grid();
   ASSERT_TRUE(r.quads.quality.problems.empty()) << quad_warning(r.quads);
   ASSERT_EQ(inverted(r), 0);
   QuadMesh& q = r.quads;
