@@ -106,7 +106,7 @@ struct State {
 class Extractor {
  public:
   Extractor(const FieldDesigner& designer, const Parametrization& param, const QuadOptions& options)
-      : t_(designer.topology()), V_(designer.V()), param_(param), options_(options) {}
+      : designer_(designer), t_(designer.topology()), V_(designer.V()), param_(param), options_(options) {}
 
   QuadMesh run();
 
@@ -158,6 +158,7 @@ class Extractor {
   }
   Eigen::Vector3d barycentric(const Node& n, int& face) const;
 
+  const FieldDesigner& designer_;
   const Topology& t_;
   const MatrixX3d& V_;
   const Parametrization& param_;
@@ -826,6 +827,8 @@ QuadMesh Extractor::run() {
     }
   }
   q_.non_quad_faces = static_cast<int>(out.other_faces.size());
+  const size_t first_sides = out.other_faces.empty() ? 0 : out.other_faces.front().size();
+  if (options_.fill_faces && !out.other_faces.empty()) q_.filled_faces = quad::fill_faces(designer_, param_, out);
   q_.target_quads = param_.quality.target_squares;
   q_.map_folds = param_.quality.flipped_faces + param_.quality.degenerate_faces;
 
@@ -860,7 +863,8 @@ QuadMesh Extractor::run() {
   if (q_.open_faces > 0) say(std::to_string(q_.open_faces) + " walks around faces of the traced graph did not close");
   if (q_.non_quad_faces > 0) {
     std::ostringstream s;
-    s << q_.non_quad_faces << " faces of the traced graph are not quads (first with " << out.other_faces.front().size() << " sides)";
+    s << q_.non_quad_faces << " faces of the traced graph are not quads (first with " << first_sides << " sides)";
+    if (q_.filled_faces > 0) s << ": " << q_.filled_faces << " of them filled with quads (docs/quad.md, \"Faces\")";
     say(s.str());
   }
   q_.seconds_extract = linalg::seconds_since(t0);
@@ -873,16 +877,6 @@ QuadMesh Extractor::run() {
 QuadMesh extract_quads(const FieldDesigner& designer, const Parametrization& param, const QuadOptions& options) {
   Extractor extractor(designer, param, options);
   QuadMesh out = extractor.run();
-  if (options.fill_faces && !out.other_faces.empty()) {
-    const auto t0 = linalg::Clock::now();
-    const int filled = quad::fill_faces(designer, param, out);
-    out.quality.filled_faces = filled;
-    if (filled > 0)
-      for (std::string& s : out.quality.problems)
-        if (s.find(" faces of the traced graph are not quads") != std::string::npos)
-          s += ": " + std::to_string(filled) + " of them filled with quads (docs/quad.md, \"Faces\")";
-    out.quality.seconds_extract += linalg::seconds_since(t0);
-  }
   if (options.relax_below > 0) {
     const auto t0 = linalg::Clock::now();
     out.quality.relaxed_vertices = quad::relax_quads(designer, param, out, options.relax_below);

@@ -4,12 +4,14 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <map>
 #include <set>
 #include <utility>
 #include <vector>
 
+#include "quad/quad_shape.h"
 #include "quad/surface_grid.h"
 
 namespace trivcon::quad {
@@ -40,16 +42,12 @@ int fill_faces(const FieldDesigner& designer, const Parametrization& param, Quad
     const auto it = c >= 0 ? cone_index.find(c) : cone_index.end();
     return 4 - (it == cone_index.end() ? 0 : it->second);
   };
-  // The worst corner of a quad: the sine of its angle about the quad's normal (the diagonals' cross product).
+  // The worst corner of a quad: the sine of its angle about the quad's own normal.
   auto worst_corner = [](const std::array<Eigen::Vector3d, 4>& p) {
-    const Eigen::Vector3d n = (p[2] - p[0]).cross(p[3] - p[1]);
+    const Eigen::Vector3d n = quad_normal(p);
     if (!(n.norm() > 0)) return -1.0;
     double worst = 1;
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d a = p[(k + 1) % 4] - p[k], b = p[(k + 3) % 4] - p[k];
-      const double lengths = a.norm() * b.norm();
-      worst = std::min(worst, lengths > 0 ? a.cross(b).dot(n.normalized()) / lengths : -1.0);
-    }
+    for (int k = 0; k < 4; ++k) worst = std::min(worst, corner_sine(p, k, n.normalized()));
     return worst;
   };
 

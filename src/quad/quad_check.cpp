@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "linalg/timing.h"
+#include "quad/quad_shape.h"
 #include "quad/surface_grid.h"
 #include "trivcon/error.h"
 #include "trivcon/quad.h"
@@ -30,6 +31,8 @@ void unite(std::vector<int>& parent, int a, int b) {
 
 }  // namespace
 
+using quad::corner_sine;
+using quad::quad_normal;
 using quad::SurfaceGrid;
 
 void check_quads(const FieldDesigner& designer, const Parametrization& param, QuadMesh& quads) {
@@ -188,7 +191,7 @@ void check_quads(const FieldDesigner& designer, const Parametrization& param, Qu
     double to_corner = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 4; ++k) to_corner = std::min(to_corner, (centre - p[k]).norm());
     const auto [face, distance] = grid.nearest(centre, to_corner, component, t.face_component);
-    const Eigen::Vector3d own = (p[2] - p[0]).cross(p[3] - p[1]);
+    const Eigen::Vector3d own = quad_normal(p);
     if (face < 0) {
       ++unmeasured;
     } else {
@@ -203,9 +206,7 @@ void check_quads(const FieldDesigner& designer, const Parametrization& param, Qu
     const Eigen::Vector3d unit_own = own.norm() > 0 ? Eigen::Vector3d(own.normalized()) : own;
     double worst = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d a = p[(k + 1) % 4] - p[k], b = p[(k + 3) % 4] - p[k];
-      const double lengths = a.norm() * b.norm();
-      const double sj = lengths > 0 ? a.cross(b).dot(unit_own) / lengths : -1;
+      const double sj = corner_sine(p, k, unit_own);
       worst = std::min(worst, sj);
       sum_sj += sj;
     }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include "quad/quad_shape.h"
 #include "quad/surface_grid.h"
 
 namespace trivcon::quad {
@@ -90,7 +91,7 @@ int relax_quads(const FieldDesigner& designer, const Parametrization& param, Qua
       x[k] = v == moved ? p : Eigen::Vector3d(quads.V.row(v).transpose());
       centre += x[k] / 4;
     }
-    const Eigen::Vector3d own = (x[2] - x[0]).cross(x[3] - x[1]);
+    const Eigen::Vector3d own = quad_normal(x);
     if (!(own.norm() > 0)) return -1.0;
     const Eigen::Vector3d n = own.normalized();
     double to_corner = std::numeric_limits<double>::infinity();
@@ -101,11 +102,7 @@ int relax_quads(const FieldDesigner& designer, const Parametrization& param, Qua
     const double facing = normal.row(nearest >= 0 ? nearest : f0).dot(n);
     if (!(facing > 0)) return facing - 2;  // inverted: worse than any quad that is not
     double worst = facing;
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d a = x[(k + 1) % 4] - x[k], b = x[(k + 3) % 4] - x[k];
-      const double lengths = a.norm() * b.norm();
-      worst = std::min(worst, lengths > 0 ? a.cross(b).dot(n) / lengths : -1.0);
-    }
+    for (int k = 0; k < 4; ++k) worst = std::min(worst, corner_sine(x, k, n));
     return worst;
   };
   // Of the quads around v with v at (p, face): the worst corner, and Σ (threshold − worst)² over the quads below
