@@ -556,68 +556,117 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     hat_gradients(layout(V, t, f, eps), grad[f], face_area[f]);
   }
   // The least squares' matrix H over the wedges' (u, v) and its right-hand side r are linear in the faces'
-  // weights (the stiffening changes only those): made once as Hw (H's stored entries × faces) and rw (wedge
-  // unknowns × faces), then H's values = Hw · weight and r = s · rw · (weight ∘ size), and K = Pᵀ H P, b = Pᵀ r.
+  // weights (the stiffening changes only those): each face's terms are made once, 9 of H (corner i, corner j:
+  // A ∇φ_i·∇φ_j, the same for u and v, at H_entry[18 f + 2 (3 i + j) + c]) and 6 of r (corner i: A ∇φ_i·X for
+  // u, A ∇φ_i·Y for v); then H = Σ_f weight_f H_f, r = s Σ_f weight_f size_f r_f, K = Pᵀ H P, b = Pᵀ r.
   std::vector<double> weight(nF, 1.0);
   std::vector<double> size(nF, 1.0);  // the target's size per face (the sizing below): s·size·(X Y)ᵀ
-  Eigen::SparseMatrix<double> H, Hw, rw, K;
+  Eigen::SparseMatrix<double> H(nX, nX), K;
   Eigen::VectorXd b;
+  std::vector<int> H_entry(18 * static_cast<size_t>(nF)), H_column;
+  std::vector<double> H_term(9 * static_cast<size_t>(nF)), r_term(6 * static_cast<size_t>(nF));
   {
-    std::vector<Eigen::Triplet<double>> ht, hwt, rt;
-    ht.reserve(18 * static_cast<size_t>(nF));
-    for (int f = 0; f < nF; ++f)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          for (int c = 0; c < 2; ++c) ht.emplace_back(2 * wedge[3 * f + i] + c, 2 * wedge[3 * f + j] + c, 1.0);
-    H.resize(nX, nX);
-    H.setFromTriplets(ht.begin(), ht.end());  // the pattern, rows ascending in each column
-    auto entry = [&](int row, int col) {  // H(row, col)'s place among H's stored values
-      const int* first = H.innerIndexPtr() + H.outerIndexPtr()[col];
-      const int* last = H.innerIndexPtr() + H.outerIndexPtr()[col + 1];
-      return static_cast<int>(std::lower_bound(first, last, row) - H.innerIndexPtr());
-    };
-    hwt.reserve(18 * static_cast<size_t>(nF));
-    rt.reserve(6 * static_cast<size_t>(nF));
-    for (int f = 0; f < nF; ++f) {
-      const double A = face_area[f];
-      const Eigen::Vector2d X(std::cos(theta[f]), std::sin(theta[f])), Y(-X.y(), X.x());
-      for (int i = 0; i < 3; ++i) {
-        const int wi = wedge[3 * f + i];
-        rt.emplace_back(2 * wi, f, A * grad[f][i].dot(X));
-        rt.emplace_back(2 * wi + 1, f, A * grad[f][i].dot(Y));
-        for (int j = 0; j < 3; ++j) {
-          const int wj = wedge[3 * f + j];
-          const double h = A * grad[f][i].dot(grad[f][j]);
-          for (int c = 0; c < 2; ++c) hwt.emplace_back(entry(2 * wi + c, 2 * wj + c), f, h);
-        }
+    // H's pattern: (2w + c, 2w' + c) for the wedges w, w' of one face, per column its rows ascending.
+    std::vector<int> start(W + 1, 0), near(9 * static_cast<size_t>(nF));
+    for (int c = 0; c < 3 * nF; ++c) start[wedge[c] + 1] += 3;
+    for (int w = 0; w < W; ++w) start[w + 1] += start[w];
+    {
+      std::vector<int> next(start.begin(), start.end() - 1);
+      for (int c = 0; c < 3 * nF; ++c)
+        for (int k = 0; k < 3; ++k) near[next[wedge[c]]++] = wedge[3 * (c / 3) + k];
+    }
+    std::vector<int> outer(nX + 1, 0), inner;
+    inner.reserve(near.size());
+    for (int w = 0; w < W; ++w) {
+      std::sort(near.begin() + start[w], near.begin() + start[w + 1]);
+      const auto last = std::unique(near.begin() + start[w], near.begin() + start[w + 1]);
+      for (int c = 0; c < 2; ++c) {
+        for (auto it = near.begin() + start[w]; it != last; ++it) inner.push_back(2 * *it + c);
+        outer[2 * w + c + 1] = static_cast<int>(inner.size());
       }
     }
-    Hw.resize(H.nonZeros(), nF);
-    Hw.setFromTriplets(hwt.begin(), hwt.end());
-    rw.resize(nX, nF);
-    rw.setFromTriplets(rt.begin(), rt.end());
+    for (int j = 2 * W; j < nX; ++j) outer[j + 1] = outer[j];
+    const std::vector<double> zeros(inner.size(), 0.0);
+    H = Eigen::Map<const Eigen::SparseMatrix<double>>(nX, nX, static_cast<int>(inner.size()), outer.data(), inner.data(), zeros.data());
+    H_column.resize(inner.size());
+    for (int j = 0; j < nX; ++j)
+      for (int k = outer[j]; k < outer[j + 1]; ++k) H_column[k] = j;
+  }
+  auto entry = [&](int row, int col) {  // H(row, col)'s place among H's stored values
+    const int* first = H.innerIndexPtr() + H.outerIndexPtr()[col];
+    const int* last = H.innerIndexPtr() + H.outerIndexPtr()[col + 1];
+    return static_cast<int>(std::lower_bound(first, last, row) - H.innerIndexPtr());
+  };
+  for (int f = 0; f < nF; ++f) {
+    const double A = face_area[f];
+    const Eigen::Vector2d X(std::cos(theta[f]), std::sin(theta[f])), Y(-X.y(), X.x());
+    for (int i = 0; i < 3; ++i) {
+      const int wi = wedge[3 * f + i];
+      r_term[6 * f + 2 * i] = A * grad[f][i].dot(X);
+      r_term[6 * f + 2 * i + 1] = A * grad[f][i].dot(Y);
+      for (int j = 0; j < 3; ++j) {
+        const int wj = wedge[3 * f + j];
+        H_term[9 * f + 3 * i + j] = A * grad[f][i].dot(grad[f][j]);
+        for (int c = 0; c < 2; ++c) H_entry[18 * f + 2 * (3 * i + j) + c] = entry(2 * wi + c, 2 * wj + c);
+      }
+    }
   }
   const Eigen::SparseMatrix<double> Pt = P.transpose();
   // The right-hand side alone (the scale s or the sizes changed, not the weights).
   auto assemble_rhs = [&]() {
-    Eigen::VectorXd sized(nF);
-    for (int f = 0; f < nF; ++f) sized[f] = weight[f] * size[f];
-    b = s * (Pt * (rw * sized));
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(nX);
+    for (int f = 0; f < nF; ++f)
+      for (int i = 0; i < 3; ++i)
+        for (int c = 0; c < 2; ++c) r[2 * wedge[3 * f + i] + c] += weight[f] * size[f] * r_term[6 * f + 2 * i + c];
+    b = s * (Pt * r);
   };
-  auto assemble = [&]() {
-    const Eigen::Map<const Eigen::VectorXd> w(weight.data(), nF);
-    Eigen::Map<Eigen::VectorXd>(H.valuePtr(), H.nonZeros()) = Hw * w;
-    K = Pt * (H * P);
+  double epsilon = 0;
+  auto add_epsilon = [&]() {
     // The map is defined up to a translation per component: a tiny pull of every unknown toward 0 makes the
     // system definite without moving anything else measurably (the right-hand side is orthogonal to translations).
     double diagonal = 0;
-    for (int j = 0; j < nY; ++j) diagonal += K.coeff(j, j);
-    const double epsilon = 1e-11 * (nY > 0 ? diagonal / nY : 1.0);
-    for (int j = 0; j < nY; ++j) K.coeffRef(j, j) += epsilon;
+    for (int j = 0; j < nY; ++j) diagonal += K.coeff(j, j) - epsilon;
+    const double next = 1e-11 * (nY > 0 ? diagonal / nY : 1.0);
+    for (int j = 0; j < nY; ++j) K.coeffRef(j, j) += next - epsilon;
+    epsilon = next;
+  };
+  {
+    double* h = H.valuePtr();
+    for (int f = 0; f < nF; ++f)
+      for (int k = 0; k < 18; ++k) h[H_entry[18 * f + k]] += weight[f] * H_term[9 * f + k / 2];
+    K = Pt * (H * P);
+    add_epsilon();
     K.makeCompressed();
     assemble_rhs();
+  }
+  // After the weights of a few faces changed by `changes` (face, change): K changes by Pᵀ ΔH P, with ΔH from
+  // those faces alone, added into K's values in place (its pattern is within K's). A product over the changed
+  // faces instead of all of them: the stiffening changes the weights of the distorted faces only.
+  auto reassemble = [&](const std::vector<std::pair<int, double>>& changes) {
+    std::vector<Eigen::Triplet<double>> dt;
+    for (const auto& [f, change] : changes) {
+      weight[f] += change;
+      for (int k = 0; k < 18; ++k) {
+        const int at = H_entry[18 * f + k];
+        dt.emplace_back(H.innerIndexPtr()[at], H_column[at], change * H_term[9 * f + k / 2]);
+      }
+    }
+    Eigen::SparseMatrix<double> dH(nX, nX);
+    dH.setFromTriplets(dt.begin(), dt.end());
+    const Eigen::SparseMatrix<double> dK = Pt * (dH * P);
+    for (int j = 0; j < nY; ++j) {
+      const int* rows = K.innerIndexPtr();
+      int k = K.outerIndexPtr()[j];
+      const int end = K.outerIndexPtr()[j + 1];
+      for (Eigen::SparseMatrix<double>::InnerIterator it(dK, j); it; ++it) {
+        while (k < end && rows[k] < it.row()) ++k;
+        if (k == end || rows[k] != it.row()) throw Error("param: internal error: a change of K outside its pattern");
+        K.valuePtr()[k] += it.value();
+      }
+    }
+    add_epsilon();
+    assemble_rhs();
   };
-  assemble();
   auto solver = std::make_unique<linalg::SparseCholesky>(K, "param");
   std::vector<char> fixed(nY, 0);
   Eigen::VectorXd value = Eigen::VectorXd::Zero(nY);  // the fixed integers' values
@@ -730,12 +779,13 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       if (folds < gain * fewest) fewest = folds, stalled = 0;
       else if (++stalled == patience) return;
       if (round >= 3 && folds > std::max(1000, nF / 50)) return;
+      std::vector<std::pair<int, double>> changes;
       for (int f = 0; f < nF; ++f) {
         if (collapsed[f] && !folded(f)) continue;
         const double ratio = folded(f) ? 20.0 : distortion(f);
-        if (ratio > 2) weight[f] += std::min(ratio - 1, 20.0);
+        if (ratio > 2) changes.emplace_back(f, std::min(ratio - 1, 20.0));
       }
-      assemble();
+      reassemble(changes);
       refactor = true;
       y = solve_fixed();
       corner_uv();
