@@ -97,11 +97,7 @@ class CholeskyEngine : public SolverEngine {
   Eigen::MatrixXd R_CC, R_inv;  // lower triangular; P = R_invᵀ R_inv
   // Sparse forward substitution (see forward_update).
   std::vector<int> position_;  // factor position of each row of M (the inverse of the factor's perm)
-  std::vector<int> super_of_col_, super_parent_;
   Eigen::VectorXd base_b_, base_z_;  // base right-hand side of the vertex rows, and L⁻¹ Π [base_b; 0]
-  mutable std::vector<int> super_stamp_;
-  mutable Eigen::VectorXd forward_work_;
-  mutable int stamp_ = 0;
   // Backward substitution on OpenMP's threads (src/linalg/substitution.h), planned once the factor has its values.
   std::unique_ptr<linalg::Substitution<double>> substitution_;
 
@@ -229,16 +225,12 @@ class CholeskyEngine : public SolverEngine {
 
   std::string ordering() const override { return nC > 0 ? "CAMD" : "AMD"; }
 
-  // Supernodal elimination tree and the factor position of each row, for forward_update.
+  // The factor position of each row, for forward_update.
   void prepare_sparse_forward() {
     const int n = nD + nC;
     const std::vector<int>& perm = symbolic_factor().perm;
     position_.resize(n);
     for (int k = 0; k < n; ++k) position_[perm[k]] = k;
-    const Supernodes L = supernodes();
-    super_of_col_ = L.owners();
-    super_parent_ = linalg::supernode_parents(L, super_of_col_);
-    super_stamp_.assign(L.count, -1);
     for (int& r : edge_rows_.row) r = position_[r];
     substitution_ = std::make_unique<linalg::Substitution<double>>(symbolic_factor(), values_);
   }
@@ -247,36 +239,10 @@ class CholeskyEngine : public SolverEngine {
   // per thread (src/linalg/substitution.h).
   void backward(Eigen::VectorXd& z) const { substitution_->backward_in_factor_order(z.data()); }
 
-  // z += L⁻¹ d for d with the few nonzeros `entries` (factor positions, values): only the supernodes on
-  // the paths from those entries to the root of the elimination tree are touched, in increasing order.
+  // z += L⁻¹ d for d with the few nonzeros `entries` (factor positions, values): only the supernodes on the
+  // paths from those entries to the root of the elimination tree are touched.
   void forward_update(const std::vector<std::pair<int, double>>& entries, Eigen::VectorXd& z) const {
-    const Supernodes L = supernodes();
-    ++stamp_;
-    std::vector<int> path;
-    for (const auto& [k, value] : entries)
-      for (int s = super_of_col_[k]; s != -1 && super_stamp_[s] != stamp_; s = super_parent_[s])
-        super_stamp_[s] = stamp_, path.push_back(s);
-    std::sort(path.begin(), path.end());
-    Eigen::VectorXd& d = forward_work_;  // zero outside a call
-    if (d.size() != z.size()) d.setZero(z.size());
-    for (const auto& [k, value] : entries) d(k) += value;
-    Eigen::VectorXd below;
-    for (int s : path) {
-      const int ncol = L.cols(s), nrow = L.height(s);
-      const auto Ls = L.values(s);
-      auto block = d.segment(L.first(s), ncol);
-      Ls.topRows(ncol).triangularView<Eigen::Lower>().solveInPlace(block);
-      if (nrow == ncol) continue;
-      below.noalias() = Ls.bottomRows(nrow - ncol) * block;
-      for (int i = 0; i < nrow - ncol; ++i) d(L.row(s, ncol + i)) -= below(i);
-    }
-    // Every entry touched lies in the columns of the path's supernodes (the rows below a supernode are
-    // columns of its ancestors): add them to z and zero them again.
-    for (int s : path) {
-      auto touched = d.segment(L.first(s), L.cols(s));
-      z.segment(L.first(s), L.cols(s)) += touched;
-      touched.setZero();
-    }
+    substitution_->forward_update(entries, z.data());
   }
 
   // R_CC: the factor's entries at rows and columns ≥ nD (in factor order), read from the supernodes.

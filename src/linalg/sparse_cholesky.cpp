@@ -16,6 +16,7 @@ struct SparseCholesky::State {
   FactorValues<double> x;              // the factor's values
   std::vector<int> outer, inner;       // the upper triangle's pattern, compressed columns
   std::vector<double> values;
+  std::vector<int> position;           // the factor position of each matrix row (the inverse of symbolic.perm)
   std::unique_ptr<Substitution<double>> substitution;
   std::string what;
 };
@@ -53,6 +54,8 @@ SparseCholesky::SparseCholesky(const Eigen::SparseMatrix<double>& A, const char*
   } catch (const Error& e) {
     throw Error(std::string(what) + ": " + e.what());
   }
+  state_->position.resize(n_);
+  for (int k = 0; k < n_; ++k) state_->position[state_->symbolic.perm[k]] = k;
 }
 
 SparseCholesky::~SparseCholesky() = default;
@@ -74,6 +77,21 @@ Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& b) const {
   if (b.size() != n_) throw Error(state_->what + ": the right-hand side has the wrong size");
   Eigen::VectorXd x = b;
   if (n_ > 0) state_->substitution->solve(x.data());
+  return x;
+}
+
+Eigen::VectorXd SparseCholesky::solve_sparse(const std::vector<std::pair<int, double>>& entries) const {
+  if (!state_->substitution) throw Error(state_->what + ": solve without a successful factorization");
+  std::vector<std::pair<int, double>> in_factor_order;
+  in_factor_order.reserve(entries.size());
+  for (const auto& [row, value] : entries) {
+    if (row < 0 || row >= n_) throw Error(state_->what + ": a right-hand side entry outside the matrix");
+    in_factor_order.emplace_back(state_->position[row], value);
+  }
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(n_), x(n_);
+  state_->substitution->forward_update(in_factor_order, z.data());
+  state_->substitution->backward_in_factor_order(z.data());
+  for (int k = 0; k < n_; ++k) x[state_->symbolic.perm[k]] = z[k];
   return x;
 }
 

@@ -12,6 +12,7 @@
 #include <Eigen/SparseCore>
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace trivcon::linalg {
@@ -29,6 +30,9 @@ class SparseCholesky {
   int factorize(const Eigen::SparseMatrix<double>& A);
   // x ← A⁻¹ b with the last factorization.
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+  // The same for b with the few nonzeros `entries` (matrix row, value; a row may repeat, its values add up):
+  // the forward half visits only the supernodes on their paths to the root of the elimination tree.
+  Eigen::VectorXd solve_sparse(const std::vector<std::pair<int, double>>& entries) const;
   int size() const { return n_; }
 
  private:

@@ -43,11 +43,13 @@ const T* Substitution<T>::values() const {
 template <class T>
 void Substitution<T>::plan() {
   const Supernodes& S = S_;
-  const std::vector<int> owner = S.owners();
+  owner_ = S.owners();
+  parent_ = supernode_parents(S, owner_);
+  stamp_.assign(S.count, -1);
   // Balanced by the entries each supernode holds: a solve reads each once.
   std::vector<double> entries(S.count);
   for (int s = 0; s < S.count; ++s) entries[s] = static_cast<double>(S.height(s)) * S.cols(s);
-  TreeSplit split = split_tree(supernode_parents(S, owner), entries, 1e4, linalg::max_threads(), true);
+  TreeSplit split = split_tree(parent_, entries, 1e4, linalg::max_threads(), true);
   top_ = std::move(split.top), part_ = std::move(split.part);
   top_slot_.assign(n_, -1);
   for (int s : top_)
@@ -202,6 +204,37 @@ void Substitution<T>::backward_in_factor_order(T* z) const {
   }
   for (const auto& e : error)
     if (e) std::rethrow_exception(e);
+}
+
+template <class T>
+void Substitution<T>::forward_update(const std::vector<std::pair<int, T>>& entries, T* z) const {
+  if (n_ == 0 || entries.empty()) return;
+  const Supernodes& S = S_;
+  const T* values = this->values();
+  ++calls_;
+  std::vector<int> path;
+  for (const auto& [k, value] : entries)
+    for (int s = owner_[k]; s != -1 && stamp_[s] != calls_; s = parent_[s]) stamp_[s] = calls_, path.push_back(s);
+  std::sort(path.begin(), path.end());
+  std::vector<T>& d = update_;
+  if (static_cast<int>(d.size()) != n_) d.assign(n_, T(0));
+  for (const auto& [k, value] : entries) d[k] += value;
+  for (int s : path) {  // as the full forward pass, the rows below sent at once
+    const int ncol = S.cols(s), nrow = S.height(s);
+    const T* panel = values + S.px[s];
+    T* y = d.data() + S.first(s);
+    const int* rows = S.rows + S.pi[s];
+    for (int c = 0; c < ncol; ++c) {
+      const T* column = panel + static_cast<size_t>(c) * nrow;
+      const T v = y[c] * (1 / std::real(column[c]));
+      y[c] = v;
+      for (int i = c + 1; i < nrow; ++i) d[rows[i]] -= times(column[i], v);
+    }
+  }
+  // Every entry touched lies in the columns of the path's supernodes (the rows below a supernode are columns of
+  // its ancestors): added to z, then zeroed again.
+  for (int s : path)
+    for (int k = S.first(s); k < S.first(s) + S.cols(s); ++k) z[k] += d[k], d[k] = T(0);
 }
 
 template class Substitution<double>;

@@ -25,6 +25,7 @@
 #endif
 
 #include <complex>
+#include <utility>
 #include <vector>
 
 #include "linalg/supernodal.h"
@@ -55,6 +56,10 @@ class Substitution {
   // Its second half alone: z ← L⁻ᴴ z in the factor's order (the trivial-connection solver's backward
   // substitution, after its own sparse forward update). Uses no member work vector.
   void backward_in_factor_order(T* z) const;
+  // z += L⁻¹ d in the factor's order, for d with the few nonzeros `entries` (factor position, value): only the
+  // supernodes on the paths from those entries to the root of the elimination tree are visited, in increasing
+  // order, on one thread (a right-hand side with few nonzeros touches a small part of the factor).
+  void forward_update(const std::vector<std::pair<int, T>>& entries, T* z) const;
   const std::vector<int>& permutation() const { return perm_; }
   int size() const { return n_; }
 
@@ -72,7 +77,11 @@ class Substitution {
   std::vector<std::vector<int>> part_;        // per thread: whole subtrees, increasing
   std::vector<int> top_slot_;                 // per column: its slot in a thread's top buffer, or −1 below the top
   int top_columns_ = 0;
+  std::vector<int> owner_, parent_;           // per column its supernode; per supernode its parent (−1: a root)
   mutable std::vector<T> work_;               // z in factor order
+  mutable std::vector<T> update_;             // forward_update's d, zero outside a call
+  mutable std::vector<int> stamp_;            // per supernode: the forward_update call that last visited it
+  mutable int calls_ = 0;
   mutable std::vector<std::vector<T>> send_;  // per thread: what its subtrees send to the top's columns
 };
 

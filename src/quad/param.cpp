@@ -1187,12 +1187,12 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     return false;
   };
   // The response of the solution to a unit change of fixed value j (one solve with the current factorization).
+  // Its right-hand side has a nonzero per neighbour of j: a sparse solve.
   auto response = [&](int j) {
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(nY);
+    std::vector<std::pair<int, double>> r{{j, 1.0}};
     for (Eigen::SparseMatrix<double>::InnerIterator it(K, j); it; ++it)
-      if (!fixed[it.row()]) r[it.row()] = -it.value();
-    r[j] = 1;
-    return solver->solve(r);
+      if (!fixed[it.row()]) r.emplace_back(static_cast<int>(it.row()), -it.value());
+    return solver->solve_sparse(r);
   };
   // Descent on the integers: the greedy rounding fixes each integer on the map of its round, before the later
   // ones; held at the end, one often lies a whole unit or more from its best value. The energy along a change t
