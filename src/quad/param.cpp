@@ -630,7 +630,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     for (int j = 0; j < nY; ++j) K.coeffRef(j, j) += next - epsilon;
     epsilon = next;
   };
-  {
+  {  // K from every face once; afterwards H's pattern alone is read (its values stay the unit weights')
     double* h = H.valuePtr();
     for (int f = 0; f < nF; ++f)
       for (int k = 0; k < 18; ++k) h[H_entry[18 * f + k]] += weight[f] * H_term[9 * f + k / 2];
