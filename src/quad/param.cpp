@@ -21,6 +21,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "linalg/parallel.h"
 #include "linalg/sparse_cholesky.h"
 #include "linalg/timing.h"
 #include "quad/untangle.h"
@@ -1391,11 +1392,15 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       return std::includes(before.wrong.begin(), before.wrong.end(), wrong.begin(), wrong.end()) && total() < before.total();
     }
   };
+  // Over the whole map: on several threads on a large mesh (a winding per vertex, read-only).
+  std::vector<char> wrong_scratch(nV, 0);
   auto badness = [&]() {
     Badness b;
     b.folds = count_folds();
+#pragma omp parallel for schedule(static) if (nF > linalg::kParallelMinElements)
+    for (int v = 0; v < nV; ++v) wrong_scratch[v] = winds_wrong(v);
     for (int v = 0; v < nV; ++v)
-      if (winds_wrong(v)) b.wrong.push_back(v);
+      if (wrong_scratch[v]) b.wrong.push_back(v);
     return b;
   };
   auto badness_of = [&](const std::vector<int>& faces, const std::vector<int>& vertices) {
