@@ -765,14 +765,14 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // Stiffening (MIQ, Bommes et al. 2009, §5): while faces fold, each face weighs more by its distortion, so that
   // it keeps its shape and the distortion spreads over its neighbours; a folded face counts as very distorted.
   // Before the rounding (on the real-valued map, so that the integers are chosen on a map without folds) and
-  // after it (the integers held).
-  auto stiffen = [&](int rounds, int patience, double gain) {
+  // after it (the integers held). It ends when at most `few` faces fold.
+  auto stiffen = [&](int rounds, int patience, double gain, int few) {
     int fewest = std::numeric_limits<int>::max(), stalled = 0;
     for (int round = 0; round < rounds; ++round) {
       check_cancelled();
       int folds = 0;
       for (int f = 0; f < nF; ++f) folds += folded(f);
-      if (folds == 0) return;
+      if (folds <= few) return;
       // Stop when `patience` rounds in a row found no fewer folds than `gain` times the fewest before them (a
       // round that removes less is not progress: each is a factorization), or after three rounds when more
       // than one face in 50 still folds (the map is wrong at large: far more singularities or feature lines than
@@ -872,7 +872,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   }
   if (options.sizing_rounds > 0) fit_target();
   q.folds_real_valued = count_folds();
-  stiffen(options.max_stiffening_rounds, 3, 1.0);
+  stiffen(options.max_stiffening_rounds, 3, 1.0, 0);
   // --- Greedy rounding: the integers nearest to whole numbers first, a fraction of those left per solve --------
   // An aligned edge whose two ends both sit on integers in the coordinate along it (a feature edge from a corner
   // or a junction of feature lines to a singularity, both on integer points) has a whole length: rounded to 0,
@@ -1652,9 +1652,9 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     q.untangled_faces += folds_before - count_folds();
     rewind();
   };
-  // After the rounding, two rounds without a fifth fewer folds end it: the untangling below opens what is left
-  // locally, and the rounds the stiffening stalls or crawls on are a factorization each.
-  stiffen(options.max_stiffening_rounds, 2, 0.8);
+  // After the rounding, two rounds without a fifth fewer folds end it, and so do 8 folds or fewer: the untangling
+  // below opens what is left locally (a region each), and each round of the stiffening is a factorization.
+  stiffen(options.max_stiffening_rounds, 2, 0.8, 8);
   q.seconds_stiffening = linalg::seconds_since(t3);
   const auto t5 = linalg::Clock::now();
   untangle_folds();
