@@ -35,12 +35,10 @@ int fill_faces(const FieldDesigner& designer, const Parametrization& param, Quad
     add_face(ids, 4);
   }
   for (const auto& face : quads.other_faces) add_face(face.data(), face.size());
-  std::map<int, int> cone_index;
-  for (size_t i = 0; i < param.cones.size() && i < param.cone_index.size(); ++i) cone_index[param.cones[i]] = param.cone_index[i];
+  const std::vector<int> cone_of = cone_quarters(param, t.num_vertices);
   auto wanted = [&](int v) {
     const int c = quads.vertex_cone[v];
-    const auto it = c >= 0 ? cone_index.find(c) : cone_index.end();
-    return 4 - (it == cone_index.end() ? 0 : it->second);
+    return 4 - (c >= 0 && c < t.num_vertices ? cone_of[c] : 0);
   };
   // The worst corner of a quad: the sine of its angle about the quad's own normal.
   auto worst_corner = [](const std::array<Eigen::Vector3d, 4>& p) {

@@ -152,8 +152,7 @@ void check_quads(const FieldDesigner& designer, const Parametrization& param, Qu
   q.oriented = misoriented == 0;
 
   // Valences against the cones.
-  std::vector<int> cone_of(t.num_vertices, 0);  // n of index n/4 at each input vertex
-  for (size_t k = 0; k < param.cones.size(); ++k) cone_of[param.cones[k]] = param.cone_index[k];
+  const std::vector<int> cone_of = quad::cone_quarters(param, t.num_vertices);  // n of index n/4 at each input vertex
   std::vector<char> cone_found(t.num_vertices, 0);
   int irregular = 0, mismatches = 0;
   for (int v = 0; v < nV; ++v) {
