@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <array>
@@ -633,6 +634,19 @@ TEST(Symbolic, NumericFactorizationOnItSolves) {
   }
 }
 
+// The whole symmetric matrix of an upper triangle.
+Eigen::SparseMatrix<double> full_matrix(const Upper& A) {
+  std::vector<Eigen::Triplet<double>> t;
+  for (int col = 0; col < A.n; ++col)
+    for (int q = A.outer[col]; q < A.outer[col + 1]; ++q) {
+      t.emplace_back(A.inner[q], col, A.values[q]);
+      if (A.inner[q] != col) t.emplace_back(col, A.inner[q], A.values[q]);
+    }
+  Eigen::SparseMatrix<double> M(A.n, A.n);
+  M.setFromTriplets(t.begin(), t.end());
+  return M;
+}
+
 // A right-hand side with few nonzeros (the map's responses to one fixed integer, the connection's changed rows):
 // the forward half visits only the supernodes on their paths to the root (Substitution::forward_update), and
 // gives the dense solve's answer, real through SparseCholesky::solve_sparse and complex through the
@@ -641,14 +655,7 @@ TEST(Symbolic, SparseRightHandSidesGiveTheDenseSolvesAnswer) {
   for (const Case& c : mesh_cases()) {
     SCOPED_TRACE(c.name);
     const Upper& A = c.A;
-    std::vector<Eigen::Triplet<double>> t;
-    for (int col = 0; col < A.n; ++col)
-      for (int q = A.outer[col]; q < A.outer[col + 1]; ++q) {
-        t.emplace_back(A.inner[q], col, A.values[q]);
-        if (A.inner[q] != col) t.emplace_back(col, A.inner[q], A.values[q]);
-      }
-    Eigen::SparseMatrix<double> M(A.n, A.n);
-    M.setFromTriplets(t.begin(), t.end());
+    const Eigen::SparseMatrix<double> M = full_matrix(A);
     linalg::SparseCholesky solver(M, "test");
     EXPECT_THROW(solver.solve_sparse({{0, 1.0}}), Error);  // before a factorization
     ASSERT_EQ(solver.factorize(M), -1);
@@ -689,6 +696,64 @@ TEST(Symbolic, SparseRightHandSidesGiveTheDenseSolvesAnswer) {
       EXPECT_LE(difference, 1e-12 * largest);
     }
   }
+}
+
+// Rows ordered last: the factor's block of them is the Cholesky factor of their Schur complement, against
+// S = A_ll − A_lr A_rr⁻¹ A_rl computed with Eigen's own sparse factorization of A_rr.
+TEST(Symbolic, RowsOrderedLastGiveTheirSchurComplement) {
+  for (const Case& c : mesh_cases()) {
+    SCOPED_TRACE(c.name);
+    const Upper& A = c.A;
+    const Eigen::SparseMatrix<double> M = full_matrix(A);
+    std::vector<int> last{A.n - 1, 0};  // scattered, not sorted
+    for (int row = 97; row < A.n - 1; row += 97) last.push_back(row);
+    const int m = static_cast<int>(last.size());
+    linalg::SparseCholesky solver(M, "test", last);
+    EXPECT_THROW(solver.schur_complement(), Error);  // before a factorization
+    ASSERT_EQ(solver.factorize(M), -1);
+    const Eigen::MatrixXd S = solver.schur_complement();
+    ASSERT_EQ(S.rows(), m);
+
+    std::vector<int> place(A.n, -1), rest;
+    for (int a = 0; a < m; ++a) place[last[a]] = a;
+    for (int row = 0; row < A.n; ++row)
+      if (place[row] < 0) place[row] = static_cast<int>(rest.size()), rest.push_back(row);
+    std::vector<Eigen::Triplet<double>> rr;
+    Eigen::MatrixXd rl = Eigen::MatrixXd::Zero(static_cast<int>(rest.size()), m), ll = Eigen::MatrixXd::Zero(m, m);
+    std::vector<char> is_last(A.n, 0);
+    for (int row : last) is_last[row] = 1;
+    for (int col = 0; col < A.n; ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(M, col); it; ++it) {
+        const int row = static_cast<int>(it.row());
+        if (!is_last[row] && !is_last[col]) rr.emplace_back(place[row], place[col], it.value());
+        else if (!is_last[row]) rl(place[row], place[col]) = it.value();
+        else if (is_last[col]) ll(place[row], place[col]) = it.value();
+      }
+    Eigen::SparseMatrix<double> Arr(static_cast<int>(rest.size()), static_cast<int>(rest.size()));
+    Arr.setFromTriplets(rr.begin(), rr.end());
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(Arr);
+    ASSERT_EQ(ldlt.info(), Eigen::Success);
+    const Eigen::MatrixXd expected = ll - rl.transpose() * ldlt.solve(rl);
+    EXPECT_LE((S - expected).lpNorm<Eigen::Infinity>(), 1e-10 * expected.lpNorm<Eigen::Infinity>());
+    EXPECT_LE((S - S.transpose()).lpNorm<Eigen::Infinity>(), 0.0);
+    // The other rows' system alone, A_rr x_r = b_r (b's rows of `last` ignored, x's 0), dense and sparse.
+    Eigen::VectorXd b(A.n), b_rest(static_cast<int>(rest.size()));
+    for (int row = 0; row < A.n; ++row) b[row] = std::sin(0.37 * row) + (is_last[row] ? 5.0 : 0.0);
+    for (size_t k = 0; k < rest.size(); ++k) b_rest[static_cast<int>(k)] = b[rest[k]];
+    const Eigen::VectorXd x_rest = ldlt.solve(b_rest), x = solver.solve_rest(b);
+    std::vector<std::pair<int, double>> entries{{rest[3], 1.0}, {last[1], 7.0}, {rest[rest.size() / 2], -2.0}};
+    Eigen::VectorXd unit = Eigen::VectorXd::Zero(static_cast<int>(rest.size()));
+    unit[3] += 1.0, unit[static_cast<int>(rest.size() / 2)] -= 2.0;
+    const Eigen::VectorXd x_unit = ldlt.solve(unit), x_sparse = solver.solve_rest_sparse(entries);
+    for (int row = 0; row < A.n; ++row) {
+      EXPECT_NEAR(x[row], is_last[row] ? 0.0 : x_rest[place[row]], 1e-10 * x_rest.lpNorm<Eigen::Infinity>());
+      EXPECT_NEAR(x_sparse[row], is_last[row] ? 0.0 : x_unit[place[row]], 1e-10 * x_unit.lpNorm<Eigen::Infinity>());
+    }
+  }
+  const Upper A = vertex_laplacian(make_icosphere(2));
+  const Eigen::SparseMatrix<double> M = full_matrix(A);
+  EXPECT_THROW(linalg::SparseCholesky(M, "test", {3, 5, 3}), Error);  // a row twice
+  EXPECT_THROW(linalg::SparseCholesky(M, "test", {A.n}), Error);     // outside the matrix
 }
 
 // An indefinite matrix: the first column found not positive definite, as with CHOLMOD's factor.

@@ -8,6 +8,7 @@
 // the free integers with re-solves, stiffening against flips, and a check of everything the map promises.
 #include "trivcon/param.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/SparseCore>
 
 #include <algorithm>
@@ -613,8 +614,10 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     }
   }
   const Eigen::SparseMatrix<double> Pt = P.transpose();
+  bool c_hat_stale = true;  // the Schur route's ĉ (below) is of an older right-hand side
   // The right-hand side alone (the scale s or the sizes changed, not the weights).
   auto assemble_rhs = [&]() {
+    c_hat_stale = true;
     Eigen::VectorXd r = Eigen::VectorXd::Zero(nX);
     for (int f = 0; f < nF; ++f)
       for (int i = 0; i < 3; ++i)
@@ -668,15 +671,76 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     add_epsilon();
     assemble_rhs();
   };
-  auto solver = std::make_unique<linalg::SparseCholesky>(K, "param");
+  // Two routes to the map with some integers fixed. The integers are ordered last in the factorization, so that
+  // the factor's trailing block gives their Schur complement S = K_ii − K_ir K_rr⁻¹ K_ri (the energy as a
+  // function of the integers, the reals solved for them). When S is small beside the factor (the integers' m³
+  // within a fifth of the factorization's flops), K is factored only when it changes: the integers' values come
+  // from S (fixed ones held, free ones solving S_ff y_f = ĉ_f − S_fF v_F, ĉ = S x_i for x = K⁻¹ b), and the
+  // reals from one solve with K whose integer rows of the right-hand side are set to reproduce those values
+  // (S y_i + b_i − ĉ). Otherwise (many integers: a mesh with hundreds of singularities) the fixed rows and
+  // columns become the identity and the matrix is factored again after each change of the fixed set.
+  auto solver = std::make_unique<linalg::SparseCholesky>(K, "param", integer_free);
+  const int nInt = static_cast<int>(integer_free.size());
+  const bool through_schur = nInt > 0 && std::pow(static_cast<double>(nInt), 3) <= 0.2 * solver->factor_flops();
+  std::vector<int> int_rank(nY, -1);  // per unknown, its place among the integers
+  for (int a = 0; a < nInt; ++a) int_rank[integer_free[a]] = a;
+  Eigen::MatrixXd S;           // the integers' Schur complement (through_schur), of the last factorization
+  Eigen::VectorXd unconstrained, c_hat;  // x = K⁻¹ b and S x_i, of the last factorization and right-hand side
   std::vector<char> fixed(nY, 0);
   Eigen::VectorXd value = Eigen::VectorXd::Zero(nY);  // the fixed integers' values
-  // Solve K y = b with the fixed unknowns held: their rows and columns become the identity (same pattern).
-  // The matrix depends on which unknowns are fixed, not on their values: it is factored again only after K or
-  // the fixed set changed (refactor = true), so that trying other values (the local search below) costs one solve each.
-  bool refactor = true;
+  // Solve K y = b with the fixed unknowns held. The matrix factored depends on K and, on the identity route,
+  // on which unknowns are fixed, not on their values: it is factored again only after K changed (refactor =
+  // true; the identity route also after the fixed set changed, refix = true), so that trying other values (the
+  // local searches below) costs one solve each.
+  bool refactor = true, refix = true;
   Eigen::SparseMatrix<double> M;
+  auto factor = [&](const Eigen::SparseMatrix<double>& A) {
+    const int bad = solver->factorize(A);
+    if (bad >= 0)
+      throw Error("param: the map's system is not positive definite (unknown " + std::to_string(bad) + "); the mesh or the field is degenerate");
+    ++q.factorizations;
+  };
   auto solve_fixed = [&]() -> Eigen::VectorXd {
+    if (through_schur) {
+      if (refactor) {
+        factor(K);
+        S = solver->schur_complement();
+        refactor = false, c_hat_stale = true;
+      }
+      if (c_hat_stale) {
+        unconstrained = solver->solve(b);
+        Eigen::VectorXd xi(nInt);
+        for (int a = 0; a < nInt; ++a) xi[a] = unconstrained[integer_free[a]];
+        c_hat = S * xi;
+        c_hat_stale = false;
+      }
+      std::vector<int> free_ints, fixed_ints;
+      for (int a = 0; a < nInt; ++a) (fixed[integer_free[a]] ? fixed_ints : free_ints).push_back(a);
+      if (fixed_ints.empty()) return unconstrained;  // nothing held: K⁻¹ b itself
+      Eigen::VectorXd yi(nInt);
+      for (int a : fixed_ints) yi[a] = value[integer_free[a]];
+      if (!free_ints.empty()) {
+        const int nf = static_cast<int>(free_ints.size());
+        Eigen::MatrixXd Sff(nf, nf);
+        Eigen::VectorXd rhs(nf);
+        for (int p = 0; p < nf; ++p) {
+          rhs[p] = c_hat[free_ints[p]];
+          for (int a : fixed_ints) rhs[p] -= S(free_ints[p], a) * yi[a];
+          for (int r = 0; r < nf; ++r) Sff(r, p) = S(free_ints[r], free_ints[p]);
+        }
+        const Eigen::LLT<Eigen::MatrixXd> llt(Sff);
+        if (llt.info() != Eigen::Success) throw Error("param: the integers' Schur complement is not positive definite; the mesh or the field is degenerate");
+        const Eigen::VectorXd yf = llt.solve(rhs);
+        for (int p = 0; p < nf; ++p) yi[free_ints[p]] = yf[p];
+      }
+      // The reals for those integers: K_rr y_r = b_r − K_ri y_i, with the factor's L_rr alone.
+      Eigen::VectorXd r = b;
+      for (int a = 0; a < nInt; ++a)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(K, integer_free[a]); it; ++it) r[it.row()] -= it.value() * yi[a];
+      Eigen::VectorXd y_new = solver->solve_rest(r);
+      for (int a = 0; a < nInt; ++a) y_new[integer_free[a]] = yi[a];
+      return y_new;
+    }
     Eigen::VectorXd r = b;
     for (int j = 0; j < nY; ++j)
       if (fixed[j])
@@ -684,7 +748,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
           if (!fixed[it.row()]) r[it.row()] -= it.value() * value[j];
     for (int j = 0; j < nY; ++j)
       if (fixed[j]) r[j] = value[j];
-    if (refactor) {
+    if (refactor || refix) {
       // M: K with the fixed rows and columns made the identity, kept between factorizations (its pattern is K's,
       // which every assembly keeps) so that its storage is not allocated and first touched each time.
       const bool same_pattern = M.nonZeros() == K.nonZeros() && M.cols() == K.cols() &&
@@ -700,11 +764,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
           const int i = static_cast<int>(it.row());
           if (fixed[i] || fixed[j]) it.valueRef() = i == j ? 1.0 : 0.0;
         }
-      const int bad = solver->factorize(M);
-      if (bad >= 0)
-        throw Error("param: the map's system is not positive definite (unknown " + std::to_string(bad) + "); the mesh or the field is degenerate");
-      refactor = false;
-      ++q.factorizations;
+      factor(M);
+      refactor = refix = false;
     }
     return solver->solve(r);
   };
@@ -713,8 +774,9 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // --- (u, v) per corner, flips, stiffening ------------------------------------------------------------------
   Eigen::VectorXd y, x(nX);
   auto corner_uv = [&]() {
-    x = P * y;
+    x = P_rows * y;  // by rows: Eigen's product runs on OpenMP's threads for a large matrix
     out.uv.resize(3 * nF, 2);
+#pragma omp parallel for if (3 * nF >= linalg::kParallelMinElements)
     for (int c = 0; c < 3 * nF; ++c) out.uv(c, 0) = x[2 * wedge[c]], out.uv(c, 1) = x[2 * wedge[c] + 1];
   };
   auto uv_area = [&](int f) {
@@ -795,6 +857,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   };
   auto count_folds = [&]() {
     int n = 0;
+#pragma omp parallel for reduction(+ : n) if (nF >= linalg::kParallelMinElements)
     for (int f = 0; f < nF; ++f) n += folded(f);
     return n;
   };
@@ -1147,7 +1210,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     while (take < left.size() && whole_offset(y[left[take]]) < 1e-9) ++take;  // already whole: free to fix
     for (size_t k = 0; k < take; ++k) fixed[left[k]] = 1, value[left[k]] = std::round(y[left[k]]);
     if (!segments.empty()) keep_segments_open(std::vector<int>(left.begin(), left.begin() + static_cast<long>(take)));
-    refactor = true;
+    refix = true;
     left.erase(left.begin(), left.begin() + static_cast<long>(take));
     y = solve_fixed();
     ++q.rounding_rounds;
@@ -1176,6 +1239,22 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     e.quadratic << gu.dot(Kgu), gu.dot(Kgv), gv.dot(Kgu), gv.dot(Kgv);
     return e;
   };
+  // The same on the Schur route with every integer fixed, for the steps of integers ju and jv (−1: none): the
+  // slope (K y0 − b)_j from K's column j, the curvature from S; e0 left 0 (the same for every step compared).
+  auto energy_of_handles = [&](const Eigen::VectorXd& y0, int ju, int jv) {
+    EnergyAlong e;
+    e.e0 = 0;
+    const std::array<int, 2> j{ju, jv};
+    for (int c = 0; c < 2; ++c) {
+      e.linear[c] = 0;
+      if (j[c] < 0) continue;
+      e.linear[c] = -b[j[c]];
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, j[c]); it; ++it) e.linear[c] += it.value() * y0[it.row()];
+    }
+    for (int c = 0; c < 2; ++c)
+      for (int d = 0; d < 2; ++d) e.quadratic(c, d) = j[c] >= 0 && j[d] >= 0 ? S(int_rank[j[c]], int_rank[j[d]]) : 0.0;
+    return e;
+  };
   auto ring_is_bad = [&](int v) {
     for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
       const int f = t.vertex_faces[j];
@@ -1189,10 +1268,17 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   };
   // The response of the solution to a unit change of fixed value j (one solve with the current factorization).
   // Its right-hand side has a nonzero per neighbour of j: a sparse solve.
+  // (On the Schur route, where every integer is fixed by now, the reals' part is −K_rr⁻¹ K_rj with L_rr alone.)
   auto response = [&](int j) {
-    std::vector<std::pair<int, double>> r{{j, 1.0}};
+    std::vector<std::pair<int, double>> r;
     for (Eigen::SparseMatrix<double>::InnerIterator it(K, j); it; ++it)
       if (!fixed[it.row()]) r.emplace_back(static_cast<int>(it.row()), -it.value());
+    if (through_schur) {
+      Eigen::VectorXd g = solver->solve_rest_sparse(r);
+      g[j] = 1.0;
+      return g;
+    }
+    r.emplace_back(j, 1.0);
     return solver->solve_sparse(r);
   };
   // Descent on the integers: the greedy rounding fixes each integer on the map of its round, before the later
@@ -1215,8 +1301,12 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     std::vector<double> curvature;
     for (const auto& [bound, j] : order) {
       check_cancelled();
-      const Eigen::VectorXd gj = response(j);
-      if (const double c = gj.dot(K * gj); c > 0) candidates.push_back(j), curvature.push_back(c);
+      // c_j = g_jᵀ K g_j: S_jj on the Schur route (without a solve)
+      const double c = through_schur ? S(int_rank[j], int_rank[j]) : [&] {
+        const Eigen::VectorXd gj = response(j);
+        return gj.dot(K * gj);
+      }();
+      if (c > 0) candidates.push_back(j), curvature.push_back(c);
     }
     std::vector<char> refused(candidates.size(), 0);
     for (int moves = 0; moves < 2 * static_cast<int>(candidates.size()); ++moves) {
@@ -1300,7 +1390,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     // fixed value j (two solves with the current factorization, instead of one per candidate).
     respond(h);
     const Eigen::VectorXd y0 = y;
-    const EnergyAlong energy = energy_along(y0, h.gu, h.gv);
+    const EnergyAlong energy = through_schur ? energy_of_handles(y0, h.u, h.v) : energy_along(y0, h.gu, h.gv);
     std::pair<int, double> best{std::numeric_limits<int>::max(), std::numeric_limits<double>::infinity()};
     Eigen::Vector2d step(0, 0);
     for (auto [dx, dy] : steps(h)) {
