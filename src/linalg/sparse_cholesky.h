@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // src/linalg/sparse_cholesky.h (internal): a sparse symmetric positive definite solve, A x = b, for the
 // layers that need one without the trivial-connection solver's structure (the integer-grid map of
-// src/quad/). The order (AMD, through libamd), the symbolic analysis, the numeric factorization and the
-// substitutions are trivcon's (src/linalg/symbolic.h, supernodal.h, substitution.h), as for the connection and
-// the smoothest field; no CHOLMOD.
+// src/quad/). The order (AMD through libamd, or CAMD through libcamd with rows constrained last), the
+// symbolic analysis, the numeric factorization and the substitutions are trivcon's (src/linalg/symbolic.h,
+// supernodal.h, substitution.h), as for the connection and the smoothest field; no CHOLMOD.
 //
 // The pattern is analysed once; factorize() may be called again with new values on the same pattern (a
 // row and column replaced by the identity to fix an unknown keeps the pattern).

@@ -676,9 +676,10 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // function of the integers, the reals solved for them). When S is small beside the factor (the integers' m³
   // within a fifth of the factorization's flops), K is factored only when it changes: the integers' values come
   // from S (fixed ones held, free ones solving S_ff y_f = ĉ_f − S_fF v_F, ĉ = S x_i for x = K⁻¹ b), and the
-  // reals from one solve with K whose integer rows of the right-hand side are set to reproduce those values
-  // (S y_i + b_i − ĉ). Otherwise (many integers: a mesh with hundreds of singularities) the fixed rows and
-  // columns become the identity and the matrix is factored again after each change of the fixed set.
+  // reals from K_rr y_r = b_r − K_ri y_i with the factor's leading block L_rr (SparseCholesky::solve_rest; not
+  // from a solve with K itself, which S's near-null translations would spoil while few integers are held).
+  // Otherwise (many integers: a mesh with hundreds of singularities) the fixed rows and columns become the
+  // identity and the matrix is factored again after each change of the fixed set.
   auto solver = std::make_unique<linalg::SparseCholesky>(K, "param", integer_free);
   const int nInt = static_cast<int>(integer_free.size());
   const bool through_schur = nInt > 0 && std::pow(static_cast<double>(nInt), 3) <= 0.2 * solver->factor_flops();
