@@ -107,16 +107,23 @@ Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& b) const {
   return x;
 }
 
-Eigen::VectorXd SparseCholesky::solve_sparse(const std::vector<std::pair<int, double>>& entries) const {
+// The entries of a sparse right-hand side at their factor positions (those in rows of `last` left out with
+// `skip_last`), each row checked.
+std::vector<std::pair<int, double>> SparseCholesky::in_factor_order(const std::vector<std::pair<int, double>>& entries, bool skip_last) const {
   if (!state_->substitution) throw Error(state_->what + ": solve without a successful factorization");
-  std::vector<std::pair<int, double>> in_factor_order;
-  in_factor_order.reserve(entries.size());
+  std::vector<std::pair<int, double>> out;
+  out.reserve(entries.size());
   for (const auto& [row, value] : entries) {
     if (row < 0 || row >= n_) throw Error(state_->what + ": a right-hand side entry outside the matrix");
-    in_factor_order.emplace_back(state_->position[row], value);
+    if (!skip_last || !state_->is_last[row]) out.emplace_back(state_->position[row], value);
   }
+  return out;
+}
+
+Eigen::VectorXd SparseCholesky::solve_sparse(const std::vector<std::pair<int, double>>& entries) const {
+  const std::vector<std::pair<int, double>> in_factor = in_factor_order(entries, false);
   Eigen::VectorXd z = Eigen::VectorXd::Zero(n_), x(n_);
-  state_->substitution->forward_update(in_factor_order, z.data());
+  state_->substitution->forward_update(in_factor, z.data());
   state_->substitution->backward_in_factor_order(z.data());
   for (int k = 0; k < n_; ++k) x[state_->symbolic.perm[k]] = z[k];
   return x;
@@ -175,15 +182,9 @@ Eigen::VectorXd SparseCholesky::solve_rest(const Eigen::VectorXd& b) const {
 }
 
 Eigen::VectorXd SparseCholesky::solve_rest_sparse(const std::vector<std::pair<int, double>>& entries) const {
-  if (!state_->substitution) throw Error(state_->what + ": solve without a successful factorization");
-  std::vector<std::pair<int, double>> in_factor_order;
-  in_factor_order.reserve(entries.size());
-  for (const auto& [row, value] : entries) {
-    if (row < 0 || row >= n_) throw Error(state_->what + ": a right-hand side entry outside the matrix");
-    if (!state_->is_last[row]) in_factor_order.emplace_back(state_->position[row], value);
-  }
+  const std::vector<std::pair<int, double>> in_factor = in_factor_order(entries, true);
   Eigen::VectorXd z = Eigen::VectorXd::Zero(n_);
-  state_->substitution->forward_update(in_factor_order, z.data());
+  state_->substitution->forward_update(in_factor, z.data());
   return solve_rest_in_factor_order(*state_->substitution, state_->last_positions, state_->symbolic.perm, z);
 }
 

@@ -49,6 +49,7 @@ class SparseCholesky {
   int size() const { return n_; }
 
  private:
+  std::vector<std::pair<int, double>> in_factor_order(const std::vector<std::pair<int, double>>& entries, bool skip_last) const;
   struct State;
   std::unique_ptr<State> state_;
   int n_ = 0;

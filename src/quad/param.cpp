@@ -180,6 +180,30 @@ void hat_gradients(const std::array<Eigen::Vector2d, 3>& p, std::array<Eigen::Ve
   }
 }
 
+// The integers' values on the map's Schur route: those `held` at `held_value`, the others minimising
+// ½ yᵀ S y − ĉᵀ y with them held, S_ff y_f = ĉ_f − S_fh v_h (dense: S is the integers' Schur complement).
+Eigen::VectorXd integers_from_schur(const Eigen::MatrixXd& S, const Eigen::VectorXd& c_hat, const std::vector<char>& held,
+                                    const Eigen::VectorXd& held_value) {
+  const int m = static_cast<int>(S.rows());
+  std::vector<int> free_ints, held_ints;
+  for (int a = 0; a < m; ++a) (held[a] ? held_ints : free_ints).push_back(a);
+  Eigen::VectorXd y = held_value;
+  const int nf = static_cast<int>(free_ints.size());
+  if (nf == 0) return y;
+  Eigen::MatrixXd Sff(nf, nf);
+  Eigen::VectorXd rhs(nf);
+  for (int p = 0; p < nf; ++p) {
+    rhs[p] = c_hat[free_ints[p]];
+    for (int a : held_ints) rhs[p] -= S(free_ints[p], a) * held_value[a];
+    for (int r = 0; r < nf; ++r) Sff(r, p) = S(free_ints[r], free_ints[p]);
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(Sff);
+  if (llt.info() != Eigen::Success) throw Error("param: the integers' Schur complement is not positive definite; the mesh or the field is degenerate");
+  const Eigen::VectorXd yf = llt.solve(rhs);
+  for (int p = 0; p < nf; ++p) y[free_ints[p]] = yf[p];
+  return y;
+}
+
 double signed_area(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
   const Eigen::Vector2d e1 = b - a, e2 = c - a;
   return 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
@@ -715,25 +739,12 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         c_hat = S * xi;
         c_hat_stale = false;
       }
-      std::vector<int> free_ints, fixed_ints;
-      for (int a = 0; a < nInt; ++a) (fixed[integer_free[a]] ? fixed_ints : free_ints).push_back(a);
-      if (fixed_ints.empty()) return unconstrained;  // nothing held: K⁻¹ b itself
-      Eigen::VectorXd yi(nInt);
-      for (int a : fixed_ints) yi[a] = value[integer_free[a]];
-      if (!free_ints.empty()) {
-        const int nf = static_cast<int>(free_ints.size());
-        Eigen::MatrixXd Sff(nf, nf);
-        Eigen::VectorXd rhs(nf);
-        for (int p = 0; p < nf; ++p) {
-          rhs[p] = c_hat[free_ints[p]];
-          for (int a : fixed_ints) rhs[p] -= S(free_ints[p], a) * yi[a];
-          for (int r = 0; r < nf; ++r) Sff(r, p) = S(free_ints[r], free_ints[p]);
-        }
-        const Eigen::LLT<Eigen::MatrixXd> llt(Sff);
-        if (llt.info() != Eigen::Success) throw Error("param: the integers' Schur complement is not positive definite; the mesh or the field is degenerate");
-        const Eigen::VectorXd yf = llt.solve(rhs);
-        for (int p = 0; p < nf; ++p) yi[free_ints[p]] = yf[p];
-      }
+      std::vector<char> held(nInt, 0);
+      Eigen::VectorXd held_value = Eigen::VectorXd::Zero(nInt);
+      for (int a = 0; a < nInt; ++a)
+        if (fixed[integer_free[a]]) held[a] = 1, held_value[a] = value[integer_free[a]];
+      if (std::find(held.begin(), held.end(), 1) == held.end()) return unconstrained;  // nothing held: K⁻¹ b itself
+      const Eigen::VectorXd yi = integers_from_schur(S, c_hat, held, held_value);
       // The reals for those integers: K_rr y_r = b_r − K_ri y_i, with the factor's L_rr alone.
       Eigen::VectorXd r = b;
       for (int a = 0; a < nInt; ++a)
