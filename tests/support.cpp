@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "trivcon/constraints.h"
 #include "trivcon/io.h"
 #include "trivcon/error.h"
 
@@ -217,6 +218,16 @@ SolverOptions sparse_path_options() {
   SolverOptions options;
   options.max_dense_paths = 256;
   return options;
+}
+
+IndexPrescription aligned_cross_field(FieldDesigner& designer, const Mesh& m) {
+  IndexPrescription p;
+  p.N = 4;
+  p.fixed = boundary_alignment(m.V, designer.topology(), designer.geometry());
+  std::vector<int> fixed;
+  for (auto [f, angle] : p.fixed) fixed.push_back(f);
+  designer.set_fixed_faces(fixed);
+  return p;
 }
 
 Mesh unwelded_sphere(int rings, int segments) {

@@ -76,6 +76,9 @@ Mesh unwelded_sphere(int rings, int segments);
 // Solver options that send more than 256 fixed-face paths down the sparse route (SolverOptions::max_dense_paths),
 // for the tests of that route on meshes of a few hundred paths.
 SolverOptions sparse_path_options();
+// A cross field with the boundary aligned (every face with a boundary edge fixed to it), its fixed faces set on
+// the designer; no singularities yet.
+IndexPrescription aligned_cross_field(FieldDesigner& designer, const Mesh& m);
 
 // Checks every structural invariant of a Topology against F (the input) alone. Cheap: O(F log F).
 void expect_consistent(const Topology& t, const MatrixX3i& F_in, int nv, const std::string& what);

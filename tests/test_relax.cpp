@@ -28,16 +28,7 @@ std::multiset<int> indices_of(const IndexPrescription& p) {
   return out;
 }
 
-// A cross field with the boundary aligned (every face with a boundary edge fixed to it), set on the designer.
-IndexPrescription aligned_cross_field(FieldDesigner& designer, const Mesh& m) {
-  IndexPrescription p;
-  p.N = 4;
-  p.fixed = boundary_alignment(m.V, designer.topology(), designer.geometry());
-  std::vector<int> fixed;
-  for (auto [f, angle] : p.fixed) fixed.push_back(f);
-  designer.set_fixed_faces(fixed);
-  return p;
-}
+using test::aligned_cross_field;
 
 // What every relaxation must satisfy: strictly decreasing energies ending at the real energy of the result,
 // a verified design, the same indices (less cancelled pairs), boundary vertices empty, pins unmoved.

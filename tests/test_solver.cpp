@@ -485,6 +485,42 @@ TEST(Solver, ChosenCycleIndicesAreLocallyOptimal) {
   }
 }
 
+// The energy alone (ConnectionSolver::energy, the forward half of a solve) equals the solve's energy: with
+// generators chosen and prescribed, with fixed-face paths in the dense block and among the vertex rows (the
+// sparse route), and on a sphere with a singularity of large index.
+TEST(Solver, EnergyAloneEqualsTheSolvesEnergy) {
+  auto expect_same = [](const FieldDesigner& d, const IndexPrescription& p) {
+    const double solved = d.solver().solve(p).energy, alone = d.solver().energy(p);
+    EXPECT_NEAR(alone, solved, 1e-10 * std::max(1.0, solved));
+  };
+  {  // genus 2: generator indices chosen, then one prescribed
+    const Mesh m = subdivide_midpoint(make_genus_surface(2, 2));
+    FieldDesigner d(m.V, m.F);
+    IndexPrescription p = gauss_bonnet_prescription(d.topology(), 4);
+    expect_same(d, p);
+    p.generator[1] = 3;
+    expect_same(d, p);
+  }
+  {  // a sphere: +1 and a +1/4 spread
+    const Mesh m = make_icosphere(3);
+    FieldDesigner d(m.V, m.F);
+    IndexPrescription p;
+    p.N = 4;
+    const std::vector<int> v = spread_interior_vertices(d.topology(), 5);
+    p.vertex = {{v[0], 4}, {v[1], 1}, {v[2], 1}, {v[3], 1}, {v[4], 1}};
+    expect_same(d, p);
+  }
+  for (bool sparse : {false, true}) {  // an aligned disk: fixed-face paths, dense and among the vertex rows
+    const Mesh m = make_disk(50, 6);
+    FieldDesigner d(m.V, m.F, sparse ? test::sparse_path_options() : SolverOptions{});
+    IndexPrescription p = test::aligned_cross_field(d, m);
+    p.vertex = {{0, 1}, {100, 1}, {500, 1}, {2000, 1}};
+    expect_same(d, p);
+    p.vertex = {{0, 1}, {101, 1}, {500, 1}, {2000, 1}, {300, 1}, {800, -1}};
+    expect_same(d, p);
+  }
+}
+
 // Prescribed generator turning: the field spins k times along the generator.
 TEST(Solver, PrescribedGeneratorIndexIsRealised) {
   const Mesh m = make_torus(80, 40);

@@ -130,6 +130,10 @@ class ConnectionSolver {
 
   // Validates the prescription and returns the connection. Only right-hand sides change per call.
   Connection solve(const IndexPrescription& prescription) const;
+  // The energy of that connection (Connection::energy) without the connection itself: the forward half of the
+  // substitution only, for ranking many prescriptions (the relaxation's candidates). It equals solve()'s energy
+  // up to round-off, before solve()'s iterative refinement (which only meshes of extreme weights need).
+  double energy(const IndexPrescription& prescription) const;
   // The Lagrange multipliers of the vertex rows for a connection this solver returned, per vertex:
   // λ = (A W Aᵀ)⁻¹ A x restricted to them, 0 where a vertex has no row (boundary and unreferenced vertices,
   // each closed component's dropped vertex). With the cycle rows' right-hand sides held at those the

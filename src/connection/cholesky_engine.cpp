@@ -298,6 +298,20 @@ class CholeskyEngine : public SolverEngine {
   Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const override {
     const int n = nD + nC;
     if (n == 0) return Eigen::VectorXd::Zero(m);
+    Eigen::VectorXd y = forward_with_cycles(b_D, choose);  // [λ; μ] in factor order, after the backward half
+    backward(y);
+    return edge_values(y);
+  }
+
+  // Σ x²/w = yᵀ L Lᵀ y = ‖Lᵀ y‖² = ‖z‖² for z = L⁻¹ Π b, the forward half's result.
+  double energy(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const override {
+    if (nD + nC == 0) return 0;
+    return forward_with_cycles(b_D, choose).squaredNorm();
+  }
+
+  // z = L⁻¹ Π [b_D; b_C] with b_C from `choose`.
+  Eigen::VectorXd forward_with_cycles(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const {
+    const int n = nD + nC;
     // Forward substitution with b_C = 0: z_D is final; z_C = z_C0 + R_CC⁻¹ b_C for any b_C (the cycle
     // rows come last, in their own order, so positions ≥ nD of Πb are b_C). When b_D differs from the
     // base in few rows, z = base_z + L⁻¹ Π (b_D − base_b) touches only their paths in the tree.
@@ -318,9 +332,7 @@ class CholeskyEngine : public SolverEngine {
       const Eigen::VectorXd b_C = choose(-(R_CC * z_C0));  // the energy ‖z‖² is least at b_C = −R_CC z_C0
       z.tail(nC) = z_C0 + R_CC.triangularView<Eigen::Lower>().solve(b_C);
     }
-    Eigen::VectorXd& y = z;  // [λ; μ] in factor order
-    backward(y);
-    return edge_values(y);
+    return z;
   }
 
   bool refine(const Eigen::VectorXd& b, Eigen::VectorXd& x) const override {

@@ -120,6 +120,11 @@ struct ConnectionSolver::Impl {
   struct CycleRhs;
   CycleRhs cycle_rhs(const IndexPrescription& prescription) const;
   Eigen::VectorXd round_sparse_path_turns(const IndexPrescription& prescription, const Eigen::VectorXd& b_D, Eigen::VectorXd& n_E) const;
+  struct Rhs;
+  Rhs rhs_of(const IndexPrescription& prescription) const;
+  // What a solve asks for the cycle rows, given r₀ (the real b_C of least energy): the cycle indices n_C moved to
+  // the nearest point of their lattice, and b_C = H − step n_C (both written to `rhs`).
+  connection::SolverEngine::CycleRhsChooser cycle_chooser(Rhs& rhs) const;
   Connection result(const IndexPrescription& prescription, const Eigen::VectorXd& x_active, const CycleRhs& cycle,
                     const Eigen::VectorXd& n_C, const Eigen::VectorXd& n_E) const;
 };
@@ -389,6 +394,37 @@ struct ConnectionSolver::Impl::CycleRhs {
   std::vector<int> component_vertex_sum;  // Σ n of the prescribed vertices, per component
 };
 
+// A prescription's right-hand sides: the vertex rows' b (with the sparse route's path rows, their turns n_E),
+// the cycle rows' holonomy, and the cycle indices and right-hand sides a solve fills in (n_C, b_C).
+struct ConnectionSolver::Impl::Rhs {
+  double step = 0;
+  CycleRhs cycle;
+  Eigen::VectorXd b, n_C, n_E, b_C;
+};
+
+// Checked against the mesh and the fixed faces first.
+ConnectionSolver::Impl::Rhs ConnectionSolver::Impl::rhs_of(const IndexPrescription& prescription) const {
+  validate_prescription(topology, num_generators(), prescription);
+  check_fixed_angles(prescription);
+  Rhs r;
+  r.step = 2 * kPi / prescription.N;
+  const Eigen::VectorXd b_D = vertex_rhs(prescription);
+  r.cycle = cycle_rhs(prescription);
+  r.n_C = r.cycle.n0;
+  r.b = sparse_paths ? round_sparse_path_turns(prescription, b_D, r.n_E) : b_D;
+  return r;
+}
+
+connection::SolverEngine::CycleRhsChooser ConnectionSolver::Impl::cycle_chooser(Rhs& rhs) const {
+  return [this, &rhs](const Eigen::VectorXd& r0) {
+    const CycleRhs& cycle = rhs.cycle;
+    const Eigen::VectorXd u = (cycle.H - r0) / rhs.step;
+    rhs.n_C += cycle.M * connection::nearest_lattice_point(*engine, u, cycle.n0, cycle.M, cycle.identity).cast<double>();
+    rhs.b_C = cycle.H - rhs.step * rhs.n_C;
+    return rhs.b_C;
+  };
+}
+
 void ConnectionSolver::Impl::check_fixed_angles(const IndexPrescription& prescription) const {
   if (prescription.fixed.size() != fixed_faces.size() ||
       !std::equal(fixed_faces.begin(), fixed_faces.end(), prescription.fixed.begin(), [](int f, const auto& kv) { return f == kv.first; }))
@@ -506,21 +542,11 @@ Eigen::VectorXd ConnectionSolver::Impl::round_sparse_path_turns(const IndexPresc
 
 Connection ConnectionSolver::solve(const IndexPrescription& prescription) const {
   const Impl& s = *impl_;
-  validate_prescription(s.topology, s.num_generators(), prescription);
-  s.check_fixed_angles(prescription);
-  const double step = 2 * kPi / prescription.N;
-  const Eigen::VectorXd b_D = s.vertex_rhs(prescription);
-  const Impl::CycleRhs cycle = s.cycle_rhs(prescription);
-  Eigen::VectorXd n_C = cycle.n0;
-  Eigen::VectorXd n_E;  // path turns, when the path rows are sparse
-  const Eigen::VectorXd b = s.sparse_paths ? s.round_sparse_path_turns(prescription, b_D, n_E) : b_D;
-  Eigen::VectorXd b_C;
-  Eigen::VectorXd x_active = s.engine->solve(b, [&](const Eigen::VectorXd& r0) {
-    const Eigen::VectorXd u = (cycle.H - r0) / step;
-    n_C += cycle.M * connection::nearest_lattice_point(*s.engine, u, cycle.n0, cycle.M, cycle.identity).cast<double>();
-    b_C = cycle.H - step * n_C;
-    return b_C;
-  });
+  Impl::Rhs r = s.rhs_of(prescription);
+  const Eigen::VectorXd& b = r.b;
+  Eigen::VectorXd x_active = s.engine->solve(b, s.cycle_chooser(r));
+  const Eigen::VectorXd &n_C = r.n_C, &n_E = r.n_E, &b_C = r.b_C;
+  const Impl::CycleRhs& cycle = r.cycle;
   Connection connection = s.result(prescription, x_active, cycle, n_C, n_E);
   // Iterative refinement, only when the residual asks for it: on meshes whose weights span many orders
   // of magnitude (slivers, needles) one substitution with A W Aᵀ can leave a residual far above round-off.
@@ -539,6 +565,13 @@ Connection ConnectionSolver::solve(const IndexPrescription& prescription) const 
     connection = std::move(better), x_active = std::move(refined);
   }
   return connection;
+}
+
+double ConnectionSolver::energy(const IndexPrescription& prescription) const {
+  const Impl& s = *impl_;
+  Impl::Rhs r = s.rhs_of(prescription);
+  const double e = s.engine->energy(r.b, s.cycle_chooser(r));
+  return e >= 0 ? e : solve(prescription).energy;
 }
 
 // x on every edge, the indices used (the dropped loop's from Gauss–Bonnet), the energy, and the

@@ -19,6 +19,9 @@ class SolverEngine {
   // asked from `choose`, given r₀: the real b_C that minimises the energy for this b_D.
   using CycleRhsChooser = std::function<Eigen::VectorXd(const Eigen::VectorXd& r0)>;
   virtual Eigen::VectorXd solve(const Eigen::VectorXd& b_D, const CycleRhsChooser& choose) const = 0;
+  // The energy Σ x²/w of that solution without x: ‖L⁻¹ Π b‖² after the forward substitution (the backward half
+  // and x are not needed). A negative value on a route that cannot (QR): the caller solves instead.
+  virtual double energy(const Eigen::VectorXd& /*b_D*/, const CycleRhsChooser& /*choose*/) const { return -1; }
 
   // P = S⁻¹ = ((A W Aᵀ)⁻¹) restricted to the cycle rows: the energy's quadratic form in their right-hand sides.
   virtual Eigen::VectorXd apply_P(const Eigen::VectorXd& v) const = 0;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <utility>
 #include <string>
 
@@ -344,8 +345,12 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
       }
       IndexPrescription p = r.prescription;
       apply(move, p);
-      Connection next = solver.solve(p);
-      const double next_objective = objective(next);
+      // A candidate is ranked by its energy alone (ConnectionSolver::energy: the forward half of a solve); the
+      // move taken is solved in full below. With the periods the objective needs the connection itself, and
+      // where the solves need iterative refinement (extreme weights) the energy alone is not as exact as theirs.
+      std::optional<Connection> next;
+      if (periods.used() || current.refinements > 0) next = solver.solve(p);
+      const double next_objective = next ? objective(*next) : solver.energy(p);
       ++r.candidates_evaluated;
       const double c = step * move.index;
       const double second = std::max(0.0, (next_objective - current_objective - move.first_order) / (c * c));
@@ -359,9 +364,10 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
       }
       measured[key(move)] = second;
       if (!(next_objective < current_objective - kRelativeDecrease * std::abs(current_objective))) continue;
+      if (!next) next = solver.solve(p);
       r.prescription = std::move(p);
-      current = std::move(next);
-      current_objective = next_objective;
+      current = std::move(*next);
+      current_objective = objective(current);
       r.moves.push_back({move.from, move.to, move.index, current_objective, move.cancels});
       r.energies.push_back(current_objective);
       moved = true;
