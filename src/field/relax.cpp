@@ -155,8 +155,42 @@ Periods make_periods(const FieldDesigner& designer, double weight) {
   return p;
 }
 
+// The distances from a vertex x to the nearest singular vertex other than `self` below the separation
+// (candidates_of's `nearest_other`), kept between the relaxation's rounds: one depends only on the singular
+// vertices within the separation of x, so a move forgets those of the vertices near its two ends (and those of
+// a singularity that moved).
+class SeparationCache {
+ public:
+  explicit SeparationCache(int num_vertices) : by_x_(num_vertices), xs_of_self_(num_vertices) {}
+  const double* find(int x, int self) const {
+    for (const auto& [s, d] : by_x_[x])
+      if (s == self) return &d;
+    return nullptr;
+  }
+  void add(int x, int self, double d) { by_x_[x].emplace_back(self, d), xs_of_self_[self].push_back(x); }
+  // After a move between `a` and `b` (or a cancellation of both): every value near either, and every value of a
+  // singularity at either.
+  void forget(const MatrixX3d& V, const Topology& t, double separation, int a, int b) {
+    std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
+    for (int z : {a, b}) {
+      // Slightly beyond the separation and inclusive: the distance from z and from x may differ in the last bit.
+      field::edge_dijkstra(V, t, z, separation * (1 + 1e-9), true, dist, [&](int x, double) {
+        by_x_[x].clear();
+        return true;
+      });
+      for (int x : xs_of_self_[z]) by_x_[x].erase(std::remove_if(by_x_[x].begin(), by_x_[x].end(), [&](const auto& e) { return e.first == z; }), by_x_[x].end());
+      xs_of_self_[z].clear();
+    }
+  }
+
+ private:
+  std::vector<std::vector<std::pair<int, double>>> by_x_;
+  std::vector<std::vector<int>> xs_of_self_;
+};
+
 std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const IndexPrescription& prescription,
-                                          const Connection& connection, const RelaxOptions& options, const Periods& periods);
+                                          const Connection& connection, const RelaxOptions& options, const Periods& periods,
+                                          SeparationCache* cache = nullptr);
 
 }  // namespace
 
@@ -170,7 +204,8 @@ std::vector<RelaxCandidate> relax_candidates(const FieldDesigner& designer, cons
 namespace {
 
 std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const IndexPrescription& prescription,
-                                          const Connection& connection, const RelaxOptions& options, const Periods& periods) {
+                                          const Connection& connection, const RelaxOptions& options, const Periods& periods,
+                                          SeparationCache* cache) {
   const Topology& t = designer.topology();
   const std::vector<char> pinned = pinned_vertices(t, options);
   const ConnectionSolver& solver = designer.solver();
@@ -219,15 +254,18 @@ std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const I
   };
   auto other_end = [&](int e, int v) { return t.edge_vertices(e, 0) == v ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0); };
   // With a separation: the distance (along edges, below the separation) from x to the nearest singular vertex
-  // other than `self`; the separation when there is none that close.
+  // other than `self`; the separation when there is none that close (kept in `cache` between rounds).
   std::vector<double> dist(options.separation > 0 ? t.num_vertices : 0, std::numeric_limits<double>::infinity());
   auto nearest_other = [&](int x, int self) {
+    if (cache)
+      if (const double* known = cache->find(x, self)) return *known;
     double found = options.separation;
     field::edge_dijkstra(designer.V(), t, x, options.separation, false, dist, [&](int y, double d) {
       if (found < options.separation) return false;  // found (nearest first): expand nothing more
       if (y != self && index_at(prescription, y) != 0) found = d;
       return found == options.separation;
     });
+    if (cache) cache->add(x, self, found);
     return found;
   };
   std::vector<int> seen(t.num_vertices, -1), frontier, next;
@@ -291,6 +329,7 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
     if (P) *P = p;
     return c.energy + periods.weight * p;
   };
+  SeparationCache separation(designer.topology().num_vertices);
   Connection current = solver.solve(start);
   double current_objective = objective(current, &r.periods_before);
   r.energy_before = current.energy;
@@ -313,7 +352,7 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
   bool held = solver.fixed_paths().empty();
   for (int g = 0; g < static_cast<int>(cycles.generators.size()); ++g) held = held && start.generator.count(g);
   while (static_cast<int>(r.moves.size()) < options.max_moves) {
-    std::vector<RelaxCandidate> candidates = candidates_of(designer, r.prescription, current, options, periods);
+    std::vector<RelaxCandidate> candidates = candidates_of(designer, r.prescription, current, options, periods, &separation);
     for (RelaxCandidate& m : candidates)
       if (const auto it = measured.find(key(m)); it != measured.end()) {
         const double c = step * m.index;
@@ -366,6 +405,7 @@ RelaxResult relax(const FieldDesigner& designer, const IndexPrescription& start,
       if (!(next_objective < current_objective - kRelativeDecrease * std::abs(current_objective))) continue;
       if (!next) next = solver.solve(p);
       r.prescription = std::move(p);
+      if (options.separation > 0) separation.forget(designer.V(), designer.topology(), options.separation, move.from, move.to);
       current = std::move(*next);
       current_objective = objective(current);
       r.moves.push_back({move.from, move.to, move.index, current_objective, move.cancels});
