@@ -860,3 +860,24 @@ TEST(Symbolic, TimeAgainstCholmodOnAScan) {
   print_times({"face Laplacian, dragon_vrip (871k faces)", face_laplacian(dragon)});
 }
 #endif
+
+// The cycle block's inverse (src/connection/cholesky_engine.cpp): R⁻¹ R = I for a lower triangular R of a
+// size where dtrtri blocks, its strict upper triangle untouched; a zero on the diagonal is reported.
+TEST(Symbolic, LowerTriangularInverse) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> entry(-1.0, 1.0);
+  const int n = 300;
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(n, n);
+  for (int j = 0; j < n; ++j) {
+    R(j, j) = 2.0 + entry(rng);
+    for (int i = j + 1; i < n; ++i) R(i, j) = entry(rng) / n;
+  }
+  Eigen::MatrixXd inverse = R;
+  ASSERT_TRUE(linalg::invert_lower_triangular(inverse));
+  EXPECT_LT((inverse * R - Eigen::MatrixXd::Identity(n, n)).lpNorm<Eigen::Infinity>(), 1e-12);
+  for (int j = 1; j < n; ++j)
+    for (int i = 0; i < j; ++i) ASSERT_EQ(inverse(i, j), 0.0);
+  Eigen::MatrixXd singular = R;
+  singular(n / 2, n / 2) = 0;
+  EXPECT_FALSE(linalg::invert_lower_triangular(singular));
+}

@@ -218,7 +218,8 @@ class CholeskyEngine : public SolverEngine {
         throw Error(
             "the holonomy of the generators, boundary loops or fixed-direction paths is nearly undetermined with these weights "
             "(ill-conditioned Schur complement); try --weights unit");
-      R_inv = R_CC.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(nC, nC));
+      R_inv = R_CC;  // its upper triangle is 0 (extract_cycle_block), and stays so
+      if (!linalg::invert_lower_triangular(R_inv)) throw Error("internal error: the cycle block's factor has a zero diagonal entry");
       P_diagonal_ = R_inv.colwise().squaredNorm().transpose();
     }
   }

@@ -27,6 +27,7 @@ void dgemm_(const char* transa, const char* transb, const int* m, const int* n, 
 void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n, const double* alpha,
             const double* a, const int* lda, double* b, const int* ldb);
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+void dtrtri_(const char* uplo, const char* diag, const int* n, double* a, const int* lda, int* info);
 // Complex (the smoothest-field matrix of trivcon/auto.h): std::complex<double> is layout-compatible with
 // Fortran's COMPLEX*16.
 void zherk_(const char* uplo, const char* trans, const int* n, const int* k, const double* alpha, const std::complex<double>* a,
@@ -468,6 +469,15 @@ int factorize(const SymbolicFactor& L, FactorValues<double>& x, const std::vecto
 int factorize_complex(const SymbolicFactor& L, FactorValues<Complex>& x, const std::vector<int>& outer, const std::vector<int>& inner,
                       const std::vector<double>& values) {
   return factorize_own<Complex>(L, x, outer, inner, reinterpret_cast<const Complex*>(values.data()));
+}
+
+bool invert_lower_triangular(Eigen::MatrixXd& R) {
+  if (R.rows() != R.cols()) throw Error("invert_lower_triangular: the matrix is not square");
+  const int n = static_cast<int>(R.rows());
+  if (n == 0) return true;
+  int info = 0;
+  dtrtri_("L", "N", &n, R.data(), &n, &info);
+  return info == 0;
 }
 
 }  // namespace trivcon::linalg

@@ -121,4 +121,8 @@ int factorize(const SymbolicFactor& L, FactorValues<double>& x, const std::vecto
 int factorize_complex(const SymbolicFactor& L, FactorValues<std::complex<double>>& x, const std::vector<int>& outer,
                       const std::vector<int>& inner, const std::vector<double>& values);
 
+// R ← R⁻¹ for a square lower triangular R (its strict upper triangle is neither read nor written): LAPACK's
+// dtrtri, blocked, on OpenBLAS's threads. Returns false, R partly overwritten, if a diagonal entry is 0.
+bool invert_lower_triangular(Eigen::MatrixXd& R);
+
 }  // namespace trivcon::linalg
