@@ -248,17 +248,13 @@ class CholeskyEngine : public SolverEngine {
 
   // R_CC: the factor's entries at rows and columns ≥ nD (in factor order), read from the supernodes.
   void extract_cycle_block() {
-    R_CC = Eigen::MatrixXd::Zero(nC, nC);
-    if (nC == 0) return;
-    const Supernodes L = supernodes();
-    for (int s = 0; s < L.count; ++s) {
-      const auto Ls = L.values(s);
-      for (int c = 0; c < L.cols(s); ++c) {
-        const int col = L.first(s) + c;
-        if (col < nD) continue;
-        for (int r = c; r < L.height(s); ++r) R_CC(L.row(s, r) - nD, col - nD) = Ls(r, c);
-      }
+    if (nC == 0) {
+      R_CC.resize(0, 0);
+      return;
     }
+    std::vector<int> place(nD + nC, -1);
+    for (int k = nD; k < nD + nC; ++k) place[k] = k - nD;
+    R_CC = linalg::trailing_block(supernodes(), place, nC);
   }
 
   // L⁻¹ b (in factor order), for a right-hand side that is not an update of the base one: the forward half of

@@ -161,7 +161,8 @@ Periods make_periods(const FieldDesigner& designer, double weight) {
 // a singularity that moved).
 class SeparationCache {
  public:
-  explicit SeparationCache(int num_vertices) : by_x_(num_vertices), xs_of_self_(num_vertices) {}
+  explicit SeparationCache(int num_vertices)
+      : by_x_(num_vertices), xs_of_self_(num_vertices), dist_(num_vertices, std::numeric_limits<double>::infinity()) {}
   const double* find(int x, int self) const {
     for (const auto& [s, d] : by_x_[x])
       if (s == self) return &d;
@@ -171,10 +172,9 @@ class SeparationCache {
   // After a move between `a` and `b` (or a cancellation of both): every value near either, and every value of a
   // singularity at either.
   void forget(const MatrixX3d& V, const Topology& t, double separation, int a, int b) {
-    std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
     for (int z : {a, b}) {
       // Slightly beyond the separation and inclusive: the distance from z and from x may differ in the last bit.
-      field::edge_dijkstra(V, t, z, separation * (1 + 1e-9), true, dist, [&](int x, double) {
+      field::edge_dijkstra(V, t, z, separation * (1 + 1e-9), true, dist_, [&](int x, double) {
         by_x_[x].clear();
         return true;
       });
@@ -186,6 +186,7 @@ class SeparationCache {
  private:
   std::vector<std::vector<std::pair<int, double>>> by_x_;
   std::vector<std::vector<int>> xs_of_self_;
+  std::vector<double> dist_;  // edge_dijkstra's work vector (infinities between calls)
 };
 
 std::vector<RelaxCandidate> candidates_of(const FieldDesigner& designer, const IndexPrescription& prescription,

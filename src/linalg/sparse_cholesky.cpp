@@ -131,26 +131,11 @@ Eigen::VectorXd SparseCholesky::solve_sparse(const std::vector<std::pair<int, do
 
 Eigen::MatrixXd SparseCholesky::schur_complement() const {
   if (!state_->substitution) throw Error(state_->what + ": Schur complement without a successful factorization");
-  const SymbolicFactor& L = state_->symbolic;
   const int m = static_cast<int>(state_->last.size());
-  std::vector<int> rank(n_, -1);  // per factor row, its place in `last`
-  for (int a = 0; a < m; ++a) rank[state_->last_positions[a]] = a;
-  // L_ll, column by column of the factor: below a column of `last` every row is one of them (the analysis).
-  Eigen::MatrixXd Lll = Eigen::MatrixXd::Zero(m, m);
-  for (int sn = 0; sn < L.nsuper; ++sn) {
-    const int height = L.pi[sn + 1] - L.pi[sn];
-    for (int k = L.super[sn]; k < L.super[sn + 1]; ++k) {
-      const int a = rank[k];
-      if (a < 0) continue;
-      const int c = k - L.super[sn];
-      const double* column = state_->x.data() + L.px[sn] + static_cast<size_t>(c) * height;
-      for (int r = c; r < height; ++r) {
-        const int b = rank[L.s[L.pi[sn] + r]];
-        if (b < 0) throw Error(state_->what + ": internal error: a row below the rows ordered last");
-        Lll(b, a) = column[r];
-      }
-    }
-  }
+  std::vector<int> place(n_, -1);  // per factor position, its place in `last`
+  for (int a = 0; a < m; ++a) place[state_->last_positions[a]] = a;
+  // L_ll: below a column of `last` every row is one of them (the analysis checked).
+  const Eigen::MatrixXd Lll = trailing_block(Supernodes(state_->symbolic, state_->x.data()), place, m);
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(m, m);
   S.selfadjointView<Eigen::Lower>().rankUpdate(Lll);
   return S.selfadjointView<Eigen::Lower>();

@@ -471,6 +471,23 @@ int factorize_complex(const SymbolicFactor& L, FactorValues<Complex>& x, const s
   return factorize_own<Complex>(L, x, outer, inner, reinterpret_cast<const Complex*>(values.data()));
 }
 
+Eigen::MatrixXd trailing_block(const Supernodes& L, const std::vector<int>& place, int m) {
+  Eigen::MatrixXd block = Eigen::MatrixXd::Zero(m, m);
+  for (int s = 0; s < L.count; ++s) {
+    const auto Ls = L.values(s);
+    for (int c = 0; c < L.cols(s); ++c) {
+      const int a = place[L.first(s) + c];
+      if (a < 0) continue;
+      for (int r = c; r < L.height(s); ++r) {
+        const int b = place[L.row(s, r)];
+        if (b < 0) throw Error("internal error: a factor row below the trailing block's columns is outside it");
+        block(b, a) = Ls(r, c);
+      }
+    }
+  }
+  return block;
+}
+
 bool invert_lower_triangular(Eigen::MatrixXd& R) {
   if (R.rows() != R.cols()) throw Error("invert_lower_triangular: the matrix is not square");
   const int n = static_cast<int>(R.rows());

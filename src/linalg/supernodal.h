@@ -98,6 +98,11 @@ struct Supernodes {
 // Parent of each supernode in the supernodal elimination tree (−1 at a root), given owners().
 std::vector<int> supernode_parents(const Supernodes& L, const std::vector<int>& owner);
 
+// The factor's block at the columns k with place[k] ≥ 0 (factor positions; m of them) and the same rows, dense:
+// block(place[i], place[j]) = L(i, j). Every row below such a column must be one of them (they are the top of
+// the elimination tree, as an order with them constrained last leaves them; a trivcon::Error otherwise).
+Eigen::MatrixXd trailing_block(const Supernodes& L, const std::vector<int>& place, int m);
+
 #ifdef TRIVCON_WITH_SUITESPARSE
 // Computes the numeric LLᵀ factor in L (a supernodal symbolic factor from cholmod_analyze_p, with its
 // permutation L.Perm) of the symmetric n × n matrix whose upper triangle is given in compressed columns

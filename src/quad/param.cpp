@@ -836,6 +836,12 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       if (const double ratio = distortion(f); !folded(f) && std::isfinite(ratio)) sum += face_area[f] * ratio, mapped += face_area[f];
     return mapped > 0 ? sum / mapped : 0.0;
   };
+  auto count_folds = [&]() {
+    int n = 0;
+#pragma omp parallel for reduction(+ : n) if (nF >= linalg::kParallelMinElements)
+    for (int f = 0; f < nF; ++f) n += folded(f);
+    return n;
+  };
   // Stiffening (MIQ, Bommes et al. 2009, §5): while faces fold, each face weighs more by its distortion, so that
   // it keeps its shape and the distortion spreads over its neighbours; a folded face counts as very distorted.
   // Before the rounding (on the real-valued map, so that the integers are chosen on a map without folds) and
@@ -844,8 +850,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     int fewest = std::numeric_limits<int>::max(), stalled = 0;
     for (int round = 0; round < rounds; ++round) {
       check_cancelled();
-      int folds = 0;
-      for (int f = 0; f < nF; ++f) folds += folded(f);
+      const int folds = count_folds();
       if (folds <= few) return;
       // Stop when `patience` rounds in a row found no fewer folds than `gain` times the fewest before them (a
       // round that removes less is not progress: each is a factorization), or after three rounds when more
@@ -866,12 +871,6 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       corner_uv();
       ++q.stiffening_rounds;
     }
-  };
-  auto count_folds = [&]() {
-    int n = 0;
-#pragma omp parallel for reduction(+ : n) if (nF >= linalg::kParallelMinElements)
-    for (int f = 0; f < nF; ++f) n += folded(f);
-    return n;
   };
 
   const auto t2 = linalg::Clock::now();
