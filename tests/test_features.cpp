@@ -449,6 +449,56 @@ TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
   EXPECT_EQ(alone, (std::map<int, int>{{junction, -1}}));
 }
 
+TEST(FeatureAlignment, SingularitiesMovedOntoALineKeepTheirSeparation) {
+  // Two −1/4 three edges apart, one edge below a straight feature line (a 12×12 grid, the line at y = 1/2): each
+  // moves onto the line vertex above it, three edges from the other. With a separation of 3.5 edges the second
+  // goes to a line vertex at least that far from the first, or stays: two singularities a fraction of a unit
+  // apart on one line are rounded onto one integer point.
+  const int n = 12;
+  const Mesh m = make_holed_grid(n, 0);
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  auto at = [&](int x, int y) {
+    for (int v = 0; v < m.V.rows(); ++v)
+      if (std::abs(m.V(v, 0) * n - x) < 1e-9 && std::abs(m.V(v, 1) * n - y) < 1e-9) return v;
+    ADD_FAILURE() << "no vertex at " << x << ", " << y;
+    return -1;
+  };
+  std::vector<int> edges;
+  for (int e = 0; e < t.num_edges; ++e) {
+    const Eigen::Vector3d a = m.V.row(t.edge_vertices(e, 0)), b = m.V.row(t.edge_vertices(e, 1));
+    if (std::abs(a.y() - 0.5) < 1e-12 && std::abs(b.y() - 0.5) < 1e-12 && std::min(a.x(), b.x()) > 0.5 / n &&
+        std::max(a.x(), b.x()) < 1 - 0.5 / n)
+      edges.push_back(e);
+  }
+  ASSERT_EQ(edges.size(), static_cast<size_t>(n - 2));
+  const int a = at(3, n / 2 - 1), b = at(6, n / 2 - 1);
+  const std::map<int, int> given{{a, -1}, {b, -1}};
+  auto on_line = [&](int v) { return std::abs(m.V(v, 1) - 0.5) < 1e-12; };
+  // Without a separation: both onto the line, three edges apart.
+  std::map<int, int> close = given;
+  FeatureAlignment near = feature_alignment(m.V, t, designer.geometry(), edges, 4);
+  move_singularities_onto_features(m.V, t, designer.geometry(), edges, 4, 3.0 / n, false, close, near);
+  ASSERT_EQ(close.size(), 2u);
+  ASSERT_EQ(near.snapped.size(), 2u);
+  EXPECT_NEAR((m.V.row(close.begin()->first) - m.V.row(std::next(close.begin())->first)).norm(), 3.0 / n, 1e-12);
+  // With it: the first moves as before; the second keeps 3.5 edges from it along the line, or stays.
+  std::map<int, int> apart = given;
+  FeatureAlignment far = feature_alignment(m.V, t, designer.geometry(), edges, 4);
+  move_singularities_onto_features(m.V, t, designer.geometry(), edges, 4, 3.0 / n, false, apart, far, 3.5 / n);
+  ASSERT_EQ(apart.size(), 2u);
+  ASSERT_GE(far.snapped.size(), 1u);
+  EXPECT_EQ(far.snapped[0].to, near.snapped[0].to);
+  for (auto [v, k] : apart) EXPECT_EQ(k, -1);
+  const int p = apart.begin()->first, q = std::next(apart.begin())->first;
+  if (on_line(p) && on_line(q)) {
+    EXPECT_GE((m.V.row(p) - m.V.row(q)).norm(), 3.5 / n - 1e-12);
+  } else {
+    EXPECT_EQ(far.snapped.size(), 1u);
+    EXPECT_TRUE(apart.count(a) || apart.count(b));  // the one not moved is where it was
+  }
+}
+
 TEST(FeatureAlignment, CubeWithSingularitiesByHand) {
   // The corners, and also a +1/4 −1/4 pair inside a cube face: exact and aligned all the same.
   const Mesh m = make_cube_sphere(8, false);

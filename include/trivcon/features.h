@@ -121,10 +121,15 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& topology,
 // faces between them. The map requests use 1.5 units (trivcon/request.h, cancel_for_map). Without `flat_sectors`,
 // not onto a sector whose quad corners at w would open wider than 1.5 steps (3π/4 for N = 4) each: a +1/N on a
 // straight line or on a T-junction's straight side gives a quad one corner of about π (scaled Jacobian about 0).
+// With `separation` > 0, not onto a vertex closer than that (along edges) to another singularity (one there
+// already, or moved before it): two singularities less than a unit apart on one line can be rounded onto one
+// integer point, folding the map between them (a row of round holes' rims); the next nearest line vertex is
+// tried instead, else the singularity stays.
 // Updates `vertex` and `alignment.fixed` (new faces among them: the sector's middle ones), lists the moves in
 // `alignment.snapped`.
 void move_singularities_onto_features(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
-                                      int N, double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment);
+                                      int N, double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment,
+                                      double separation = 0);
 
 // One line of a .sharp file.
 struct SharpFaceEdge {

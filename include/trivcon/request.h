@@ -133,7 +133,8 @@ double map_unit(const FieldDesigner& designer, double edge_length, double target
 // distance was given, and to split every singularity of |index| ≥ 1 into ones of ±1/4 about one unit around it
 // (AutoOptions::split_above = 3) when no split was asked for: a quad vertex has valence 4 − 4k, so k ≥ 1
 // cannot be made (the smoothest field of a round disk with its boundary aligned puts +1 at the centre); and to
-// move ±1/4 singularities closer than kMapOntoFeatures units to a feature line onto it (AutoOptions::onto_features).
+// move ±1/4 singularities closer than kMapOntoFeatures units to a feature line onto it (AutoOptions::onto_features),
+// but not within one unit of another singularity (AutoOptions::onto_separation).
 void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double edge_length, double target_faces);
 
 // A field and its map, as `param`, `quad` and Python's solve with a map scale make them.

@@ -293,7 +293,8 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const 
 }
 
 void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, const Geometry& g, const std::vector<int>& edges, int N,
-                                      double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment) {
+                                      double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment,
+                                      double separation) {
   if (N < 4 || N % 2 != 0 || edges.empty() || !(distance > 0)) return;
   const std::vector<char> sharp = sharp_flags(t, edges);
   const std::map<int, std::vector<int>> beside = sharp_faces(t, edges);
@@ -303,6 +304,16 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
   for (const NarrowCorner& k : alignment.narrow)
     for (int f : k.faces) claimed[f] = 1;
   std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
+  // Whether a singularity other than s lies closer than `separation` to w.
+  auto crowded = [&](int w, int s) {
+    bool found = false;
+    if (separation > 0)
+      field::edge_dijkstra(V, t, w, separation, false, dist, [&](int v, double) {
+        found = found || (v != s && vertex.count(v));
+        return !found;
+      });
+    return found;
+  };
   const std::map<int, int> given = vertex;
   for (auto [s, n] : given) {
     if (std::abs(n) != 1 || degree[s] > 0 || !t.is_interior_vertex(s)) continue;
@@ -318,7 +329,7 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
     std::sort(candidates.begin(), candidates.end());
     for (auto [d, w] : candidates) {
       // A line vertex (two sharp edges) or a junction (more): either way its sector facing s lies between two.
-      if (degree[w] < 2 || vertex.count(w)) continue;
+      if (degree[w] < 2 || vertex.count(w) || crowded(w, s)) continue;
       // The sector of w facing s: the one holding the reached neighbour of w nearest s.
       int x = -1;
       double best = std::numeric_limits<double>::infinity();

@@ -176,7 +176,8 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
     if (request.auto_options.onto_features > 0 && !request.split_large_turns && !out.constraints.sharp_edges.empty()) {
       FeatureAlignment& a = out.constraints.features;
       move_singularities_onto_features(designer.V(), designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N,
-                                       request.auto_options.onto_features, request.auto_options.onto_flat_sectors, p.vertex, a);
+                                       request.auto_options.onto_features, request.auto_options.onto_flat_sectors, p.vertex, a,
+                                       request.auto_options.onto_separation);
       if (!a.snapped.empty()) {  // the sectors turned anew, unless a direction given by hand holds the face
         for (const FeatureSnap& k : a.snapped)
           for (int f : k.faces)
@@ -280,6 +281,7 @@ void cancel_for_map(FieldRequest& request, const FieldDesigner& designer, double
   const double unit = map_unit(designer, edge_length, target_faces);
   if (request.auto_options.split_above == 0) request.auto_options.split_above = 3, request.auto_options.split_distance = unit;
   if (request.auto_options.onto_features == 0) request.auto_options.onto_features = kMapOntoFeatures * unit;
+  if (request.auto_options.onto_separation == 0) request.auto_options.onto_separation = unit;
   if (request.auto_options.cancel_distance != 0) return;
   request.auto_options.cancel_distance = unit;
   request.auto_options.cancel_absolute = true;
