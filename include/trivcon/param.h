@@ -88,6 +88,7 @@ struct ParamQuality {
   int untangled_faces = 0;    // folded or degenerate faces opened by the local untangling (docs/param.md)
   int untangling_regions = 0; // regions untangled (each kept only when the map had fewer folds after it)
   int rewound_regions = 0;    // of those, regions untangled again from their least squares against a wrong winding
+  int relieved_regions = 0;   // regions around a nearly flat face opened after the untangling (docs/param.md)
   int flipped_faces = 0;      // faces whose (u, v) triangle is inverted
   int degenerate_faces = 0;   // faces whose (u, v) triangle has (nearly) zero area
   int collapsed_faces = 0;    // faces with an edge of length 0 on the surface, not turned over (not counted above)

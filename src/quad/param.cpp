@@ -34,6 +34,10 @@ namespace trivcon {
 
 namespace {
 
+// The relief (after the untangling): faces whose σ_max/σ_min exceeds kReliefRatio are opened until every face
+// of their region has det J > kReliefDeterminant (relative to the ideal unit square); a flat or folded face
+// counts as kReliefFlat in the region's stretch.
+constexpr double kReliefRatio = 10, kReliefDeterminant = 0.05, kReliefFlat = 1e6;
 
 using Terms = std::vector<std::pair<int, double>>;
 
@@ -1526,16 +1530,28 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // Bounds on the untangling's work, so that a map that cannot be untangled (a singularity of index ≥ 1 folds by
   // necessity) costs little: at most this many regions and this much work in all, and none when the folds are
   // more than a small share of the faces (the map is then wrong at large, not locally).
-  int regions_left = 64 + nF / 256;
+  int regions_left = 64 + nF / 256, relief_left = 64 + nF / 1024;
   double work_left = 2000.0 * nF + 2e7;  // faces × L-BFGS steps, over all regions
   const int too_many_folds = std::max(100, nF / 200);
   std::vector<char> inside_scratch(nV, 0), moved_scratch(nF, 0);
   std::vector<int> variable_scratch(nY, -1);
   // `restart`: the untangling starts from the region's least squares (quad::least_squares_start), not from the
   // map as it is.
-  auto untangle_around = [&](const std::vector<int>& seeds, int rings, bool restart = false) {
-    if (regions_left <= 0 || work_left <= 0) return false;
-    --regions_left;
+  // Σ area · σ_max/σ_min over `faces` (a flat or folded face counts as kReliefFlat).
+  auto stretch_of = [&](const std::vector<int>& faces) {
+    double sum = 0;
+    for (int f : faces) {
+      const double ratio = distortion(f);
+      sum += face_area[f] * (folded(f) || !std::isfinite(ratio) ? kReliefFlat : std::min(ratio, kReliefFlat));
+    }
+    return sum;
+  };
+  // `relieve`: the region holds no fold but a face left nearly flat; the barrier runs until every face has
+  // det J > kReliefDeterminant, and the result is kept when no face folds that did not, no vertex winds wrong
+  // that did not, and the region's stretch (stretch_of) is lower.
+  auto untangle_around = [&](const std::vector<int>& seeds, int rings, bool restart = false, bool relieve = false) {
+    if (relieve ? relief_left <= 0 : regions_left <= 0 || work_left <= 0) return false;
+    --(relieve ? relief_left : regions_left);
     std::vector<char>& inside = inside_scratch;
     std::vector<int> frontier, region;
     for (int v : seeds)
@@ -1582,6 +1598,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     const Badness before = badness_of(faces, touched);
+    const double stretch_before = relieve ? stretch_of(faces) : 0.0;
     quad::UntangleProblem problem;
     problem.num_variables = static_cast<int>(variables.size());
     for (int f : faces) {
@@ -1608,12 +1625,15 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     for (size_t k = 0; k < variables.size(); ++k) z[static_cast<int>(k)] = y[variables[k]];
     const Eigen::VectorXd z0 = z;
     if (restart) z = quad::least_squares_start(problem, z);
-    const quad::UntangleResult result = quad::untangle(problem, z, 1e-3, 0.5, 30, 30);
-    work_left -= static_cast<double>(faces.size()) * (result.inner_iterations + result.outer_iterations);
+    const quad::UntangleResult result = quad::untangle(problem, z, relieve ? kReliefDeterminant : 1e-3, 0.5, 30, 30);
+    if (!relieve) work_left -= static_cast<double>(faces.size()) * (result.inner_iterations + result.outer_iterations);
     for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z[static_cast<int>(k)];
     corner_uv_of(faces);
-    if (badness_of(faces, touched).better_than(before)) {
-      ++q.untangling_regions;
+    const Badness after = badness_of(faces, touched);
+    if (relieve ? after.folds <= before.folds && std::includes(before.wrong.begin(), before.wrong.end(), after.wrong.begin(), after.wrong.end()) &&
+                      stretch_of(faces) < stretch_before
+                : after.better_than(before)) {
+      ++(relieve ? q.relieved_regions : q.untangling_regions);
       return true;
     }
     for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z0[static_cast<int>(k)];
@@ -1759,6 +1779,24 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   q.seconds_stiffening = linalg::seconds_since(t3);
   const auto t5 = linalg::Clock::now();
   untangle_folds();
+  // Relief: a face can be left nearly flat without folding (a corner at a singularity opened to about π, its
+  // σ_max/σ_min in the thousands), which alone moves the area-weighted mean ratio by a whole unit. Around each
+  // face above kReliefRatio, worst (area · ratio) first, the region of 2, then 4 rings is opened with the barrier
+  // (untangle_around with `relieve`), kept only when it stretches less and folds and winds no worse.
+  {
+    std::vector<std::pair<double, int>> strained;
+    for (int f = 0; f < nF; ++f)
+      if (const double ratio = distortion(f); !folded(f) && !(collapsed[f]) && ratio > kReliefRatio)
+        strained.emplace_back(-face_area[f] * std::min(ratio, kReliefFlat), f);
+    std::sort(strained.begin(), strained.end());
+    for (auto [key, f] : strained) {
+      if (relief_left <= 0) break;
+      if (folded(f) || !(distortion(f) > kReliefRatio)) continue;  // relieved with an earlier one
+      check_cancelled();
+      for (int rings : {2, 4})
+        if (untangle_around({t.F(f, 0), t.F(f, 1), t.F(f, 2)}, rings, false, true)) break;
+    }
+  }
   q.seconds_untangling = linalg::seconds_since(t5);
 
   // --- What the map promises, checked on the result --------------------------------------------------------
