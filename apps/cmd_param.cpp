@@ -44,7 +44,7 @@ void run_param(const ParamCommand& o) {
   if (!o.sing_out.empty()) staged.write(o.sing_out, [&](const std::string& path) { write_map_singularities(path, run); });
   if (!o.report.empty()) {
     nlohmann::ordered_json report = map_report(o.map, run);
-    report["seconds"] = {{"read", run.read_seconds}, {"write", seconds_since(t1)}};
+    report["seconds"] = {{"read", run.read_seconds}, {"map", run.map_seconds}, {"write", seconds_since(t1)}};
     staged.write(o.report, [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& s) { s << report.dump(2) << "\n"; }); });
   }
   staged.commit();

@@ -51,6 +51,7 @@ void run_quad(const QuadCommand& o) {
     report["quad"] = quad_report(quads);
     report["seconds"] = {{"read", run.read_seconds},
                          {"field", run.out.design.solve_seconds + run.out.design.field_seconds},
+                         {"map", run.map_seconds},
                          {"write", seconds_since(t1)}};
     staged.write(o.report, [&](const std::string& path) { write_file_atomically(path, [&](std::ostream& s) { s << report.dump(2) << "\n"; }); });
   }

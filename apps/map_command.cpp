@@ -49,7 +49,9 @@ MapRun run_map(const MapCommand& o, bool quads) {
     run.boundary_aligned_unasked = true;
     if (!o.quiet) std::cout << "boundary: aligned (quads end on it; --auto aligns every boundary loop for quad)\n";
   }
+  const auto t1 = Clock::now();
   MapOutcome made = map_request(*run.designer, mesh.F, run.request, o.edge_length, o.target_faces, quads);
+  run.map_seconds = seconds_since(t1);
   run.out = std::move(made.field);
   if (!run.out.verified)
     throw Error("the field did not pass verification, so no map was made: " + verification_failure(*run.designer, run.out.design));

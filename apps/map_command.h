@@ -35,6 +35,7 @@ struct MapCommand {
 struct MapRun {
   LoadedMesh loaded;
   double read_seconds = 0;
+  double map_seconds = 0;  // map_request's wall time: every placement tried, its relaxations, maps and retries
   std::unique_ptr<FieldDesigner> designer;
   FieldRequest request;
   FieldOutcome out;

@@ -113,6 +113,11 @@ TEST(CliQuad, CubeGivesEightValenceThreeCornersAndNothingElseIrregular) {
   EXPECT_GT(j["quad"]["min_scaled_jacobian"].get<double>(), 0.3);
   EXPECT_TRUE(j["param"]["seamless"].get<bool>());
   EXPECT_EQ(read_corner_uv(uv, m.F).rows(), m.F.rows());
+  // The map step's time encloses the kept map's stages and the kept field's solve (one clock, nested).
+  double stages = 0;
+  for (const auto& [stage, seconds] : j["param"]["seconds"].items()) stages += seconds.get<double>();
+  EXPECT_GE(j["seconds"]["map"].get<double>(), stages);
+  EXPECT_GE(j["seconds"]["map"].get<double>(), j["seconds"]["field"].get<double>());
 }
 
 // A square plate with holes, its boundary aligned: the quads end on every boundary loop (as many loops, same χ),
