@@ -380,6 +380,14 @@ TEST(FeatureAlignment, NarrowCornersTurnByOneStep) {
   EXPECT_TRUE(lines.narrow.empty());
 }
 
+// The vertex at (x / n, y / n) of an n × n grid (make_holed_grid).
+int grid_vertex(const Mesh& m, int n, int x, int y) {
+  for (int v = 0; v < m.V.rows(); ++v)
+    if (std::abs(m.V(v, 0) * n - x) < 1e-9 && std::abs(m.V(v, 1) * n - y) < 1e-9) return v;
+  ADD_FAILURE() << "no vertex at " << x << ", " << y;
+  return -1;
+}
+
 TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
   // A flat 12×12 grid with a feature line across it at y = 1/2 and another from its middle up to y = 11/12:
   // a T-junction of three sharp edges at (1/2, 1/2). A +1/4 one edge below the junction is moved onto it
@@ -390,12 +398,7 @@ TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
   const Mesh m = make_holed_grid(n, 0);
   FieldDesigner designer(m.V, m.F);
   const Topology& t = designer.topology();
-  auto at = [&](int x, int y) {
-    for (int v = 0; v < m.V.rows(); ++v)
-      if (std::abs(m.V(v, 0) * n - x) < 1e-9 && std::abs(m.V(v, 1) * n - y) < 1e-9) return v;
-    ADD_FAILURE() << "no vertex at " << x << ", " << y;
-    return -1;
-  };
+  auto at = [&](int x, int y) { return grid_vertex(m, n, x, y); };
   auto edge_between = [&](int a, int b) {
     for (int e = 0; e < t.num_edges; ++e)
       if ((t.edge_vertices(e, 0) == a && t.edge_vertices(e, 1) == b) || (t.edge_vertices(e, 0) == b && t.edge_vertices(e, 1) == a)) return e;
@@ -458,12 +461,7 @@ TEST(FeatureAlignment, SingularitiesMovedOntoALineKeepTheirSeparation) {
   const Mesh m = make_holed_grid(n, 0);
   FieldDesigner designer(m.V, m.F);
   const Topology& t = designer.topology();
-  auto at = [&](int x, int y) {
-    for (int v = 0; v < m.V.rows(); ++v)
-      if (std::abs(m.V(v, 0) * n - x) < 1e-9 && std::abs(m.V(v, 1) * n - y) < 1e-9) return v;
-    ADD_FAILURE() << "no vertex at " << x << ", " << y;
-    return -1;
-  };
+  auto at = [&](int x, int y) { return grid_vertex(m, n, x, y); };
   std::vector<int> edges;
   for (int e = 0; e < t.num_edges; ++e) {
     const Eigen::Vector3d a = m.V.row(t.edge_vertices(e, 0)), b = m.V.row(t.edge_vertices(e, 1));
