@@ -44,6 +44,9 @@ constexpr double kAcuteCorner = 0.7853981633974483;
 // are descended (docs/param.md, "Rounding") and map_request places the singularities again.
 inline constexpr double kMapDistortionGoal = 1.5;
 
+// How the map's target size per face is set (ParamOptions::sizing).
+enum class Sizing { uniform, map, connection };
+
 struct ParamOptions {
   double edge_length = 0;   // the quad edge length in the mesh's units (> 0 wins over target_faces)
   double target_faces = 0;  // otherwise: about this many unit squares (edge_length = √(area / target_faces))
@@ -62,8 +65,11 @@ struct ParamOptions {
   // retries' factorizations stay below twice the first attempt's (not wall time: the same map on any machine);
   // 0: never.
   int retries = 4;
-  // Rounds of sizing before the rounding (docs/param.md, "Sizing"): each lets a face's target size follow the
-  // real-valued map's own scale there, smoothed; 0: the field's unit length everywhere.
+  // The target size per face before the rounding (docs/param.md, "Sizing"): the conformal factor of the field's
+  // connection, e^φ (Sizing::connection); or sizing_rounds rounds that each let it follow the real-valued map's
+  // own scale, smoothed (Sizing::map); or the field's unit length everywhere (Sizing::uniform). Where the map
+  // keeps problems the other variants are made too (parametrize).
+  Sizing sizing = Sizing::connection;
   int sizing_rounds = 2;
   // After the rounding, where the map misses a goal (folds, or a mean singular-value ratio above
   // kMapDistortionGoal): coordinate descent of the energy on the integers (docs/param.md, "Rounding"); false: the
@@ -77,7 +83,8 @@ struct ParamQuality {
   int rounding_rounds = 0;    // solves of the rounding
   int factorizations = 0;     // numeric factorizations of the map's system in all
   int stiffening_rounds = 0;  // re-solves against flips
-  int sizing_rounds = 0;      // re-solves with the target's size per face following the map (ParamOptions::sizing_rounds)
+  Sizing sizing = Sizing::uniform;  // the kept map's sizing (ParamOptions::sizing)
+  int sizing_rounds = 0;      // re-solves with the target's size per face following the map (Sizing::map)
   int folds_real_valued = 0;  // folded faces of the first, real-valued map (before stiffening)
   int folds_rounded = 0;      // folded faces right after the rounding (before stiffening again)
   int cones_moved = 0;        // singularities moved to a neighbouring integer point against a fold or a shared point

@@ -1260,7 +1260,7 @@ PYBIND11_MODULE(_core, m) {
             const Topology& t = r->state->topology();
             ParamOptions o;
             o.edge_length = edge_length, o.target_faces = target_faces;
-            if (uniform_size) o.sizing_rounds = 0;
+            if (uniform_size) o.sizing = Sizing::uniform;
             if (align_boundary)
               for (int e = 0; e < t.num_edges; ++e)
                 if (t.is_boundary_edge(e)) o.aligned_edges.push_back(e);

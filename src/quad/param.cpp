@@ -215,6 +215,47 @@ double signed_area(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eig
 
 double whole_offset(double x) { return std::abs(x - std::round(x)); }
 
+// The conformal factor the connection implies, per vertex (docs/param.md, "Sizing"). Across edge e = {i, j} the
+// connection turns the field by x_e against the surface's parallel transport from its left face to its right;
+// the Levi-Civita connection of the metric e^{2φ} g turns by w_e (φ_i − φ_j) there (w_e = ½(cot α + cot β), the
+// cotan Hodge star), so the trivial connection of least Σ x_e² / w_e with only vertex constraints is exactly that
+// of e^{2φ} g with φ its vertex multipliers. The field's connection (features and cycles add other terms) is
+// fitted by least squares, Σ_e w_e (φ_i − φ_j − x_e / w_e)² → min over the interior edges: the cotan Poisson
+// problem L φ = Σ_e x_e (δ_i − δ_j), made definite by a pull toward 0 of 1e-8 of its mean diagonal (weighted
+// by vertex area; the right-hand side sums to 0 on every component, so each component's mean stays near 0).
+// Weights below 1e-3 of the mean positive weight (slivers, clamped cotangents) are raised to it. Empty when
+// the system cannot be factored or the solution is not finite (the map then keeps the field's unit size).
+std::vector<double> connection_log_scale(const Topology& t, const Geometry& g, const Eigen::VectorXd& x, const std::vector<double>& face_area) {
+  const int nV = t.num_vertices, nE = t.num_edges, nF = t.num_faces;
+  double weight_sum = 0, area_sum = 0;
+  int weights = 0;
+  for (int e = 0; e < nE; ++e)
+    if (!t.is_boundary_edge(e) && g.cotan_weight[e] > 0) weight_sum += g.cotan_weight[e], ++weights;
+  if (weights == 0) return {};
+  const double mean_weight = weight_sum / weights, floor = 1e-3 * mean_weight;
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(nV), rhs = Eigen::VectorXd::Zero(nV);
+  for (int f = 0; f < nF; ++f)
+    for (int k = 0; k < 3; ++k) mass[t.F(f, k)] += face_area[f] / 3, area_sum += face_area[f] / 3;
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int e = 0; e < nE; ++e) {
+    if (t.is_boundary_edge(e)) continue;
+    const int i = t.edge_vertices(e, 0), j = t.edge_vertices(e, 1);
+    const double w = std::max(g.cotan_weight[e], floor);
+    triplets.emplace_back(i, i, w), triplets.emplace_back(j, j, w), triplets.emplace_back(i, j, -w);
+    rhs[i] += x[e], rhs[j] -= x[e];
+  }
+  const double mean_mass = area_sum > 0 ? area_sum / nV : 1.0;
+  // A vertex no face holds has no row otherwise: the identity there.
+  for (int v = 0; v < nV; ++v) triplets.emplace_back(v, v, mass[v] > 0 ? 1e-8 * mean_weight * mass[v] / mean_mass : 1.0);
+  Eigen::SparseMatrix<double> L(nV, nV);
+  L.setFromTriplets(triplets.begin(), triplets.end());
+  linalg::SparseCholesky cholesky(L, "param: the connection's conformal factor");
+  if (cholesky.factorize(L) >= 0) return {};
+  const Eigen::VectorXd phi = cholesky.solve(rhs);
+  if (!phi.allFinite()) return {};
+  return std::vector<double>(phi.data(), phi.data() + nV);
+}
+
 }  // namespace
 
 namespace {
@@ -908,35 +949,14 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   fit_target();
   // Sizing: the field's unit length everywhere cannot be integrated where the field turns (around a round hole,
   // along a curved feature line, near singularities): the least squares then stretch one direction against the
-  // other. Each round takes the real-valued map's own scale along the field's two directions, a = ∇u·X and
-  // d = ∇v·Y, as the size of its face, s·e^φ with φ = log(√(a d) / s), smooths φ over neighbouring faces
-  // (three passes of half the face's value and half its neighbours' mean), bounds it to [−1, 1] and solves again
-  // with the target s·e^φ (X, Y) instead (the same matrix: only the right-hand side changes), normalized so that
-  // Σ area·e^{2φ} is the area. A conformal map's scale varies this way, and the mean singular-value ratio falls
-  // (docs/param.md, "Sizing").
-  for (int round = 0; round < options.sizing_rounds; ++round) {
-    check_cancelled();
-    std::vector<double> phi(nF);
-    for (int f = 0; f < nF; ++f) {
-      const Eigen::Matrix2d J = jacobian(f);
-      const Eigen::Vector2d X(std::cos(theta[f]), std::sin(theta[f])), Y(-X.y(), X.x());
-      const double a = J.row(0).dot(X), d = J.row(1).dot(Y);
-      phi[f] = a > 0 && d > 0 ? std::log(std::sqrt(a * d) / s) : std::log(size[f]);  // a folded face keeps its size
-    }
-    for (int pass = 0; pass < 3; ++pass) {
-      std::vector<double> next = phi;
-      for (int f = 0; f < nF; ++f) {
-        double sum = 0;
-        int n = 0;
-        for (int k = 0; k < 3; ++k) {
-          const int e = t.face_edges(f, k);
-          const int other = t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
-          if (other >= 0) sum += phi[other], ++n;
-        }
-        if (n > 0) next[f] = 0.5 * phi[f] + 0.5 * sum / n;
-      }
-      phi = std::move(next);
-    }
+  // other. The target becomes s·e^φ (X, Y) per face instead (the same matrix: only the right-hand side changes),
+  // φ bounded to [−1, 1] and normalized so that Σ area·e^{2φ} is the area; φ is the connection's own conformal
+  // factor (Sizing::connection, connection_log_scale above, averaged over the face's corners) or follows the
+  // real-valued map (Sizing::map: each round takes its scale along the field's two directions, a = ∇u·X and
+  // d = ∇v·Y, φ = log(√(a d) / s), smoothed by three passes of half the face's value and half its neighbours'
+  // mean). A conformal map's scale varies this way, and the mean singular-value ratio falls (docs/param.md,
+  // "Sizing").
+  auto resize = [&](const std::vector<double>& phi) {
     double covered = 0, total = 0;
     for (int f = 0; f < nF; ++f) {
       size[f] = std::exp(std::clamp(phi[f], -1.0, 1.0));
@@ -946,9 +966,46 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     assemble_rhs();
     y = solve_fixed();
     corner_uv();
-    ++q.sizing_rounds;
+  };
+  if (options.sizing == Sizing::connection) {
+    check_cancelled();
+    const std::vector<double> phi_v = connection_log_scale(t, g, design.connection.x, face_area);
+    if (!phi_v.empty()) {
+      std::vector<double> phi(nF);
+      for (int f = 0; f < nF; ++f) phi[f] = (phi_v[t.F(f, 0)] + phi_v[t.F(f, 1)] + phi_v[t.F(f, 2)]) / 3;
+      resize(phi);
+      q.sizing = Sizing::connection;
+    }
+  } else if (options.sizing == Sizing::map) {
+    for (int round = 0; round < options.sizing_rounds; ++round) {
+      check_cancelled();
+      std::vector<double> phi(nF);
+      for (int f = 0; f < nF; ++f) {
+        const Eigen::Matrix2d J = jacobian(f);
+        const Eigen::Vector2d X(std::cos(theta[f]), std::sin(theta[f])), Y(-X.y(), X.x());
+        const double a = J.row(0).dot(X), d = J.row(1).dot(Y);
+        phi[f] = a > 0 && d > 0 ? std::log(std::sqrt(a * d) / s) : std::log(size[f]);  // a folded face keeps its size
+      }
+      for (int pass = 0; pass < 3; ++pass) {
+        std::vector<double> next = phi;
+        for (int f = 0; f < nF; ++f) {
+          double sum = 0;
+          int n = 0;
+          for (int k = 0; k < 3; ++k) {
+            const int e = t.face_edges(f, k);
+            const int other = t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
+            if (other >= 0) sum += phi[other], ++n;
+          }
+          if (n > 0) next[f] = 0.5 * phi[f] + 0.5 * sum / n;
+        }
+        phi = std::move(next);
+      }
+      resize(phi);
+      ++q.sizing_rounds;
+      q.sizing = Sizing::map;
+    }
   }
-  if (options.sizing_rounds > 0) fit_target();
+  if (q.sizing != Sizing::uniform) fit_target();
   q.folds_real_valued = count_folds();
   stiffen(options.max_stiffening_rounds, 3, 1.0, 0);
   // --- Greedy rounding: the integers nearest to whole numbers first, a fraction of those left per solve --------
@@ -1864,13 +1921,18 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
 
 int problems(const ParamQuality& q) { return q.flipped_faces + q.degenerate_faces + q.winding_errors; }
 
-// The sizing moves the rounding's integers: where its map keeps problems, the map of the field's unit size is
-// made too, and the one with fewer problems kept; the retries try both.
+// The sizing moves the rounding's integers: where its map keeps problems, the map of the other sizing (the
+// connection's, then the map's) and of the field's unit size are made too, until one has none, and the one with
+// the fewest problems kept; the retries try the first and the unit size.
 std::vector<ParamOptions> size_variants(const ParamOptions& options) {
   std::vector<ParamOptions> variants{options};
-  if (options.sizing_rounds > 0) {
+  if (options.sizing == Sizing::connection && options.sizing_rounds > 0) {
     variants.push_back(options);
-    variants.back().sizing_rounds = 0;
+    variants.back().sizing = Sizing::map;
+  }
+  if (options.sizing != Sizing::uniform) {
+    variants.push_back(options);
+    variants.back().sizing = Sizing::uniform;
   }
   return variants;
 }
@@ -1883,7 +1945,8 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
   const int near_miss = std::max(16, best.quality.faces / 20000);
   bool necessary = false;
   for (int n : best.cone_index) necessary |= n >= 4;
-  const std::vector<ParamOptions> variants = size_variants(options);
+  std::vector<ParamOptions> variants = size_variants(options);
+  if (variants.size() > 2) variants.erase(variants.begin() + 1);  // the first sizing and the unit size, as many as before
   const int n = static_cast<int>(variants.size());
   int attempts = best.quality.attempts, retried = 0;
   best.quality.seconds_retries = 0;
@@ -1917,10 +1980,14 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   const int first_factorizations = best.quality.factorizations;
   const std::vector<ParamOptions> variants = size_variants(options);
   int attempts = 1;
-  if (problems(best.quality) > 0 && variants.size() > 1) {
-    Parametrization other = parametrize_at(designer, design, variants[1], 1.0);
+  for (size_t v = 1; v < variants.size(); ++v) {
+    // A map without problems past the distortion goal tries the other sized variant too, for the lower ratio.
+    const bool stretched = best.quality.mean_distortion > kMapDistortionGoal && variants[v].sizing != Sizing::uniform;
+    if (problems(best.quality) == 0 && !stretched) break;
+    Parametrization other = parametrize_at(designer, design, variants[v], 1.0);
     ++attempts;
-    if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other);
+    const int p = problems(other.quality), b = problems(best.quality);
+    if (other.quality.seamless && (p < b || (p == b && other.quality.mean_distortion < best.quality.mean_distortion))) best = std::move(other);
   }
   best.quality.attempts = attempts;
   best.quality.first_factorizations = first_factorizations;
