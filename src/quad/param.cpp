@@ -1923,7 +1923,7 @@ int problems(const ParamQuality& q) { return q.flipped_faces + q.degenerate_face
 
 // The sizing moves the rounding's integers: where its map keeps problems, the map of the other sizing (the
 // connection's, then the map's) and of the field's unit size are made too, until one has none, and the one with
-// the fewest problems kept; the retries try the first and the unit size.
+// the fewest problems kept; the retries try the map's sizing and the unit size.
 std::vector<ParamOptions> size_variants(const ParamOptions& options) {
   std::vector<ParamOptions> variants{options};
   if (options.sizing == Sizing::connection && options.sizing_rounds > 0) {
@@ -1946,7 +1946,7 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
   bool necessary = false;
   for (int n : best.cone_index) necessary |= n >= 4;
   std::vector<ParamOptions> variants = size_variants(options);
-  if (variants.size() > 2) variants.erase(variants.begin() + 1);  // the first sizing and the unit size, as many as before
+  if (variants.size() > 2) variants.erase(variants.begin());  // the map's sizing and the unit size
   const int n = static_cast<int>(variants.size());
   int attempts = best.quality.attempts, retried = 0;
   best.quality.seconds_retries = 0;
