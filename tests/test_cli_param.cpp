@@ -116,8 +116,8 @@ TEST(CliParam, DiskWithAlignedBoundary) {
   EXPECT_EQ(uv.vt.size(), 3 * static_cast<size_t>(m.F.rows()));
 }
 
-// --uniform-size: no sizing (one unit of (u, v) everywhere); without it the connection's conformal factor, and an
-// annulus with its circles aligned (iso-lines ringing the hole as many at every radius) stretches less.
+// --uniform-size: no sizing (one unit of (u, v) everywhere); without it the map's own scale, and an annulus with
+// its circles aligned (iso-lines ringing the hole as many at every radius) stretches less.
 TEST(CliParam, UniformSizeTurnsTheSizingOff) {
   const std::string mesh = mesh_file(make_annulus(12, 96, 0.5, 1.0), "annulus.obj"), obj = temp_file("annulus_uv.obj");
   double ratio[2] = {0, 0};
@@ -129,7 +129,7 @@ TEST(CliParam, UniformSizeTurnsTheSizingOff) {
     const nlohmann::json j = nlohmann::json::parse(slurp(report));
     EXPECT_TRUE(j["param"]["seamless"].get<bool>());
     EXPECT_EQ(j["param"]["flipped_faces"], 0);
-    EXPECT_EQ(j["param"]["sizing"], uniform ? "uniform" : "connection");
+    EXPECT_EQ(j["param"]["sizing"], uniform ? "uniform" : "map");
     ratio[uniform] = j["param"]["mean_distortion"].get<double>();
   }
   EXPECT_LT(ratio[0], ratio[1] - 0.05) << "sized " << ratio[0] << ", uniform " << ratio[1];

@@ -252,7 +252,7 @@ TEST(CliQuad, PlateWith27HolesIsCleanAtTheFirstPlacement) {
   EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
   EXPECT_EQ(j["quad"]["inverted_quads"], 0);
   EXPECT_EQ(j["quad"]["nonconvex_quads"], 0);
-  EXPECT_GT(j["quad"]["min_scaled_jacobian"].get<double>(), 0.25);
+  EXPECT_GT(j["quad"]["min_scaled_jacobian"].get<double>(), 0.3);
   const QuadFile q = read_quads(out);
   const Census c = census(q);
   EXPECT_EQ(c.euler, -26);

@@ -65,11 +65,11 @@ struct ParamOptions {
   // retries' factorizations stay below twice the first attempt's (not wall time: the same map on any machine);
   // 0: never.
   int retries = 4;
-  // The target size per face before the rounding (docs/param.md, "Sizing"): the conformal factor of the field's
-  // connection, e^φ (Sizing::connection); or sizing_rounds rounds that each let it follow the real-valued map's
-  // own scale, smoothed (Sizing::map); or the field's unit length everywhere (Sizing::uniform). Where the map
-  // keeps problems the other variants are made too (parametrize).
-  Sizing sizing = Sizing::connection;
+  // The target size per face before the rounding (docs/param.md, "Sizing"): sizing_rounds rounds that each let
+  // it follow the real-valued map's own scale, smoothed (Sizing::map); or the conformal factor of the field's
+  // connection, e^φ (Sizing::connection); or the field's unit length everywhere (Sizing::uniform). Where the map
+  // keeps problems, or is past kMapDistortionGoal, the other sizing is made too (parametrize).
+  Sizing sizing = Sizing::map;
   int sizing_rounds = 2;
   // After the rounding, where the map misses a goal (folds, or a mean singular-value ratio above
   // kMapDistortionGoal): coordinate descent of the energy on the integers (docs/param.md, "Rounding"); false: the

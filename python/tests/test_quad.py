@@ -166,13 +166,13 @@ def test_fan_caps_are_refined_as_the_program_refines_them(cli, tmp_path):
 
 
 def test_uniform_size_turns_the_sizing_off():
-    # An annulus with its circles aligned: by default the unit follows the connection's conformal factor and
-    # stretches less; uniform_size=True keeps one unit everywhere, as `--uniform-size`.
+    # An annulus with its circles aligned: by default the unit follows the map's own scale and stretches less;
+    # uniform_size=True keeps one unit everywhere, as `--uniform-size`.
     V, F = trivcon.make_annulus(12, 96, 0.5, 1.0)
     r = trivcon.FieldDesigner(V, F).solve(4, "auto", align_boundary=True)
     sized = r.parametrize(target_faces=400)
     uniform = r.parametrize(target_faces=400, uniform_size=True)
-    assert sized.quality["sizing"] == "connection" and uniform.quality["sizing"] == "uniform"
+    assert sized.quality["sizing"] == "map" and uniform.quality["sizing"] == "uniform"
     assert sized.quality["flipped_faces"] == 0 and uniform.quality["flipped_faces"] == 0
     assert sized.quality["mean_distortion"] < uniform.quality["mean_distortion"] - 0.05
     q = r.quad(target_faces=400, uniform_size=True)

@@ -1921,19 +1921,18 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
 
 int problems(const ParamQuality& q) { return q.flipped_faces + q.degenerate_faces + q.winding_errors; }
 
-// The sizing moves the rounding's integers: where its map keeps problems, the map of the other sizing (the
-// connection's, then the map's) and of the field's unit size are made too, until one has none, and the one with
-// the fewest problems kept; the retries try the map's sizing and the unit size.
+// The sizing moves the rounding's integers: where its map keeps problems, the maps of the other sizings (the
+// map's and the connection's, the one not asked for first) and of the field's unit size are made too, until one
+// has none, and the one with the fewest problems kept; the retries try the map's sizing and the unit size.
 std::vector<ParamOptions> size_variants(const ParamOptions& options) {
   std::vector<ParamOptions> variants{options};
-  if (options.sizing == Sizing::connection && options.sizing_rounds > 0) {
+  if (options.sizing == Sizing::uniform) return variants;
+  if (options.sizing == Sizing::map || options.sizing_rounds > 0) {
     variants.push_back(options);
-    variants.back().sizing = Sizing::map;
+    variants.back().sizing = options.sizing == Sizing::map ? Sizing::connection : Sizing::map;
   }
-  if (options.sizing != Sizing::uniform) {
-    variants.push_back(options);
-    variants.back().sizing = Sizing::uniform;
-  }
+  variants.push_back(options);
+  variants.back().sizing = Sizing::uniform;
   return variants;
 }
 
@@ -1946,7 +1945,9 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
   bool necessary = false;
   for (int n : best.cone_index) necessary |= n >= 4;
   std::vector<ParamOptions> variants = size_variants(options);
-  if (variants.size() > 2) variants.erase(variants.begin());  // the map's sizing and the unit size
+  variants.erase(std::remove_if(variants.begin(), variants.end(), [](const ParamOptions& o) { return o.sizing == Sizing::connection; }),
+                 variants.end());  // the map's sizing and the unit size
+  if (variants.empty()) variants.push_back(options);
   const int n = static_cast<int>(variants.size());
   int attempts = best.quality.attempts, retried = 0;
   best.quality.seconds_retries = 0;
