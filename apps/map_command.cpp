@@ -19,8 +19,12 @@ void MapCommand::add_to(CLI::App* cmd, const std::string& what_unit) {
   length = cmd->add_option("--edge-length", edge_length, "The length of one unit of (u, v) (one " + what_unit + "'s side), in the mesh's units")
                ->check(CLI::PositiveNumber);
   target->excludes(length);
-  cmd->add_flag("--uniform-size", uniform_size,
-                "One unit of (u, v) everywhere (a texture's even density): no sizing, which lets the unit follow the map's own scale where the field turns (docs/param.md)");
+  auto* uniform = cmd->add_flag("--uniform-size", uniform_size,
+                                "One unit of (u, v) everywhere (a texture's even density): no sizing, which lets the unit follow the map's own scale where the field turns (docs/param.md); as --sizing uniform");
+  cmd->add_option("--sizing", sizing,
+                  "The unit's size per face: map (follows the real-valued map's own scale; the default), connection (the conformal factor of the field's connection first), uniform (docs/param.md, \"Sizing\")")
+      ->check(CLI::IsMember({"map", "connection", "uniform"}))
+      ->excludes(uniform);
   cmd->add_flag("-q,--quiet", quiet, "Print nothing on success");
   add_mesh_options(cmd, mesh_options);
 }
@@ -41,7 +45,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   const MeshData& mesh = run.loaded.mesh;
   run.designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F, o.field.solver_options());
   run.request = o.field.request(*run.designer, run.repaired());
-  run.request.uniform_size = o.uniform_size;
+  run.request.sizing = o.uniform_size || o.sizing == "uniform" ? Sizing::uniform : o.sizing == "connection" ? Sizing::connection : Sizing::map;
   // Quads end on a boundary only where it lies on integer iso-lines (docs/quad.md, "Boundaries"): with --auto
   // (the placement is trivcon's, so it can count the boundary's turning) `quad` aligns the boundary unasked.
   if (quads && run.request.auto_place && !run.request.align_boundary && !run.designer->topology().boundary_loops.empty()) {

@@ -20,7 +20,8 @@ struct MapCommand {
   FieldOptions field;
   double target_faces = 0, edge_length = 0;
   bool quiet = false;
-  bool uniform_size = false;  // --uniform-size
+  bool uniform_size = false;  // --uniform-size (as --sizing uniform)
+  std::string sizing = "map";  // --sizing
   MeshOptions mesh_options;  // --no-repair, --weld
   CLI::Option* target = nullptr;
   CLI::Option* length = nullptr;

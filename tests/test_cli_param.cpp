@@ -117,22 +117,33 @@ TEST(CliParam, DiskWithAlignedBoundary) {
 }
 
 // --uniform-size: no sizing (one unit of (u, v) everywhere); without it the map's own scale, and an annulus with
-// its circles aligned (iso-lines ringing the hole as many at every radius) stretches less.
+// its circles aligned (iso-lines ringing the hole as many at every radius) stretches less; --sizing connection
+// (the connection's conformal factor, φ = −log r here) less still. --sizing uniform is --uniform-size.
 TEST(CliParam, UniformSizeTurnsTheSizingOff) {
   const std::string mesh = mesh_file(make_annulus(12, 96, 0.5, 1.0), "annulus.obj"), obj = temp_file("annulus_uv.obj");
-  double ratio[2] = {0, 0};
-  for (int uniform = 0; uniform < 2; ++uniform) {
-    const std::string report = temp_file("annulus_" + std::to_string(uniform) + ".json");
-    const auto r = run_cli("param " + q(mesh) + " --auto --align-boundary --target-faces 400 -o " + q(obj) + " --report " + q(report) +
-                           (uniform ? " --uniform-size" : ""));
+  const std::vector<std::pair<std::string, std::string>> runs{
+      {"", "map"}, {" --uniform-size", "uniform"}, {" --sizing uniform", "uniform"}, {" --sizing connection", "connection"}};
+  std::vector<double> ratio;
+  for (size_t k = 0; k < runs.size(); ++k) {
+    const std::string report = temp_file("annulus_" + std::to_string(k) + ".json");
+    const auto r = run_cli("param " + q(mesh) + " --auto --align-boundary --target-faces 1600 -o " + q(obj) + " --report " + q(report) +
+                           runs[k].first);
     ASSERT_EQ(r.status, 0) << r.err;
     const nlohmann::json j = nlohmann::json::parse(slurp(report));
     EXPECT_TRUE(j["param"]["seamless"].get<bool>());
     EXPECT_EQ(j["param"]["flipped_faces"], 0);
-    EXPECT_EQ(j["param"]["sizing"], uniform ? "uniform" : "map");
-    ratio[uniform] = j["param"]["mean_distortion"].get<double>();
+    EXPECT_EQ(j["param"]["sizing"], runs[k].second) << runs[k].first;
+    ratio.push_back(j["param"]["mean_distortion"].get<double>());
   }
   EXPECT_LT(ratio[0], ratio[1] - 0.05) << "sized " << ratio[0] << ", uniform " << ratio[1];
+  EXPECT_EQ(ratio[1], ratio[2]);
+  EXPECT_LT(ratio[3], ratio[0]) << "connection " << ratio[3] << ", map " << ratio[0];
+  auto r = run_cli("param " + q(mesh) + " --auto --align-boundary --target-faces 1600 -o " + q(obj) + " --sizing conformal");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("--sizing: conformal not in {map,connection,uniform}"), std::string::npos) << r.err;
+  r = run_cli("param " + q(mesh) + " --auto --align-boundary --target-faces 1600 -o " + q(obj) + " --sizing map --uniform-size");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("excludes"), std::string::npos) << r.err;
 }
 
 TEST(CliParam, UsageErrors) {

@@ -50,7 +50,7 @@ struct FieldRequest {
   RelaxOptions relax_options;            // its pins, moves at most, cancellations
   bool split_large_turns = false;        // refine where the connection turns by π/N or more (split_large_turns.h)
   int max_split_rounds = 8;
-  bool uniform_size = false;             // for a map (request_param_options): the field's unit size everywhere, no sizing
+  Sizing sizing = Sizing::map;           // for a map (request_param_options): ParamOptions::sizing
   bool features_given() const { return feature_degrees.has_value() || !feature_edges.empty(); }
 };
 

@@ -1256,11 +1256,17 @@ PYBIND11_MODULE(_core, m) {
       .def(
           "parametrize",
           [](const DesignResultPtr& r, double edge_length, double target_faces, bool align_boundary,
-             const std::vector<std::pair<int, int>>& aligned_pairs, bool uniform_size) {
+             const std::vector<std::pair<int, int>>& aligned_pairs, const std::string& sizing) {
             const Topology& t = r->state->topology();
             ParamOptions o;
             o.edge_length = edge_length, o.target_faces = target_faces;
-            if (uniform_size) o.sizing = Sizing::uniform;
+            if (sizing == "uniform") {
+              o.sizing = Sizing::uniform;
+            } else if (sizing == "connection") {
+              o.sizing = Sizing::connection;
+            } else if (sizing != "map") {
+              throw Error("sizing: expected 'map', 'connection' or 'uniform', not '" + sizing + "'");
+            }
             if (align_boundary)
               for (int e = 0; e < t.num_edges; ++e)
                 if (t.is_boundary_edge(e)) o.aligned_edges.push_back(e);
@@ -1289,7 +1295,7 @@ PYBIND11_MODULE(_core, m) {
             return py::make_tuple(uv, cut, rotation, translation, int64_vector(p->cones), int64_vector(p->cone_index), p->edge_length,
                                   json_to_python(cli::param_report(*p)), param_warning(*p), p);
           },
-          py::arg("edge_length"), py::arg("target_faces"), py::arg("align_boundary"), py::arg("aligned_edges"), py::arg("uniform_size") = false,
+          py::arg("edge_length"), py::arg("target_faces"), py::arg("align_boundary"), py::arg("aligned_edges"), py::arg("sizing") = "map",
           "The integer-grid map (trivcon/param.h): (uv (F, 3, 2) in the input's corner order, cut edges (n, 2), their rotations, "
           "translations (n, 2), cone vertices, their numerators (index n/4), edge length, quality dict (param's report), warning, "
           "the map itself for quads).")

@@ -173,6 +173,13 @@ def test_uniform_size_turns_the_sizing_off():
     sized = r.parametrize(target_faces=400)
     uniform = r.parametrize(target_faces=400, uniform_size=True)
     assert sized.quality["sizing"] == "map" and uniform.quality["sizing"] == "uniform"
+    conformal = r.parametrize(target_faces=400, sizing="connection")
+    assert conformal.quality["sizing"] == "connection" and conformal.quality["flipped_faces"] == 0
+    assert conformal.quality["mean_distortion"] < uniform.quality["mean_distortion"] - 0.05
+    with pytest.raises(trivcon.Error, match="sizing: expected 'map', 'connection' or 'uniform', not 'conformal'"):
+        r.parametrize(target_faces=400, sizing="conformal")
+    with pytest.raises(trivcon.Error, match="disagree"):
+        r.parametrize(target_faces=400, uniform_size=True, sizing="map")
     assert sized.quality["flipped_faces"] == 0 and uniform.quality["flipped_faces"] == 0
     assert sized.quality["mean_distortion"] < uniform.quality["mean_distortion"] - 0.05
     q = r.quad(target_faces=400, uniform_size=True)

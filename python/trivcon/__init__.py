@@ -1336,7 +1336,7 @@ class Result(_Cached):
         """Write the singularities used, as --sing-out does (readable by `trivcon solve -s`)."""
         self._r.write_singularities(str(path))
 
-    def parametrize(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None, uniform_size=False):
+    def parametrize(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None, uniform_size=False, sizing=None):
         """The seamless integer-grid map of this cross field (N = 4), as `trivcon param`: a Parametrization.
 
         target_faces: about this many unit squares; or edge_length: one unit of (u, v) in the mesh's units.
@@ -1347,6 +1347,8 @@ class Result(_Cached):
           to put on iso-lines (default: the sharp edges the solve followed, Result.sharp_edges).
         uniform_size: one unit of (u, v) everywhere (a texture's even density), as `--uniform-size`; by default
           the unit follows the map's own scale where the field turns (docs/param.md, "Sizing").
+        sizing: "map" (the default), "connection" (the conformal factor of the field's connection first) or
+          "uniform" (as uniform_size=True), as `--sizing`.
         The mathematics and what is checked: docs/param.md. Raises trivcon.Error for N other than 4, a
         missing or non-positive scale, or an aligned edge that is not an edge of the mesh.
         """
@@ -1366,10 +1368,16 @@ class Result(_Cached):
             if pairs.size and (pairs.ndim != 2 or pairs.shape[1] != 2 or pairs.dtype.kind not in "iu"):
                 raise Error(f"aligned_edges: expected (n, 2) vertex ids, got an array of shape {pairs.shape} and type {pairs.dtype}")
         edge_pairs = [(int(a), int(b)) for a, b in _np.asarray(pairs).reshape(-1, 2)]
-        args = (float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs, bool(uniform_size))
+        if sizing is None:
+            sizing = "uniform" if uniform_size else "map"
+        elif sizing not in ("map", "connection", "uniform"):
+            raise Error(f"sizing: expected 'map', 'connection' or 'uniform', not {sizing!r}")
+        elif uniform_size and sizing != "uniform":
+            raise Error(f"parametrize: uniform_size=True and sizing={sizing!r} disagree")
+        args = (float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs, sizing)
         return Parametrization(self, *self._r.parametrize(*args), args=args)
 
-    def quad(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None, uniform_size=False):
+    def quad(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None, uniform_size=False, sizing=None):
         """The quad mesh of this cross field (N = 4), as `trivcon quad`: a QuadMesh (V, Q = result.quad(...) works too).
 
         The map is made as by parametrize (same arguments), then its integer grid is extracted (trivcon/quad.h,
@@ -1379,7 +1387,7 @@ class Result(_Cached):
         boundary only where it is aligned: on a mesh with boundary, solve with align_boundary=True (as
         `trivcon quad --auto` does unasked), or the quads along it are missing (reported).
         """
-        return self.parametrize(target_faces, edge_length, align_boundary, aligned_edges, uniform_size).quads()
+        return self.parametrize(target_faces, edge_length, align_boundary, aligned_edges, uniform_size, sizing).quads()
 
     def render(self, size=(1200, 900), view=(30, 20), up="y", style="hedgehog", spacing=11, flat=False, legend=True,
                singularities=None, supersampling=3):

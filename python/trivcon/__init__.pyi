@@ -277,6 +277,7 @@ class Result:
         align_boundary: Optional[bool] = ...,
         aligned_edges: Optional[npt.ArrayLike] = ...,
         uniform_size: bool = ...,
+        sizing: Optional[Literal["map", "connection", "uniform"]] = ...,
     ) -> Parametrization: ...
     def quad(
         self,
@@ -285,6 +286,7 @@ class Result:
         align_boundary: Optional[bool] = ...,
         aligned_edges: Optional[npt.ArrayLike] = ...,
         uniform_size: bool = ...,
+        sizing: Optional[Literal["map", "connection", "uniform"]] = ...,
     ) -> QuadMesh: ...
     def render(
         self,

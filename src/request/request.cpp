@@ -265,7 +265,7 @@ ParamOptions request_param_options(const FieldDesigner& designer, const FieldReq
     for (int e = 0; e < t.num_edges; ++e)
       if (t.is_boundary_edge(e)) options.aligned_edges.push_back(e);
   options.aligned_edges.insert(options.aligned_edges.end(), sharp_edges.begin(), sharp_edges.end());
-  if (request.uniform_size) options.sizing = Sizing::uniform;
+  options.sizing = request.sizing;
   return options;
 }
 
