@@ -249,9 +249,16 @@ std::vector<double> connection_log_scale(const Topology& t, const Geometry& g, c
   for (int v = 0; v < nV; ++v) triplets.emplace_back(v, v, mass[v] > 0 ? 1e-8 * mean_weight * mass[v] / mean_mass : 1.0);
   Eigen::SparseMatrix<double> L(nV, nV);
   L.setFromTriplets(triplets.begin(), triplets.end());
-  linalg::SparseCholesky cholesky(L, "param: the connection's conformal factor");
-  if (cholesky.factorize(L) >= 0) return {};
-  const Eigen::VectorXd phi = cholesky.solve(rhs);
+  Eigen::VectorXd phi;
+  try {
+    linalg::SparseCholesky cholesky(L, "param: the connection's conformal factor");
+    if (cholesky.factorize(L) >= 0) return {};
+    phi = cholesky.solve(rhs);
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const Error&) {  // not ordered or analysed: the map keeps the unit size
+    return {};
+  }
   if (!phi.allFinite()) return {};
   return std::vector<double>(phi.data(), phi.data() + nV);
 }
