@@ -45,7 +45,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   const MeshData& mesh = run.loaded.mesh;
   run.designer = std::make_unique<FieldDesigner>(mesh.V, mesh.F, o.field.solver_options());
   run.request = o.field.request(*run.designer, run.repaired());
-  run.request.sizing = o.uniform_size || o.sizing == "uniform" ? Sizing::uniform : o.sizing == "connection" ? Sizing::connection : Sizing::map;
+  run.request.sizing = o.uniform_size ? Sizing::uniform : sizing_from_name(o.sizing);
   // Quads end on a boundary only where it lies on integer iso-lines (docs/quad.md, "Boundaries"): with --auto
   // (the placement is trivcon's, so it can count the boundary's turning) `quad` aligns the boundary unasked.
   if (quads && run.request.auto_place && !run.request.align_boundary && !run.designer->topology().boundary_loops.empty()) {

@@ -122,7 +122,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"integer_unknowns", q.integer_unknowns},
           {"rounding_rounds", q.rounding_rounds},
           {"factorizations", q.factorizations},
-          {"sizing", q.sizing == Sizing::connection ? "connection" : q.sizing == Sizing::map ? "map" : "uniform"},
+          {"sizing", sizing_name(q.sizing)},
           {"sizing_rounds", q.sizing_rounds},
           {"stiffening_rounds", q.stiffening_rounds},
           {"folds_real_valued", q.folds_real_valued},

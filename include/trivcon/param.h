@@ -46,6 +46,10 @@ inline constexpr double kMapDistortionGoal = 1.5;
 
 // How the map's target size per face is set (ParamOptions::sizing).
 enum class Sizing { uniform, map, connection };
+// Its name in reports and options ("uniform", "map", "connection"), and the sizing of a name: throws
+// trivcon::Error "sizing: expected 'map', 'connection' or 'uniform', not '<name>'" for any other.
+const char* sizing_name(Sizing sizing);
+Sizing sizing_from_name(const std::string& name);
 
 struct ParamOptions {
   double edge_length = 0;   // the quad edge length in the mesh's units (> 0 wins over target_faces)

@@ -1260,13 +1260,7 @@ PYBIND11_MODULE(_core, m) {
             const Topology& t = r->state->topology();
             ParamOptions o;
             o.edge_length = edge_length, o.target_faces = target_faces;
-            if (sizing == "uniform") {
-              o.sizing = Sizing::uniform;
-            } else if (sizing == "connection") {
-              o.sizing = Sizing::connection;
-            } else if (sizing != "map") {
-              throw Error("sizing: expected 'map', 'connection' or 'uniform', not '" + sizing + "'");
-            }
+            o.sizing = sizing_from_name(sizing);
             if (align_boundary)
               for (int e = 0; e < t.num_edges; ++e)
                 if (t.is_boundary_edge(e)) o.aligned_edges.push_back(e);

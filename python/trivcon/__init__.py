@@ -1370,8 +1370,6 @@ class Result(_Cached):
         edge_pairs = [(int(a), int(b)) for a, b in _np.asarray(pairs).reshape(-1, 2)]
         if sizing is None:
             sizing = "uniform" if uniform_size else "map"
-        elif sizing not in ("map", "connection", "uniform"):
-            raise Error(f"sizing: expected 'map', 'connection' or 'uniform', not {sizing!r}")
         elif uniform_size and sizing != "uniform":
             raise Error(f"parametrize: uniform_size=True and sizing={sizing!r} disagree")
         args = (float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs, sizing)

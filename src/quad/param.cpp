@@ -1954,7 +1954,6 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
   std::vector<ParamOptions> variants = size_variants(options);
   variants.erase(std::remove_if(variants.begin(), variants.end(), [](const ParamOptions& o) { return o.sizing == Sizing::connection; }),
                  variants.end());  // the map's sizing and the unit size
-  if (variants.empty()) variants.push_back(options);
   const int n = static_cast<int>(variants.size());
   int attempts = best.quality.attempts, retried = 0;
   best.quality.seconds_retries = 0;
@@ -2018,6 +2017,23 @@ Eigen::MatrixXd input_corner_uv(const Parametrization& param, const Topology& to
       out(f, 2 * k) = param.uv(3 * f + c, 0), out(f, 2 * k + 1) = param.uv(3 * f + c, 1);
     }
   return out;
+}
+
+const char* sizing_name(Sizing sizing) {
+  switch (sizing) {
+    case Sizing::map:
+      return "map";
+    case Sizing::connection:
+      return "connection";
+    default:
+      return "uniform";
+  }
+}
+
+Sizing sizing_from_name(const std::string& name) {
+  for (Sizing s : {Sizing::map, Sizing::connection, Sizing::uniform})
+    if (name == sizing_name(s)) return s;
+  throw Error("sizing: expected 'map', 'connection' or 'uniform', not '" + name + "'");
 }
 
 std::string param_warning(const Parametrization& param) {
