@@ -9,6 +9,8 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <tuple>
+#include <vector>
 
 #include "linalg/sparse_cholesky.h"
 #include "trivcon/cancel.h"
@@ -20,15 +22,48 @@ namespace {
 double chi(double D, double eps) { return 0.5 * (D + std::sqrt(eps * eps + D * D)); }
 double chi_derivative(double D, double eps) { return 0.5 * (1 + D / std::sqrt(eps * eps + D * D)); }
 
+// The energy reads each face's Jacobian as J = J0 + Σ_k z[variable_k] · (row_k ← a_k): the problem's affine
+// forms times the hat gradients, merged per face by (variable, row) and stored flat, so that each evaluation (one
+// per L-BFGS step and line-search trial) reads memory in order.
 class Energy {
  public:
-  Energy(const UntangleProblem& p, double lambda) : p_(p), lambda_(lambda) {}
+  Energy(const UntangleProblem& p, double lambda) : p_(p), lambda_(lambda) {
+    const size_t n = p.area.size();
+    constant_.resize(n);
+    start_.assign(n + 1, 0);
+    std::vector<Term> face_terms;
+    for (size_t f = 0; f < n; ++f) {
+      Eigen::Matrix2d J0 = Eigen::Matrix2d::Zero();
+      face_terms.clear();
+      for (int i = 0; i < 3; ++i)
+        for (int r = 0; r < 2; ++r) {
+          const AffineForm& a = p.corner[f][i][r];
+          const Eigen::Vector2d& g = p.gradient[f][i];
+          J0.row(r) += a.constant * g.transpose();
+          for (const auto& [j, coefficient] : a.terms) face_terms.push_back({j, r, coefficient * g.x(), coefficient * g.y()});
+        }
+      std::sort(face_terms.begin(), face_terms.end(), [](const Term& x, const Term& y) { return std::tie(x.variable, x.row) < std::tie(y.variable, y.row); });
+      for (size_t k = 0; k < face_terms.size(); ++k) {
+        if (terms_.size() > static_cast<size_t>(start_[f]) && terms_.back().variable == face_terms[k].variable &&
+            terms_.back().row == face_terms[k].row) {
+          terms_.back().a0 += face_terms[k].a0, terms_.back().a1 += face_terms[k].a1;
+          continue;
+        }
+        terms_.push_back(face_terms[k]);
+      }
+      constant_[f] = J0;
+      start_[f + 1] = static_cast<int>(terms_.size());
+    }
+  }
 
   // The relative Jacobian of face f at z.
   Eigen::Matrix2d jacobian(int f, const Eigen::VectorXd& z) const {
-    Eigen::Matrix2d J = Eigen::Matrix2d::Zero();
-    for (int i = 0; i < 3; ++i)
-      for (int r = 0; r < 2; ++r) J.row(r) += value(p_.corner[f][i][r], z) * p_.gradient[f][i].transpose();
+    Eigen::Matrix2d J = constant_[f];
+    for (int k = start_[f]; k < start_[f + 1]; ++k) {
+      const Term& t = terms_[k];
+      const double x = z[t.variable];
+      J(t.row, 0) += x * t.a0, J(t.row, 1) += x * t.a1;
+    }
     return J;
   }
 
@@ -52,23 +87,24 @@ class Energy {
       cofactor << J(1, 1), -J(1, 0), -J(0, 1), J(0, 0);
       const Eigen::Matrix2d G = a * ((1 - lambda_) * (2 * J / c - T * dc / (c * c) * cofactor) +
                                      lambda_ * (2 * D / c - (D * D + 1) * dc / (c * c)) * cofactor);
-      for (int i = 0; i < 3; ++i)
-        for (int r = 0; r < 2; ++r) {
-          const double d = G.row(r).dot(p_.gradient[f][i]);
-          for (const auto& [j, coefficient] : p_.corner[f][i][r].terms) (*grad)[j] += coefficient * d;
-        }
+      for (int k = start_[f]; k < start_[f + 1]; ++k) {
+        const Term& t = terms_[k];
+        (*grad)[t.variable] += G(t.row, 0) * t.a0 + G(t.row, 1) * t.a1;
+      }
     }
     return total;
   }
 
  private:
-  static double value(const AffineForm& a, const Eigen::VectorXd& z) {
-    double v = a.constant;
-    for (const auto& [j, coefficient] : a.terms) v += coefficient * z[j];
-    return v;
-  }
+  struct Term {
+    int variable, row;
+    double a0, a1;
+  };
   const UntangleProblem& p_;
   double lambda_;
+  std::vector<Eigen::Matrix2d> constant_;
+  std::vector<int> start_;
+  std::vector<Term> terms_;
 };
 
 // L-BFGS (Nocedal & Wright, Algorithm 7.4, memory 8) with a backtracking Armijo line search, from z, for at
