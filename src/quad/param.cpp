@@ -38,6 +38,9 @@ namespace {
 // of their region has det J > kReliefDeterminant (relative to the ideal unit square); a flat or folded face
 // counts as kReliefFlat in the region's stretch.
 constexpr double kReliefRatio = 10, kReliefDeterminant = 0.05, kReliefFlat = 1e6;
+// The share of the untangling's bounds (regions, L-BFGS work) that a map gets when the map of another sizing
+// follows it where it keeps problems (parametrize).
+constexpr double kUntangleShareBeforeFallback = 0.25;
 
 using Terms = std::vector<std::pair<int, double>>;
 
@@ -268,7 +271,8 @@ std::vector<double> connection_log_scale(const Topology& t, const Geometry& g, c
 namespace {
 
 // One attempt at the map, with the quad edge length (from options) times `scale`.
-Parametrization parametrize_at(const FieldDesigner& designer, const Design& design, const ParamOptions& options, double scale) {
+Parametrization parametrize_at(const FieldDesigner& designer, const Design& design, const ParamOptions& options, double scale,
+                               double untangle_share = 1.0) {
   const auto t0 = linalg::Clock::now();
   const Topology& t = designer.topology();
   const Geometry& g = designer.geometry();
@@ -1594,8 +1598,9 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // Bounds on the untangling's work, so that a map that cannot be untangled (a singularity of index ≥ 1 folds by
   // necessity) costs little: at most this many regions and this much work in all, and none when the folds are
   // more than a small share of the faces (the map is then wrong at large, not locally).
-  int regions_left = 64 + nF / 256, relief_left = 64 + nF / 1024;
-  double work_left = 2000.0 * nF + 2e7;  // faces × L-BFGS steps, over all regions
+  // A map that another sizing's map follows gets `untangle_share` of them (kUntangleShareBeforeFallback).
+  int regions_left = static_cast<int>(untangle_share * (64 + nF / 256)), relief_left = static_cast<int>(untangle_share * (64 + nF / 1024));
+  double work_left = untangle_share * (2000.0 * nF + 2e7);  // faces × L-BFGS steps, over all regions
   const int too_many_folds = std::max(100, nF / 200);
   std::vector<char> inside_scratch(nV, 0), moved_scratch(nF, 0);
   std::vector<int> variable_scratch(nY, -1);
@@ -1983,15 +1988,18 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
 // map is wrong at large: other scales would not mend it).
 Parametrization parametrize(const FieldDesigner& designer, const Design& design, const ParamOptions& options) {
   const auto start = linalg::Clock::now();
-  Parametrization best = parametrize_at(designer, design, options, 1.0);
-  const int first_factorizations = best.quality.factorizations;
   const std::vector<ParamOptions> variants = size_variants(options);
+  // Each map but the last variant's untangles on a share of the budget: the next sizing is the cheaper remedy
+  // for the folds a long untangling would fight.
+  auto share = [&](size_t v) { return v + 1 < variants.size() ? kUntangleShareBeforeFallback : 1.0; };
+  Parametrization best = parametrize_at(designer, design, options, 1.0, share(0));
+  const int first_factorizations = best.quality.factorizations;
   int attempts = 1;
   for (size_t v = 1; v < variants.size(); ++v) {
     // A map without problems past the distortion goal tries the other sized variant too, for the lower ratio.
     const bool stretched = best.quality.mean_distortion > kMapDistortionGoal && variants[v].sizing != Sizing::uniform;
     if (problems(best.quality) == 0 && !stretched) break;
-    Parametrization other = parametrize_at(designer, design, variants[v], 1.0);
+    Parametrization other = parametrize_at(designer, design, variants[v], 1.0, share(v));
     ++attempts;
     const int p = problems(other.quality), b = problems(best.quality);
     if (other.quality.seamless && (p < b || (p == b && other.quality.mean_distortion < best.quality.mean_distortion))) best = std::move(other);
