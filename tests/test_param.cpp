@@ -408,6 +408,20 @@ TEST(Param, RefusesWhatItCannotMap) {
   }
   o.aligned_edges = {d.topology().num_edges};
   EXPECT_THROW(parametrize(d, four, o), Error);
+  o.aligned_edges.clear();
+  for (double share : {0.0, -0.5, 1.5, std::nan("")}) {
+    o.untangle_share = share;
+    EXPECT_THROW(parametrize(d, four, o), Error) << share;
+  }
+  o.untangle_share = 1.5;
+  try {
+    parametrize(d, four, o);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "param: untangle_share must be in (0, 1], got 1.5");
+  }
+  o.untangle_share = kUntangleShareFollowed;
+  EXPECT_TRUE(parametrize(d, four, o).quality.seamless);
 }
 
 }  // namespace

@@ -43,6 +43,10 @@ constexpr double kAcuteCorner = 0.7853981633974483;
 // The goal for a map's mean singular-value ratio (ParamQuality::mean_distortion): above it the map's integers
 // are descended (docs/param.md, "Rounding") and map_request places the singularities again.
 inline constexpr double kMapDistortionGoal = 1.5;
+// The share of the untangling's bounds that a map gets when another map follows it where it keeps problems
+// (ParamOptions::untangle_share): a long untangling mostly fights regions it cannot open, and the next map is the
+// cheaper remedy.
+inline constexpr double kUntangleShareFollowed = 0.25;
 
 // How the map's target size per face is set (ParamOptions::sizing).
 enum class Sizing { uniform, map, connection };
@@ -79,6 +83,10 @@ struct ParamOptions {
   // kMapDistortionGoal): coordinate descent of the energy on the integers (docs/param.md, "Rounding"); false: the
   // greedy rounding's integers as they are.
   bool descend_integers = true;
+  // The share of the local untangling's bounds (regions, L-BFGS work; docs/param.md, "Folds") for the map of the
+  // last sizing variant, in (0, 1]; the variants that another follows get kUntangleShareFollowed. A search that
+  // makes other maps after this one (trivcon's map requests while they screen placements) sets that share too.
+  double untangle_share = 1.0;
 };
 
 struct ParamQuality {
@@ -146,11 +154,13 @@ struct Parametrization {
 };
 
 // The map of `design`'s field (N = 4) on `designer`'s mesh. Throws trivcon::Error for another N, a missing
-// or non-positive scale, an aligned edge id out of range, or a system our factorization finds not positive definite.
+// or non-positive scale, an untangle_share outside (0, 1], an aligned edge id out of range, or a system our
+// factorization finds not positive definite.
 Parametrization parametrize(const FieldDesigner& designer, const Design& design, const ParamOptions& options);
 
 // The near-miss retries alone, resumed from `screened`: a map parametrize made with the same designer, design and
-// options but retries = 0. The result equals parametrize(designer, design, options); the maps `screened` made
+// options but retries = 0 (a screening search also gives it untangle_share = kUntangleShareFollowed; the retries
+// untangle with the whole bounds). The result equals parametrize(designer, design, options); the maps `screened` made
 // are not made again (a search that screens many fields' maps retries only the one it keeps). Throws
 // trivcon::Error when `screened` does not come from parametrize.
 Parametrization parametrize_retries(const FieldDesigner& designer, const Design& design, const ParamOptions& options,

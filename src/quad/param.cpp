@@ -38,9 +38,6 @@ namespace {
 // of their region has det J > kReliefDeterminant (relative to the ideal unit square); a flat or folded face
 // counts as kReliefFlat in the region's stretch.
 constexpr double kReliefRatio = 10, kReliefDeterminant = 0.05, kReliefFlat = 1e6;
-// The share of the untangling's bounds (regions, L-BFGS work) that a map gets when the map of another sizing
-// follows it where it keeps problems (parametrize).
-constexpr double kUntangleShareBeforeFallback = 0.25;
 
 using Terms = std::vector<std::pair<int, double>>;
 
@@ -279,6 +276,11 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   const MatrixX3d& V = designer.V();
   const Field& field = design.field;
   if (field.N != 4) throw Error("param: a seamless parametrization needs a cross field (N = 4), got N = " + std::to_string(field.N));
+  if (!(options.untangle_share > 0 && options.untangle_share <= 1)) {
+    std::ostringstream m;
+    m << "param: untangle_share must be in (0, 1], got " << options.untangle_share;
+    throw Error(m.str());
+  }
   const int nF = t.num_faces, nE = t.num_edges, nV = t.num_vertices;
   if (field.angle.size() != nF || design.connection.x.size() != nE) throw Error("param: the design does not belong to this mesh");
 
@@ -1598,7 +1600,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // Bounds on the untangling's work, so that a map that cannot be untangled (a singularity of index ≥ 1 folds by
   // necessity) costs little: at most this many regions and this much work in all, and none when the folds are
   // more than a small share of the faces (the map is then wrong at large, not locally).
-  // A map that another sizing's map follows gets `untangle_share` of them (kUntangleShareBeforeFallback).
+  // A map that another map follows gets `untangle_share` of them (kUntangleShareFollowed, parametrize).
   int regions_left = static_cast<int>(untangle_share * (64 + nF / 256)), relief_left = static_cast<int>(untangle_share * (64 + nF / 1024));
   double work_left = untangle_share * (2000.0 * nF + 2e7);  // faces × L-BFGS steps, over all regions
   const int too_many_folds = std::max(100, nF / 200);
@@ -1991,7 +1993,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
   const std::vector<ParamOptions> variants = size_variants(options);
   // Each map but the last variant's untangles on a share of the budget: the next sizing is the cheaper remedy
   // for the folds a long untangling would fight.
-  auto share = [&](size_t v) { return v + 1 < variants.size() ? kUntangleShareBeforeFallback : 1.0; };
+  auto share = [&](size_t v) { return v + 1 < variants.size() ? kUntangleShareFollowed : options.untangle_share; };
   Parametrization best = parametrize_at(designer, design, options, 1.0, share(0));
   const int first_factorizations = best.quality.factorizations;
   int attempts = 1;

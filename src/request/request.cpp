@@ -394,8 +394,9 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   using PlacementKey = std::tuple<double, double, bool>;
   std::map<PlacementKey, std::map<int, int>> unrelaxed;
   std::set<std::pair<std::map<int, int>, bool>> relaxed_from;
-  // The maps are made without ParamOptions::retries while other attempts may follow (a retry costs up to a few
-  // maps, another placement often mends more); the kept map's retries follow if it still has problems.
+  // The maps are made without ParamOptions::retries and with a share of the untangling while other attempts may
+  // follow (a retry costs up to a few maps, another placement often mends more); the kept map's retries (with the
+  // whole untangling) follow if it still has problems.
   const bool screen = attempts.size() > 1;
   for (const Attempt& attempt : attempts) {
     const PlacementKey key{attempt.units, attempt.onto, attempt.flat};
@@ -448,7 +449,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     placed.push_back(m.field.prescription.vertex);
     ++maps;
     ParamOptions options = request_param_options(designer, r, m.field, edge_length, target_faces);
-    if (screen) options.retries = 0;
+    if (screen) options.retries = 0, options.untangle_share = kUntangleShareFollowed;
     m.param = parametrize(m.field.designer(designer), m.field.design, options);
     if (quads) m.quads = extract_quads(m.field.designer(designer), m.param);
     m.cancel_units = escalate ? attempt.units : 0.0;
