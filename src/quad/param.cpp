@@ -1991,8 +1991,8 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
 Parametrization parametrize(const FieldDesigner& designer, const Design& design, const ParamOptions& options) {
   const auto start = linalg::Clock::now();
   const std::vector<ParamOptions> variants = size_variants(options);
-  // Each map but the last variant's untangles on a share of the budget: the next sizing is the cheaper remedy
-  // for the folds a long untangling would fight.
+  // Each variant but the last untangles on kUntangleShareFollowed of the bounds (the next sizing is the cheaper
+  // remedy for the folds a long untangling would fight), the last on options.untangle_share.
   auto share = [&](size_t v) { return v + 1 < variants.size() ? kUntangleShareFollowed : options.untangle_share; };
   Parametrization best = parametrize_at(designer, design, options, 1.0, share(0));
   const int first_factorizations = best.quality.factorizations;

@@ -43,13 +43,11 @@ class Energy {
           for (const auto& [j, coefficient] : a.terms) face_terms.push_back({j, r, coefficient * g.x(), coefficient * g.y()});
         }
       std::sort(face_terms.begin(), face_terms.end(), [](const Term& x, const Term& y) { return std::tie(x.variable, x.row) < std::tie(y.variable, y.row); });
-      for (size_t k = 0; k < face_terms.size(); ++k) {
-        if (terms_.size() > static_cast<size_t>(start_[f]) && terms_.back().variable == face_terms[k].variable &&
-            terms_.back().row == face_terms[k].row) {
-          terms_.back().a0 += face_terms[k].a0, terms_.back().a1 += face_terms[k].a1;
-          continue;
-        }
-        terms_.push_back(face_terms[k]);
+      for (const Term& term : face_terms) {
+        if (terms_.size() > static_cast<size_t>(start_[f]) && terms_.back().variable == term.variable && terms_.back().row == term.row)
+          terms_.back().a0 += term.a0, terms_.back().a1 += term.a1;
+        else
+          terms_.push_back(term);
       }
       constant_[f] = J0;
       start_[f + 1] = static_cast<int>(terms_.size());
