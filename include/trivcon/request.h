@@ -193,8 +193,8 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // more than kMapRelaxMaxSingularities singularities, and each relaxation stops at its budget (kMapRelaxSolves, kMapRelaxWork).
 // While other attempts may follow, the maps are made without ParamOptions::retries; when the kept map has
 // problems its retries follow, resumed from it (parametrize_retries). The search ends at the first map without problems
-// within the goal, or without problems once the placement found was mapped as found and relaxed both ways; the kept map is the one with the fewest
-// problems, then the least stretch beyond the goal (the earliest of equals). `request` is left as the kept one
+// within the goal; past it every attempt is made; the kept map is the one with the fewest problems, then the least
+// stretch beyond the goal (the earliest of equals). `request` is left as the kept one
 // was made.
 // Last, when the kept map has problems and folds beside an edge that is not aligned but whose two ends lie on
 // aligned edges, every such edge is split at its midpoint (split_edges_at_midpoints) and the whole search runs

@@ -373,9 +373,6 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     if (onto_attempts)
       for (double onto : {kMapOntoFeatures, kMapOntoFeaturesFar}) attempts.push_back({1.0, request.relax, false, onto, true});
   }
-  // The attempts from the placement found (the first ones).
-  const int same_placement = static_cast<int>(
-      std::count_if(attempts.begin(), attempts.end(), [](const Attempt& a) { return a.units == 1 && a.onto == kMapOntoFeatures && !a.flat; }));
   MapOutcome best;
   FieldRequest kept = request;
   // The screened maps next in rank after the kept one (better first, at most kMapRetryCandidates − 1), with
@@ -467,9 +464,9 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     } else if (screen) {
       rank_runner(std::move(m), r);
     }
-    // Past the goal only the first placement is relaxed: once its attempts are made, a map without problems ends
-    // the search.
-    if (map_problems(best) == 0 && (stretch(best) == 0 || tried >= same_placement)) break;
+    // A map without problems within the goal ends the search; past it every attempt is made, the least stretch
+    // kept.
+    if (map_problems(best) == 0 && stretch(best) == 0) break;
   }
   // A screened map's retries, resumed from its first maps (at the edge length and at the field's unit size); the
   // designer holds that field's fixed faces.
