@@ -1350,7 +1350,8 @@ class Result(_Cached):
         sizing: "map" (the default), "connection" (the conformal factor of the field's connection first) or
           "uniform" (as uniform_size=True), as `--sizing`.
         The mathematics and what is checked: docs/param.md. Raises trivcon.Error for N other than 4, a
-        missing or non-positive scale, or an aligned edge that is not an edge of the mesh.
+        missing or non-positive scale, an aligned edge that is not an edge of the mesh, a sizing other than the
+        three, or uniform_size=True with another sizing.
         """
         if self.N != 4:
             raise Error(f"param: a seamless parametrization needs a cross field (N = 4), got N = {self.N}")

@@ -1941,9 +1941,11 @@ int problems(const ParamQuality& q) { return q.flipped_faces + q.degenerate_face
 std::vector<ParamOptions> size_variants(const ParamOptions& options) {
   std::vector<ParamOptions> variants{options};
   if (options.sizing == Sizing::uniform) return variants;
-  if (options.sizing == Sizing::map || options.sizing_rounds > 0) {
+  // The other sizing, unless it would size nothing (the map's with no rounds).
+  const Sizing other = options.sizing == Sizing::map ? Sizing::connection : Sizing::map;
+  if (other == Sizing::connection || options.sizing_rounds > 0) {
     variants.push_back(options);
-    variants.back().sizing = options.sizing == Sizing::map ? Sizing::connection : Sizing::map;
+    variants.back().sizing = other;
   }
   variants.push_back(options);
   variants.back().sizing = Sizing::uniform;
