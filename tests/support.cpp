@@ -291,6 +291,32 @@ Mesh perforated_plate(int nx, int ny, int m, int layers, double r) {
   return out;
 }
 
+Mesh extruded(const Mesh& flat, double height) {
+  const int n = static_cast<int>(flat.V.rows()), nf = static_cast<int>(flat.F.rows());
+  std::set<std::pair<int, int>> directed;
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) directed.insert({flat.F(f, k), flat.F(f, (k + 1) % 3)});
+  std::vector<std::pair<int, int>> boundary;
+  for (auto [a, b] : directed)
+    if (!directed.count({b, a})) boundary.push_back({a, b});
+  Mesh out;
+  out.V.resize(2 * n, 3);
+  out.V.topRows(n) = flat.V;
+  out.V.bottomRows(n) = flat.V;
+  out.V.bottomRows(n).col(2).array() -= height;
+  out.F.resize(2 * nf + 2 * static_cast<int>(boundary.size()), 3);
+  for (int f = 0; f < nf; ++f) {
+    out.F.row(f) = flat.F.row(f);
+    out.F.row(nf + f) << flat.F(f, 2) + n, flat.F(f, 1) + n, flat.F(f, 0) + n;
+  }
+  int row = 2 * nf;
+  for (auto [a, b] : boundary) {
+    out.F.row(row++) << b, a, a + n;
+    out.F.row(row++) << b, a + n, b + n;
+  }
+  return out;
+}
+
 Mesh jittered_disk(int rings, int segments, double amount) {
   Mesh m = make_disk(rings, segments);
   const Topology t = topo(m);

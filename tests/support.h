@@ -68,6 +68,9 @@ Mesh sheared_box(int n);
 // quads (each cut into two triangles) from the hole's circle, sampled at the angles of 4m points evenly spaced
 // along the cell's square, out to that square; the cells share their squares' points.
 Mesh perforated_plate(int nx, int ny, int m, int layers, double r);
+// A flat mesh in the plane z = 0 (faces counter-clockwise seen from +z) made a closed solid of thickness `height`:
+// its faces, their copy at z = −height turned over, and two triangles per boundary edge for the wall between.
+Mesh extruded(const Mesh& flat, double height);
 // The unit sphere as modelling tools export it: a grid of (rings + 1) × (segments + 1) points by latitude and
 // longitude, unwelded, two triangles per cell. Each pole is a row of `segments` + 1 points at one place (exactly),
 // joined by edges of length 0, and the seam two coincident columns: a disk whose one boundary loop runs along both

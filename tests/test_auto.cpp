@@ -283,6 +283,31 @@ TEST(Auto, InputWheelsOppositeSingularitiesMeetForAMap) {
   EXPECT_EQ(cancel_singularity_pairs(designer.V(), designer.topology(), r.vertex, o.cancel_distance, nullptr, true), r.vertex);
 }
 
+// The split on its own (split_auto_singularities, which the map requests run after the moves onto feature lines)
+// is the one auto_singularities ends with: on the genus-7 plate at 100 squares, with a few vertices held.
+TEST(Auto, TheSplitOnItsOwnIsAutosSplit) {
+  const Mesh m = make_genus_surface(7, 2);
+  const FieldDesigner designer(m.V, m.F);
+  AutoOptions o = map_placement(designer, 100);
+  const AutoResult whole = auto_singularities(designer, o);
+  ASSERT_GT(whole.split + whole.met, 0);  // the split and the meeting change something here
+  o.split_above = 0;
+  AutoResult before = auto_singularities(designer, o);
+  ASSERT_NE(before.vertex, whole.vertex);
+  o.split_above = 3;
+  const std::map<int, int> split = split_auto_singularities(designer.V(), designer.topology(), before.vertex, o, before);
+  EXPECT_EQ(split, whole.vertex);
+  EXPECT_EQ(before.split, whole.split);
+  EXPECT_EQ(before.met, whole.met);
+  EXPECT_EQ(before.pairs, whole.pairs);
+  // Held vertices keep their singularities as they are.
+  o.held.clear();
+  for (auto [v, n] : before.vertex) o.held.push_back(v);
+  EXPECT_EQ(split_auto_singularities(designer.V(), designer.topology(), before.vertex, o, before), before.vertex);
+  o.split_distance = 0;
+  EXPECT_THROW(split_auto_singularities(designer.V(), designer.topology(), before.vertex, o, before), Error);
+}
+
 TEST(Auto, BadInputIsAClearError) {
   const Mesh m = make_icosphere(1);
   AutoOptions o;

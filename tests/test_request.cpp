@@ -165,6 +165,44 @@ TEST(Request, MapSearchRetriesTheRunnersUpWhenTheKeptMapKeepsProblems) {
   EXPECT_GT(cancel_100, 0);
 }
 
+// With moves onto feature lines, the split's gathering comes after them. A plate 0.3 thick with 3 × 2 round holes
+// of radius 0.3 at 200 squares: each hole's eight −1/4 lie on its two rims (none gathered into a −2/4 in the strip
+// between two holes, as the gathering before the moves made it), the eight +1/4 at the plate's corners, and the
+// map and the quads have no problems.
+TEST(Request, MapMovesSingularitiesOntoFeatureLinesBeforeGathering) {
+  const Mesh m = test::extruded(test::perforated_plate(3, 2, 8, 3, 0.3), 0.3);
+  FieldDesigner d(m.V, m.F);
+  FieldRequest r;
+  r.prescription.N = 4;
+  r.auto_place = true;
+  r.feature_degrees = 30;
+  const MapOutcome o = map_request(d, m.F, r, 0, 200, true);
+  ASSERT_TRUE(o.field.verified);
+  int negative = 0, positive = 0;
+  for (auto [v, n] : o.field.prescription.vertex) {
+    ASSERT_LT(v, m.V.rows());  // an input vertex
+    ASSERT_EQ(std::abs(n), 1) << "vertex " << v;
+    const Eigen::RowVector3d p = m.V.row(v);
+    const bool top_or_bottom = std::abs(p.z()) < 1e-9 || std::abs(p.z() + 0.3) < 1e-9;
+    EXPECT_TRUE(top_or_bottom) << "vertex " << v;
+    if (n < 0) {
+      ++negative;
+      const double radius = std::hypot(p.x() - std::floor(p.x()) - 0.5, p.y() - std::floor(p.y()) - 0.5);
+      EXPECT_NEAR(radius, 0.3, 1e-6) << "vertex " << v << " is not on a rim";
+    } else {
+      ++positive;
+      EXPECT_TRUE((p.x() == 0 || p.x() == 3) && (p.y() == 0 || p.y() == 2)) << "vertex " << v << " is not a corner";
+    }
+  }
+  EXPECT_EQ(negative, 48);
+  EXPECT_EQ(positive, 8);
+  const ParamQuality& q = o.param.quality;
+  EXPECT_EQ(q.flipped_faces + q.degenerate_faces + q.winding_errors, 0);
+  ASSERT_TRUE(o.quads.has_value());
+  EXPECT_TRUE(o.quads->quality.problems.empty());
+  EXPECT_EQ(o.quads->quality.irregular_vertices, 56);
+}
+
 TEST(Request, SplittingRefusesWhatItCannotCarry) {
   const Mesh m = make_cube_sphere(3, false);
   FieldDesigner d(m.V, m.F);

@@ -106,6 +106,13 @@ AutoResult auto_singularities(const MatrixX3d& V, const MatrixX3i& F, const Auto
 std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& topology, const std::map<int, int>& vertex, double distance,
                                             std::vector<std::pair<int, int>>* pairs = nullptr, bool partial = false, int* met = nullptr);
 
+// The split of AutoOptions::split_above on its own, as auto_singularities ends (after the cancellation): the
+// singularities of `vertex` but those at options.held vertices (kept as they are) gathered, split and met with
+// opposite ones within options.cancel_distance; `result`'s split, met and pairs count them. The map requests run
+// it after moving singularities onto feature lines (trivcon/request.h). `vertex` itself when split_above is 0.
+std::map<int, int> split_auto_singularities(const MatrixX3d& V, const Topology& topology, const std::map<int, int>& vertex,
+                                            const AutoOptions& options, AutoResult& result);
+
 // The summing over coincident vertices above on its own.
 std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topology& topology, const std::map<int, int>& vertex);
 

@@ -126,7 +126,7 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& topology,
 // integer point, folding the map between them (a row of round holes' rims); the next nearest line vertex is
 // tried instead, else the singularity stays.
 // Updates `vertex` and `alignment.fixed` (new faces among them: the sector's middle ones), lists the moves in
-// `alignment.snapped`.
+// `alignment.snapped`; the sectors of moves listed there already (an earlier call's) are not turned again.
 void move_singularities_onto_features(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
                                       int N, double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment,
                                       double separation = 0);

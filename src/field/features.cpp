@@ -303,6 +303,8 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
   std::vector<char> claimed(t.num_faces, 0);
   for (const NarrowCorner& k : alignment.narrow)
     for (int f : k.faces) claimed[f] = 1;
+  for (const FeatureSnap& k : alignment.snapped)  // turned by an earlier call
+    for (int f : k.faces) claimed[f] = 1;
   std::vector<double> dist(t.num_vertices, std::numeric_limits<double>::infinity());
   // Whether a singularity other than s lies closer than `separation` to w.
   auto crowded = [&](int w, int s) {

@@ -490,6 +490,29 @@ std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topo
   return merged;
 }
 
+namespace {
+
+// The singularities of `free` at `held` vertices, taken out of it.
+std::map<int, int> take_held(const Topology& t, std::map<int, int>& free, const std::vector<int>& held_vertices) {
+  std::map<int, int> held;
+  for (int v : held_vertices) {
+    if (v < 0 || v >= t.num_vertices) throw Error("automatic singularities: held vertex " + std::to_string(v) + " out of range");
+    if (auto it = free.find(v); it != free.end()) held.insert(*it), free.erase(it);
+  }
+  return held;
+}
+
+// AutoOptions::split_above's gathering and split, then the meeting of opposite singularities within `distance`.
+std::map<int, int> split_and_meet(const MatrixX3d& V, const Topology& t, const std::map<int, int>& free, const AutoOptions& o,
+                                  double distance, AutoResult& r) {
+  if (!(o.split_distance > 0) || !std::isfinite(o.split_distance))
+    throw Error("automatic singularities: invalid split distance " + std::to_string(o.split_distance) + " (need a finite number > 0)");
+  const std::map<int, int> split = split_singularities(V, t, free, o.split_above, o.split_distance, r.split);
+  return cancel_singularity_pairs(V, t, split, distance, &r.pairs, true, &r.met);
+}
+
+}  // namespace
+
 AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geometry& g, const Cycles& cycles, const AutoOptions& o) {
   if (o.N < 1) throw Error("automatic singularities: invalid N = " + std::to_string(o.N) + " (need N >= 1)");
   if (o.iterations < 1) throw Error("automatic singularities: invalid iterations = " + std::to_string(o.iterations) + " (need at least 1)");
@@ -563,22 +586,28 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
   if (!(o.cancel_distance >= 0) || !std::isfinite(o.cancel_distance))
     throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
   const double distance = o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
-  std::map<int, int> free = merged, held;
-  for (int v : o.held) {
-    if (v < 0 || v >= t.num_vertices) throw Error("automatic singularities: held vertex " + std::to_string(v) + " out of range");
-    if (auto it = free.find(v); it != free.end()) held.insert(*it), free.erase(it);
-  }
+  std::map<int, int> free = merged;
+  const std::map<int, int> held = take_held(t, free, o.held);
   r.vertex = cancel_singularity_pairs(V, t, free, distance, &r.pairs);
-  if (o.split_above > 0) {
-    if (!(o.split_distance > 0) || !std::isfinite(o.split_distance))
-      throw Error("automatic singularities: invalid split distance " + std::to_string(o.split_distance) + " (need a finite number > 0)");
-    r.vertex = split_singularities(V, t, r.vertex, o.split_above, o.split_distance, r.split);
-    r.vertex = cancel_singularity_pairs(V, t, r.vertex, distance, &r.pairs, true, &r.met);
-  }
+  if (o.split_above > 0) r.vertex = split_and_meet(V, t, r.vertex, o, distance, r);
   for (auto [v, n] : held)
     if ((r.vertex[v] += n) == 0) r.vertex.erase(v);
   r.seconds.cancel = seconds_since(t0);
   return r;
+}
+
+std::map<int, int> split_auto_singularities(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex,
+                                            const AutoOptions& o, AutoResult& result) {
+  if (o.split_above <= 0) return vertex;
+  if (!(o.cancel_distance >= 0) || !std::isfinite(o.cancel_distance))
+    throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
+  const double distance = o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
+  std::map<int, int> free = vertex;
+  const std::map<int, int> held = take_held(t, free, o.held);
+  std::map<int, int> out = split_and_meet(V, t, free, o, distance, result);
+  for (auto [v, n] : held)
+    if ((out[v] += n) == 0) out.erase(v);
+  return out;
 }
 
 AutoResult auto_singularities(const FieldDesigner& designer, const AutoOptions& options) {

@@ -121,13 +121,21 @@ Design request_design(const FieldDesigner& designer, const IndexPrescription& pr
   return d;
 }
 
-AutoResult request_auto(const FieldDesigner& designer, const FieldRequest& request, const RequestConstraints& constraints) {
+namespace {
+
+AutoOptions request_auto_options(const FieldDesigner& designer, const FieldRequest& request, const RequestConstraints& constraints) {
   AutoOptions o = request.auto_options;
   o.N = request.prescription.N;
   o.fixed = constraints.fixed;
   const Topology& t = designer.topology();
   for (int e : constraints.sharp_edges) o.held.push_back(t.edge_vertices(e, 0)), o.held.push_back(t.edge_vertices(e, 1));
-  return auto_singularities(designer, o);
+  return o;
+}
+
+}  // namespace
+
+AutoResult request_auto(const FieldDesigner& designer, const FieldRequest& request, const RequestConstraints& constraints) {
+  return auto_singularities(designer, request_auto_options(designer, request, constraints));
 }
 
 void move_request_to_repaired(FieldRequest& r, const Topology& t, const RepairedMesh& repaired) {
@@ -171,14 +179,25 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
   out.sharp_edges = out.constraints.sharp_edges;
   if (designer.fixed_faces() != out.constraints.fixed_faces) designer.set_fixed_faces(out.constraints.fixed_faces);
   if (request.auto_place) {
-    out.auto_result = request_auto(designer, request, out.constraints);
+    const bool onto = request.auto_options.onto_features > 0 && !request.split_large_turns && !out.constraints.sharp_edges.empty();
+    AutoOptions o = request_auto_options(designer, request, out.constraints);
+    // With moves onto the feature lines, they come before the split (AutoOptions::split_above) and again after
+    // it: a −1/N beside a line moves onto it (a corner of the line's quads) instead of first gathering with a
+    // neighbour a fraction of a unit away (two −1/N of neighbouring round holes in a plate became one −2/N in the
+    // strip between them, which folds the map); those moved are held, neither gathered nor split; the ±1/N the
+    // split spreads (a cap's +1 made four +1/4 a unit from its centre) may then move onto a line in turn.
+    if (onto) o.split_above = 0;
+    out.auto_result = auto_singularities(designer, o);
     p.vertex = out.auto_result->vertex;
-    if (request.auto_options.onto_features > 0 && !request.split_large_turns && !out.constraints.sharp_edges.empty()) {
+    if (onto) {
       FeatureAlignment& a = out.constraints.features;
-      move_singularities_onto_features(designer.V(), designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N,
-                                       request.auto_options.onto_features, request.auto_options.onto_flat_sectors, p.vertex, a,
-                                       request.auto_options.onto_separation);
-      if (!a.snapped.empty()) {  // the sectors turned anew, unless a direction given by hand holds the face
+      auto move_onto = [&]() {
+        const size_t before = a.snapped.size();
+        move_singularities_onto_features(designer.V(), designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N,
+                                         request.auto_options.onto_features, request.auto_options.onto_flat_sectors, p.vertex, a,
+                                         request.auto_options.onto_separation);
+        if (a.snapped.size() == before) return;
+        // The sectors turned anew, unless a direction given by hand holds the face.
         for (const FeatureSnap& k : a.snapped)
           for (int f : k.faces)
             if (!request.prescription.fixed.count(f)) out.constraints.fixed[f] = a.fixed.at(f);
@@ -186,6 +205,13 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
         for (auto [f, angle] : out.constraints.fixed) out.constraints.fixed_faces.push_back(f);
         p.fixed = out.constraints.fixed;
         designer.set_fixed_faces(out.constraints.fixed_faces);
+      };
+      move_onto();
+      o.split_above = request.auto_options.split_above;
+      std::map<int, int> split = split_auto_singularities(designer.V(), designer.topology(), p.vertex, o, *out.auto_result);
+      if (split != p.vertex) {
+        p.vertex = std::move(split);
+        move_onto();
       }
     }
   }
