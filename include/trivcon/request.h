@@ -90,7 +90,9 @@ struct FieldOutcome {
   std::vector<int> sharp_edges;           // the feature edges of the final mesh
   Design design;                          // on the final mesh
   bool verified = false;                  // design_verified(design)
-  std::optional<AutoResult> auto_result;  // with auto_place
+  // With auto_place. Its `vertex` is the placement before the moves onto feature lines (AutoOptions::onto_features)
+  // and, where those are made, before the split that follows them; `prescription` holds what was designed.
+  std::optional<AutoResult> auto_result;
   std::optional<RelaxResult> relax_result;  // with relax: its prescription is the one designed (on the input mesh)
   // With split_large_turns: the refined mesh (refined == nullptr when no round was needed: the input's).
   std::unique_ptr<FieldDesigner> refined;

@@ -878,8 +878,9 @@ class FieldDesigner(_Cached):
 
         map_target_faces or map_edge_length (N = 4, singularities="auto"): choose the singularities for a map at
           that scale, as `trivcon param`/`quad --auto` do (docs/param.md): +- pairs closer than one unit
-          cancelled (unless auto_cancel is given), close same-sign ones gathered or spread, those at the ends of
-          sharp edges kept, a +-1/4 within 1.5 units of a sharp edge moved onto it; when their map folds
+          cancelled (unless auto_cancel is given), those at the ends of sharp edges kept, a +-1/4 within 1.5 units
+          of a sharp edge moved onto it, then close same-sign ones gathered or spread (and those spread moved onto
+          a sharp edge in turn); when their map folds
           or its quad mesh fails a check (the scale too coarse for them), or it stretches (mean singular-value
           ratio above 1.5), placed again: relaxed, with pairs cancelled within 2, then 4 units, and those relaxed, the
           cleanest map's kept (this makes the map once or more). Then Result.parametrize/quad at the same scale
@@ -1538,8 +1539,9 @@ class Parametrization:
 class AutoResult(_Cached):
     """Singularities found automatically (FieldDesigner.auto_singularities).
 
-      singularities  {vertex: Fraction} to prescribe (after cancellation); singularity_arrays the same as
-                     (vertices, numerators) arrays
+      singularities  {vertex: Fraction} to prescribe (after cancellation; from solve(..., map_target_faces=K) with
+                     sharp edges, before the moves onto them and the split after those: Result.singularities
+                     holds what was designed); singularity_arrays the same as (vertices, numerators) arrays
       found          {vertex: Fraction} of the smoothest field, before cancellation
       pairs          [(vertex of +n, vertex of -n)] cancelled, in order
       coincident_removed  singularities removed by summing over coincident vertices (auto.h)

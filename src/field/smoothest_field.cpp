@@ -492,6 +492,13 @@ std::map<int, int> merge_coincident_singularities(const MatrixX3d& V, const Topo
 
 namespace {
 
+// AutoOptions::cancel_distance in the mesh's units, checked.
+double cancel_distance_of(const MatrixX3d& V, const Topology& t, const AutoOptions& o) {
+  if (!(o.cancel_distance >= 0) || !std::isfinite(o.cancel_distance))
+    throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
+  return o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
+}
+
 // The singularities of `free` at `held` vertices, taken out of it.
 std::map<int, int> take_held(const Topology& t, std::map<int, int>& free, const std::vector<int>& held_vertices) {
   std::map<int, int> held;
@@ -583,9 +590,7 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
   r.coincident_removed = static_cast<int>(r.found.size() - merged.size());
 
   t0 = Clock::now();
-  if (!(o.cancel_distance >= 0) || !std::isfinite(o.cancel_distance))
-    throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
-  const double distance = o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
+  const double distance = cancel_distance_of(V, t, o);
   std::map<int, int> free = merged;
   const std::map<int, int> held = take_held(t, free, o.held);
   r.vertex = cancel_singularity_pairs(V, t, free, distance, &r.pairs);
@@ -599,9 +604,7 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
 std::map<int, int> split_auto_singularities(const MatrixX3d& V, const Topology& t, const std::map<int, int>& vertex,
                                             const AutoOptions& o, AutoResult& result) {
   if (o.split_above <= 0) return vertex;
-  if (!(o.cancel_distance >= 0) || !std::isfinite(o.cancel_distance))
-    throw Error("automatic singularities: invalid cancel distance " + std::to_string(o.cancel_distance) + " (need a finite number >= 0)");
-  const double distance = o.cancel_absolute ? o.cancel_distance : o.cancel_distance * mean_edge_length(V, t);
+  const double distance = cancel_distance_of(V, t, o);
   std::map<int, int> free = vertex;
   const std::map<int, int> held = take_held(t, free, o.held);
   std::map<int, int> out = split_and_meet(V, t, free, o, distance, result);
