@@ -131,6 +131,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"integers_moved", q.integers_moved},
           {"integers_descended", q.integers_descended},
           {"segments_opened", q.segments_opened},
+          {"strip_widths", q.strip_widths},
           {"turned_boundary_points", q.turned_boundary_points},
           {"untangled_faces", q.untangled_faces},
           {"untangling_regions", q.untangling_regions},

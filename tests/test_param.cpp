@@ -163,6 +163,54 @@ TEST(Param, GenusTwoWithAutomaticSingularities) {
   EXPECT_LE(r.param.quality.flipped_faces, 0);
 }
 
+
+// Strips narrower than a unit between two parallel aligned lines, meshed four triangles across: a 6 × 4 plate with
+// a 4 × 3.2 slot leaves strips 0.4 high below and above it, at an edge length of 1. No face has its three corners
+// on the two lines, so only the strip's own width (found by walking the real-valued map across from each line)
+// keeps the rounding from putting both lines on one integer, where the strip's faces would collapse and fold (the
+// first rounding, without the strips, leaves 52 problems). Each strip keeps a unit across: its faces beside the
+// slot cover at least 4 squares.
+TEST(Param, NarrowStripsBetweenAlignedLinesKeepAUnit) {
+  constexpr double gap = 0.4;
+  std::vector<double> xs, ys{0, gap / 4, gap / 2, 3 * gap / 4, gap, 1.2, 2.0, 2.8, 4 - gap, 4 - 3 * gap / 4, 4 - gap / 2, 4 - gap / 4, 4};
+  for (int i = 0; i <= 12; ++i) xs.push_back(0.5 * i);
+  const int nx = static_cast<int>(xs.size()), ny = static_cast<int>(ys.size());
+  Mesh m;
+  m.V.resize(nx * ny, 3);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) m.V.row(j * nx + i) << xs[i], ys[j], 0;
+  std::vector<std::array<int, 3>> faces;
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i) {
+      const double cx = 0.5 * (xs[i] + xs[i + 1]), cy = 0.5 * (ys[j] + ys[j + 1]);
+      if (cx > 1 && cx < 5 && cy > gap && cy < 4 - gap) continue;  // the slot
+      const int a = j * nx + i, b = a + 1, c = a + nx + 1, d = a + nx;
+      if ((i + j) % 2) faces.push_back({a, b, c}), faces.push_back({a, c, d});
+      else faces.push_back({a, b, d}), faces.push_back({b, c, d});
+    }
+  m.F = test::faces(faces);
+  FieldRequest req;
+  req.auto_place = true;
+  req.align_boundary = true;
+  ParamOptions o;
+  o.edge_length = 1;
+  const MapRun r = run(m, req, o);
+  expect_seamless(r);
+  const ParamQuality& q = r.param.quality;
+  EXPECT_EQ(q.flipped_faces + q.degenerate_faces + q.winding_errors, 0) << param_warning(r.param);
+  EXPECT_GT(q.strip_widths, 0);  // the second rounding's map
+  double below = 0, above = 0;  // the (u, v) area of the strips' faces beside the slot
+  for (int f = 0; f < m.F.rows(); ++f) {
+    const Eigen::Vector3d c = (m.V.row(m.F(f, 0)) + m.V.row(m.F(f, 1)) + m.V.row(m.F(f, 2))).transpose() / 3;
+    if (c.x() < 1 || c.x() > 5) continue;
+    const Eigen::Vector2d p0 = r.param.uv.row(3 * f), p1 = r.param.uv.row(3 * f + 1), p2 = r.param.uv.row(3 * f + 2);
+    const double area = 0.5 * std::abs((p1 - p0).x() * (p2 - p0).y() - (p1 - p0).y() * (p2 - p0).x());
+    if (c.y() < gap) below += area;
+    if (c.y() > 4 - gap) above += area;
+  }
+  EXPECT_GE(below, 4 - 1e-6);
+  EXPECT_GE(above, 4 - 1e-6);
+}
 // Relief: a plate with 27 round holes of radius 0.3, its boundary aligned, at 900 squares (about three units
 // between neighbouring holes). Its map keeps no fold, but where the rounding left a singularity's corner opened to
 // about π a face is nearly flat (σ_max/σ_min in the thousands: alone it would lift the area-weighted mean by a

@@ -104,6 +104,8 @@ struct ParamQuality {
   int integers_descended = 0; // integers moved by whole units to lower energy after the rounding (docs/param.md)
   int segments_opened = 0;    // lengths between integer points (aligned edges and chains of them, loop and face
                               // extents) the rounding would have collapsed, kept a unit (docs/param.md)
+  int strip_widths = 0;       // widths of strips between parallel aligned lines the second rounding kept open (0:
+                              // the first rounding's map, docs/param.md "Rounding")
   int untangled_faces = 0;    // folded or degenerate faces opened by the local untangling (docs/param.md)
   int untangling_regions = 0; // regions untangled (each kept only when the map had fewer folds after it)
   int rewound_regions = 0;    // of those, regions untangled again from their least squares against a wrong winding

@@ -267,9 +267,10 @@ std::vector<double> connection_log_scale(const Topology& t, const Geometry& g, c
 
 namespace {
 
-// One attempt at the map, with the quad edge length (from options) times `scale`.
+// One attempt at the map, with the quad edge length (from options) times `scale`; with `keep_strips`, the widths of
+// strips between parallel aligned lines are kept open by the rounding too (the second rounding, parametrize).
 Parametrization parametrize_at(const FieldDesigner& designer, const Design& design, const ParamOptions& options, double scale,
-                               double untangle_share = 1.0) {
+                               double untangle_share = 1.0, bool keep_strips = false) {
   const auto t0 = linalg::Clock::now();
   const Topology& t = designer.topology();
   const Geometry& g = designer.geometry();
@@ -1033,6 +1034,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     double least = 1;                          // the fewest units it keeps
     bool either_sign = false;                  // kept from 0 only, not from turning (a face's extent)
     std::vector<char> held;                    // per term: never the one changed to open it (empty: none held)
+    bool strip = false;                        // a strip's width (kept at the rounding itself)
   };
   std::vector<Segment> segments;
   std::vector<std::vector<int>> segments_of(nY);  // per free integer, the segments it enters
@@ -1162,6 +1164,114 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         add_extent(corner[hi][c], corner[lo][c]);
       }
     }
+    // With keep_strips: two parallel aligned lines less than kStripUnits apart with vertices between them (a strip
+    // between a hole's rim and a plate's outer edge, or a thin wall between two rims, meshed more than one triangle
+    // across): rounded onto one integer, the strip collapses and the vertices inside fold over the lines (a strip
+    // one triangle across collapses to segments, counted apart, and its faces' extents are kept above). The strip's
+    // width, line to line, keeps its real-valued sign and a unit. It is found by walking the real-valued map from
+    // each aligned edge straight across (along the coordinate constant on it), face by face, to the first aligned
+    // edge reached: kept when that one has the same coordinate constant and a vertex off the lines was passed. A
+    // cut is crossed with its transition (the width then gathers the cut's translation); a walk that meets the
+    // boundary, a folded face or a line across it ends unkept.
+    if (keep_strips) {
+      constexpr double kStripUnits = 2.0;
+      std::vector<int> coordinate_in(3 * static_cast<size_t>(nF), -1);  // per (face, edge slot): its aligned coordinate, 2 both
+      std::vector<char> on_line(nV, 0);                                 // an end of an aligned edge
+      for (int i = 0; i < nAligned; ++i) {
+        const auto [e, f] = aligned[i];
+        on_line[t.edge_vertices(e, 0)] = on_line[t.edge_vertices(e, 1)] = 1;
+        for (int k = 0; k < 3; ++k)
+          if (t.face_edges(f, k) == e) coordinate_in[3 * f + k] = coordinate_in[3 * f + k] == -1 ? aligned_coordinate[i] : 2;
+      }
+      auto real_at = [&](int w, int c) {
+        double x = 0;
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * w + c); it; ++it) x += it.value() * y[it.col()];
+        return x;
+      };
+      auto corners_of = [&](int f) {
+        std::array<Eigen::Vector2d, 3> p;
+        for (int k = 0; k < 3; ++k) p[k] = Eigen::Vector2d(real_at(wedge[3 * f + k], 0), real_at(wedge[3 * f + k], 1));
+        return p;
+      };
+      std::set<std::vector<std::pair<int, double>>> strips;
+      for (int i = 0; i < nAligned; ++i) {
+        const auto [e0, f0] = aligned[i];
+        if (folded(f0)) continue;
+        int k0 = 0;
+        while (t.face_edges(f0, k0) != e0) ++k0;  // edge slot k joins corners k and k + 1
+        std::array<Eigen::Vector2d, 3> p = corners_of(f0);
+        // The start's coordinate c0 in the current chart: sign · (its coordinate c) + offset.
+        const int c0 = aligned_coordinate[i];
+        int c = c0;
+        double sign = 1;
+        std::map<int, double> offset;
+        const double across = p[(k0 + 2) % 3][c] - 0.5 * (p[k0][c] + p[(k0 + 1) % 3][c]);
+        if (std::abs(across) < 1e-9) continue;
+        Eigen::Vector2d d = Eigen::Vector2d::Zero();
+        d[c] = across > 0 ? 1.0 : -1.0;
+        Eigen::Vector2d at = 0.5 * (p[k0] + p[(k0 + 1) % 3]);
+        int f = f0, entry = e0;
+        double travelled = 0;
+        bool inner = false;
+        for (int steps = 0; steps < nF; ++steps) {
+          for (int k = 0; k < 3; ++k) inner = inner || !on_line[t.F(f, k)];
+          // The edge of f (other than the entry) the ray leaves through, the nearest ahead.
+          int exit_slot = -1;
+          double exit_at = std::numeric_limits<double>::infinity();
+          for (int k = 0; k < 3; ++k) {
+            if (t.face_edges(f, k) == entry) continue;
+            const Eigen::Vector2d ab = p[(k + 1) % 3] - p[k], r = p[k] - at;
+            const double det = ab.x() * d.y() - ab.y() * d.x();
+            if (std::abs(det) < 1e-14) continue;
+            const double ahead = (ab.x() * r.y() - ab.y() * r.x()) / det, u = (d.x() * r.y() - d.y() * r.x()) / det;  // at + ahead d = p_k + u ab
+            if (ahead > 1e-12 && u >= -1e-9 && u <= 1 + 1e-9 && ahead < exit_at) exit_at = ahead, exit_slot = k;
+          }
+          if (exit_slot < 0) break;
+          travelled += exit_at;
+          if (travelled >= kStripUnits) break;
+          const int e = t.face_edges(f, exit_slot), line = coordinate_in[3 * f + exit_slot];
+          if (line == c) {
+            std::map<int, double> width = offset;
+            along_row(wedge[3 * f + exit_slot], c, width, sign);
+            along_row(wedge[3 * f0 + k0], c0, width, -1.0);
+            std::vector<std::pair<int, double>> key = terms_of(width);
+            if (!key.empty() && key.front().second < 0)
+              for (auto& term : key) term.second = -term.second;
+            const size_t before = segments.size();
+            if (inner && !key.empty() && strips.insert(key).second) add_segment(width, 1);
+            if (segments.size() > before) segments.back().strip = true, ++q.strip_widths;
+            break;
+          }
+          if (line >= 0) break;  // a line across the walk, or a point on both
+          const int next = t.edge_faces(e, 0) == f ? t.edge_faces(e, 1) : t.edge_faces(e, 0);
+          if (next < 0 || folded(next)) break;
+          at += exit_at * d;
+          const std::array<Eigen::Vector2d, 3> p_next = corners_of(next);
+          const int v0 = t.edge_vertices(e, 0), v1 = t.edge_vertices(e, 1);
+          const int w0 = wedge_at(f, v0), w0_next = wedge_at(next, v0);
+          if (w0 != w0_next || wedge_at(f, v1) != wedge_at(next, v1)) {
+            // A cut: φ_next = J^r φ_f + T at both its ends, r from the edge's direction in the two charts. Then
+            // φ_f[c] = Σ_b J^{−r}[c][b] (φ_next[b] − T[b]), one b, with T[b] = φ_next(v0)[b] − (J^r φ_f(v0))[b].
+            const Eigen::Vector2d in_f = p[t.corner_of(f, v1)] - p[t.corner_of(f, v0)];
+            const Eigen::Vector2d in_next = p_next[t.corner_of(next, v1)] - p_next[t.corner_of(next, v0)];
+            const double turn = std::atan2(in_f.x() * in_next.y() - in_f.y() * in_next.x(), in_f.dot(in_next));
+            const int r = static_cast<int>(((std::lround(turn / (kPi / 2)) % 4) + 4) % 4);
+            int b = 0;
+            while (rotation_entry(4 - r, c, b) == 0) ++b;
+            std::map<int, double> T;
+            along_row(w0_next, b, T, 1.0);
+            for (int a = 0; a < 2; ++a)
+              if (const double j = rotation_entry(r, b, a); j != 0) along_row(w0, a, T, -j);
+            sign *= rotation_entry(4 - r, c, b);
+            for (auto [j, x] : T) offset[j] -= sign * x;
+            c = b;
+            at = rotate(r, at) + (p_next[t.corner_of(next, v0)] - rotate(r, p[t.corner_of(f, v0)]));
+            d = rotate(r, d);
+          }
+          f = next, entry = e, p = p_next;
+        }
+      }
+    }
     // A boundary loop's extent: its width and height in (u, v) are kept at least one unit the same way, so that a
     // hole smaller than a square does not round to a point or to a slit one unit long (whose two sides would be
     // one quad edge: the quad mesh would close it). The loop is developed into the chart of its first edge's
@@ -1228,27 +1338,45 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     }
   }
   // After a round's integers are given values: every segment now whole that the round completed, and that would be
-  // 0 or turned, gets one unit in the real map's sense through one of its integers of coefficient ±1 (the one in
-  // the fewest other segments: a corner between two segments moves neither); the segments that integer enters
-  // are looked at again, a bounded number of times.
+  // 0 or turned, gets one unit in the real map's sense through one of its integers of coefficient ±1: one whose
+  // change closes no other whole segment if there is one, and of those the one in the fewest other segments (a
+  // corner between two segments moves neither); the segments that integer enters are looked at again, after
+  // those waiting, a bounded number of times.
+  auto open_length = [&](const Segment& seg, int changed, double change, bool& whole) {  // in the real map's sense
+    double length = 0;
+    whole = true;
+    for (auto [i, coefficient] : seg.terms) whole &= fixed[i] != 0, length += coefficient * (value[i] + (i == changed ? change : 0.0));
+    return seg.either_sign ? std::abs(length) : seg.real > 0 ? length : -length;
+  };
+  auto closes_another = [&](int k, int j, double change) {
+    for (int other : segments_of[j]) {
+      bool whole = false;
+      if (other != k && open_length(segments[other], -1, 0, whole) > segments[other].least - 0.5 && whole &&
+          !(open_length(segments[other], j, change, whole) > segments[other].least - 0.5))
+        return true;
+    }
+    return false;
+  };
   auto keep_segments_open = [&](const std::vector<int>& round) {
     std::vector<int> queue;
     for (int j : round) queue.insert(queue.end(), segments_of[j].begin(), segments_of[j].end());
-    for (int budget = 4 * static_cast<int>(queue.size()) + 16; !queue.empty() && budget > 0; --budget) {
-      const int k = queue.back();
-      queue.pop_back();
+    const size_t budget = 4 * queue.size() + 16;
+    for (size_t head = 0; head < queue.size() && head < budget; ++head) {
+      const int k = queue[head];
       const Segment& seg = segments[k];
+      bool whole = false;
+      if (open_length(seg, -1, 0, whole) > seg.least - 0.5 || !whole) continue;
       double length = 0;
-      bool whole = true;
-      for (auto [i, coefficient] : seg.terms) whole &= fixed[i] != 0, length += coefficient * value[i];
-      if (!whole || (seg.either_sign ? std::abs(length) : seg.real > 0 ? length : -length) > seg.least - 0.5) continue;  // in the real map's sense
+      for (auto [i, coefficient] : seg.terms) length += coefficient * value[i];
       int pick = -1;
       double pick_coefficient = 0;
+      bool pick_closes = true;
       for (size_t m = 0; m < seg.terms.size(); ++m) {
         const auto [i, coefficient] = seg.terms[m];
-        if (std::abs(std::abs(coefficient) - 1) < 1e-9 && (seg.held.empty() || !seg.held[m]) &&
-            (pick < 0 || segments_of[i].size() < segments_of[pick].size()))
-          pick = i, pick_coefficient = coefficient;
+        if (!(std::abs(std::abs(coefficient) - 1) < 1e-9) || (!seg.held.empty() && seg.held[m])) continue;
+        const bool closes = closes_another(k, i, ((seg.real > 0 ? seg.least : -seg.least) - length) * coefficient);
+        if (pick < 0 || (pick_closes && !closes) || (pick_closes == closes && segments_of[i].size() < segments_of[pick].size()))
+          pick = i, pick_coefficient = coefficient, pick_closes = closes;
       }
       if (pick < 0) continue;
       // The length becomes ±least; not when that moves the integer more than two units from its rounding (the
@@ -1283,6 +1411,36 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         if (closes(k)) return true;
     return false;
   };
+  // The value integer j is rounded to: the whole number nearest its real value that keeps open every strip's width
+  // it completes (its other terms already fixed), within three units; its plain rounding when there is none. (The
+  // other segments are opened after the round, above: at the rounding itself they would move fandisk's map.)
+  auto rounded_keeping_strips = [&](int j) {
+    struct Bound {
+      double a, rest, least;  // a x + rest, in the real map's sense, at least `least`
+    };
+    std::vector<Bound> bounds;
+    for (int k : segments_of[j]) {
+      const Segment& seg = segments[k];
+      if (!seg.strip) continue;
+      Bound b{0, 0, seg.least};
+      bool complete = true;
+      for (auto [i, coefficient] : seg.terms) {
+        if (i == j) b.a += coefficient;
+        else complete = complete && fixed[i] != 0, b.rest += coefficient * value[i];
+      }
+      if (!complete || b.a == 0) continue;
+      if (seg.real < 0) b.a = -b.a, b.rest = -b.rest;
+      bounds.push_back(b);
+    }
+    const double nearest = std::round(y[j]);
+    if (bounds.empty()) return nearest;
+    std::vector<double> candidates;
+    for (int d = -3; d <= 3; ++d) candidates.push_back(nearest + d);
+    std::stable_sort(candidates.begin(), candidates.end(), [&](double a, double c) { return std::abs(a - y[j]) < std::abs(c - y[j]); });
+    for (double x : candidates)
+      if (std::all_of(bounds.begin(), bounds.end(), [&](const Bound& b) { return b.a * x + b.rest > b.least - 0.5; })) return x;
+    return nearest;
+  };
   std::vector<int> left = integer_free;
   while (!left.empty()) {
     check_cancelled();
@@ -1293,7 +1451,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     size_t take = std::max<size_t>(1, static_cast<size_t>(std::ceil(options.rounding_fraction * left.size())));
     if (static_cast<int>(left.size()) <= options.round_all_below) take = left.size();  // the last few at once
     while (take < left.size() && whole_offset(y[left[take]]) < 1e-9) ++take;  // already whole: free to fix
-    for (size_t k = 0; k < take; ++k) fixed[left[k]] = 1, value[left[k]] = std::round(y[left[k]]);
+    for (size_t k = 0; k < take; ++k) fixed[left[k]] = 1, value[left[k]] = rounded_keeping_strips(left[k]);
     if (!segments.empty()) keep_segments_open(std::vector<int>(left.begin(), left.begin() + static_cast<long>(take)));
     refix = true;
     left.erase(left.begin(), left.begin() + static_cast<long>(take));
@@ -1952,6 +2110,13 @@ std::vector<ParamOptions> size_variants(const ParamOptions& options) {
   return variants;
 }
 
+// The untangling's share for sizing variant v of `count` (parametrize_at): each but the last untangles on
+// kUntangleShareFollowed of the bounds (the next sizing is the cheaper remedy for the folds a long untangling would
+// fight), the last on options.untangle_share.
+double variant_share(size_t v, size_t count, const ParamOptions& options) {
+  return v + 1 < count ? kUntangleShareFollowed : options.untangle_share;
+}
+
 // The near-miss retries from `best`, the first map (or its unit-size variant) with the search's time so far.
 Parametrization retry_near_miss(const FieldDesigner& designer, const Design& design, const ParamOptions& options, Parametrization best,
                                 linalg::Clock::time_point start, double seconds_before) {
@@ -1966,6 +2131,19 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
   const int n = static_cast<int>(variants.size());
   int attempts = best.quality.attempts, retried = 0;
   best.quality.seconds_retries = 0;
+  // Still with problems: the sizing variants again with the second rounding, which also keeps the widths of strips
+  // between parallel aligned lines open (parametrize_at). Not first: where the first rounding has no problems its
+  // map is kept as it was; where it has, this one often has fewer (plates with holes near their edges, thin walls).
+  // None when the first of them finds no strip (its map would be the first rounding's); none in a screening.
+  const std::vector<ParamOptions> sized = size_variants(options);
+  for (size_t v = 0; v < sized.size() && problems(best.quality) > 0 && options.retries > 0 && !necessary; ++v) {
+    Parametrization other = parametrize_at(designer, design, sized[v], 1.0, variant_share(v, sized.size(), options), true);
+    ++attempts;
+    if (other.quality.strip_widths == 0) break;
+    const int p = problems(other.quality), b = problems(best.quality);
+    if (other.quality.seamless && (p < b || (p == b && other.quality.mean_distortion < best.quality.mean_distortion))) best = std::move(other);
+  }
+  const bool keep_strips = best.quality.strip_widths > 0;  // the rounding of the map kept
   if (problems(best.quality) > 0 && problems(best.quality) <= near_miss && !necessary)
     for (double scale : {0.97, 1.03, 0.94, 1.06})
       for (const ParamOptions& variant : variants) {
@@ -1973,7 +2151,7 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
         // in factorizations (each a solve's main cost; unlike wall time, the same on every machine, so the same map
         // everywhere).
         if (problems(best.quality) == 0 || retried >= options.retries * n || retry_factorizations >= 2 * n * first_factorizations) break;
-        Parametrization other = parametrize_at(designer, design, variant, scale);
+        Parametrization other = parametrize_at(designer, design, variant, scale, 1.0, keep_strips);
         ++attempts, ++retried;
         retry_factorizations += other.quality.factorizations;
         if (other.quality.seamless && problems(other.quality) < problems(best.quality)) best = std::move(other);
@@ -1986,6 +2164,7 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
 
 }  // namespace
 
+// A map left with problems is made again with the second rounding (the widths of strips kept, retry_near_miss).
 // The rounding's outcome is sensitive to the scale: a map left with a few folds or wrong windings (a near miss)
 // is made again at quad edge lengths 3 % and 6 % shorter and longer (while those attempts have cost less than
 // twice the first), the first without any kept, else the one with the fewest. Not when a singularity has index ≥ 1 (its folds are necessary) or the problems are many (the
@@ -1993,9 +2172,7 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
 Parametrization parametrize(const FieldDesigner& designer, const Design& design, const ParamOptions& options) {
   const auto start = linalg::Clock::now();
   const std::vector<ParamOptions> variants = size_variants(options);
-  // Each variant but the last untangles on kUntangleShareFollowed of the bounds (the next sizing is the cheaper
-  // remedy for the folds a long untangling would fight), the last on options.untangle_share.
-  auto share = [&](size_t v) { return v + 1 < variants.size() ? kUntangleShareFollowed : options.untangle_share; };
+  auto share = [&](size_t v) { return variant_share(v, variants.size(), options); };
   Parametrization best = parametrize_at(designer, design, options, 1.0, share(0));
   const int first_factorizations = best.quality.factorizations;
   int attempts = 1;
