@@ -509,6 +509,12 @@ std::map<int, int> take_held(const Topology& t, std::map<int, int>& free, const 
   return held;
 }
 
+// `held` put back into `vertex` (an index that sums to 0 with one there leaves no singularity).
+void put_back(std::map<int, int>& vertex, const std::map<int, int>& held) {
+  for (auto [v, n] : held)
+    if ((vertex[v] += n) == 0) vertex.erase(v);
+}
+
 // AutoOptions::split_above's gathering and split, then the meeting of opposite singularities within `distance`.
 std::map<int, int> split_and_meet(const MatrixX3d& V, const Topology& t, const std::map<int, int>& free, const AutoOptions& o,
                                   double distance, AutoResult& r) {
@@ -595,8 +601,7 @@ AutoResult auto_singularities(const MatrixX3d& V, const Topology& t, const Geome
   const std::map<int, int> held = take_held(t, free, o.held);
   r.vertex = cancel_singularity_pairs(V, t, free, distance, &r.pairs);
   if (o.split_above > 0) r.vertex = split_and_meet(V, t, r.vertex, o, distance, r);
-  for (auto [v, n] : held)
-    if ((r.vertex[v] += n) == 0) r.vertex.erase(v);
+  put_back(r.vertex, held);
   r.seconds.cancel = seconds_since(t0);
   return r;
 }
@@ -608,8 +613,7 @@ std::map<int, int> split_auto_singularities(const MatrixX3d& V, const Topology& 
   std::map<int, int> free = vertex;
   const std::map<int, int> held = take_held(t, free, o.held);
   std::map<int, int> out = split_and_meet(V, t, free, o, distance, result);
-  for (auto [v, n] : held)
-    if ((out[v] += n) == 0) out.erase(v);
+  put_back(out, held);
   return out;
 }
 

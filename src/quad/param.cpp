@@ -1066,6 +1066,13 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         if (std::abs(coefficient) > 1e-12) key.emplace_back(j, coefficient);
       return key;
     };
+    // The same up to its sign (a length found from either end), its first term's coefficient positive.
+    auto unsigned_terms_of = [&](const std::map<int, double>& acc) {
+      std::vector<std::pair<int, double>> key = terms_of(acc);
+      if (!key.empty() && key.front().second < 0)
+        for (auto& term : key) term.second = -term.second;
+      return key;
+    };
     for (int i = 0; i < nAligned; ++i) {
       const auto [e, f] = aligned[i];
       const int c = aligned_coordinate[i];
@@ -1106,9 +1113,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
               std::map<int, double> along;
               along_row(wa, 1 - c, along, -1.0);
               along_row(w, 1 - c, along, 1.0);
-              std::vector<std::pair<int, double>> key = terms_of(along);
-              if (!key.empty() && key.front().second < 0)
-                for (auto& term : key) term.second = -term.second;
+              const std::vector<std::pair<int, double>> key = unsigned_terms_of(along);
               if (!key.empty() && chains.insert(key).second) add_segment(along, 1);
               break;
             }
@@ -1183,15 +1188,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         for (int k = 0; k < 3; ++k)
           if (t.face_edges(f, k) == e) coordinate_in[3 * f + k] = coordinate_in[3 * f + k] == -1 ? aligned_coordinate[i] : 2;
       }
-      auto real_at = [&](int w, int c) {
-        double x = 0;
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * w + c); it; ++it) x += it.value() * y[it.col()];
-        return x;
-      };
-      auto corners_of = [&](int f) {
-        std::array<Eigen::Vector2d, 3> p;
-        for (int k = 0; k < 3; ++k) p[k] = Eigen::Vector2d(real_at(wedge[3 * f + k], 0), real_at(wedge[3 * f + k], 1));
-        return p;
+      auto corners_of = [&](int f) {  // in the real-valued map
+        return std::array<Eigen::Vector2d, 3>{out.uv.row(3 * f).transpose(), out.uv.row(3 * f + 1).transpose(), out.uv.row(3 * f + 2).transpose()};
       };
       std::set<std::vector<std::pair<int, double>>> strips;
       for (int i = 0; i < nAligned; ++i) {
@@ -1234,9 +1232,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
             std::map<int, double> width = offset;
             along_row(wedge[3 * f + exit_slot], c, width, sign);
             along_row(wedge[3 * f0 + k0], c0, width, -1.0);
-            std::vector<std::pair<int, double>> key = terms_of(width);
-            if (!key.empty() && key.front().second < 0)
-              for (auto& term : key) term.second = -term.second;
+            const std::vector<std::pair<int, double>> key = unsigned_terms_of(width);
             const size_t before = segments.size();
             if (inner && !key.empty() && strips.insert(key).second) add_segment(width, 1);
             if (segments.size() > before) segments.back().strip = true, ++q.strip_widths;
@@ -1342,19 +1338,24 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // change closes no other whole segment if there is one, and of those the one in the fewest other segments (a
   // corner between two segments moves neither); the segments that integer enters are looked at again, after
   // those waiting, a bounded number of times.
-  auto open_length = [&](const Segment& seg, int changed, double change, bool& whole) {  // in the real map's sense
+  // Segment seg's length in the real map's sense with integer j1 changed by d1 and j2 by d2 (−1: none); `whole`
+  // tells whether all its integers are fixed.
+  auto open_length = [&](const Segment& seg, bool& whole, int j1 = -1, double d1 = 0, int j2 = -1, double d2 = 0) {
     double length = 0;
     whole = true;
-    for (auto [i, coefficient] : seg.terms) whole &= fixed[i] != 0, length += coefficient * (value[i] + (i == changed ? change : 0.0));
+    for (auto [i, coefficient] : seg.terms)
+      whole &= fixed[i] != 0, length += coefficient * (value[i] + (i == j1 ? d1 : 0.0) + (i == j2 ? d2 : 0.0));
     return seg.either_sign ? std::abs(length) : seg.real > 0 ? length : -length;
   };
+  // Whether those changes close segment k, whole and open before.
+  auto closes = [&](int k, int j1, double d1, int j2 = -1, double d2 = 0) {
+    const Segment& seg = segments[k];
+    bool whole = false;
+    return open_length(seg, whole) > seg.least - 0.5 && whole && !(open_length(seg, whole, j1, d1, j2, d2) > seg.least - 0.5);
+  };
   auto closes_another = [&](int k, int j, double change) {
-    for (int other : segments_of[j]) {
-      bool whole = false;
-      if (other != k && open_length(segments[other], -1, 0, whole) > segments[other].least - 0.5 && whole &&
-          !(open_length(segments[other], j, change, whole) > segments[other].least - 0.5))
-        return true;
-    }
+    for (int other : segments_of[j])
+      if (other != k && closes(other, j, change)) return true;
     return false;
   };
   auto keep_segments_open = [&](const std::vector<int>& round) {
@@ -1365,7 +1366,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       const int k = queue[head];
       const Segment& seg = segments[k];
       bool whole = false;
-      if (open_length(seg, -1, 0, whole) > seg.least - 0.5 || !whole) continue;
+      if (open_length(seg, whole) > seg.least - 0.5 || !whole) continue;
       double length = 0;
       for (auto [i, coefficient] : seg.terms) length += coefficient * value[i];
       int pick = -1;
@@ -1393,22 +1394,11 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // keep_segments_open means it): the moves after the rounding (the descent, the singularities' and the other
   // integers' local searches) refuse those.
   auto closes_segment = [&](int j1, double d1, int j2 = -1, double d2 = 0) {
-    auto closes = [&](int k) {
-      const Segment& seg = segments[k];
-      double before = 0, after = 0;
-      for (auto [i, coefficient] : seg.terms) {
-        before += coefficient * value[i];
-        after += coefficient * (value[i] + (i == j1 ? d1 : 0.0) + (i == j2 ? d2 : 0.0));
-      }
-      const double sign = seg.real > 0 ? 1.0 : -1.0;
-      if (seg.either_sign) return std::abs(before) > seg.least - 0.5 && !(std::abs(after) > seg.least - 0.5);
-      return sign * before > seg.least - 0.5 && !(sign * after > seg.least - 0.5);
-    };
     for (int k : segments_of[j1])
-      if (closes(k)) return true;
+      if (closes(k, j1, d1, j2, d2)) return true;
     if (j2 >= 0)
       for (int k : segments_of[j2])
-        if (closes(k)) return true;
+        if (closes(k, j1, d1, j2, d2)) return true;
     return false;
   };
   // The value integer j is rounded to: the whole number nearest its real value that keeps open every strip's width
@@ -2093,6 +2083,12 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
 
 int problems(const ParamQuality& q) { return q.flipped_faces + q.degenerate_faces + q.winding_errors; }
 
+// Whether `other` is to be kept over `best`: seamless, with fewer problems, or as few and less stretched.
+bool better_map(const Parametrization& other, const Parametrization& best) {
+  const int p = problems(other.quality), b = problems(best.quality);
+  return other.quality.seamless && (p < b || (p == b && other.quality.mean_distortion < best.quality.mean_distortion));
+}
+
 // The sizing moves the rounding's integers: where its map keeps problems, the maps of the other sizings (the
 // map's and the connection's, the one not asked for first) and of the field's unit size are made too, until one
 // has none, and the one with the fewest problems kept; the retries try the map's sizing and the unit size.
@@ -2140,8 +2136,7 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
     Parametrization other = parametrize_at(designer, design, sized[v], 1.0, variant_share(v, sized.size(), options), true);
     ++attempts;
     if (other.quality.strip_widths == 0) break;
-    const int p = problems(other.quality), b = problems(best.quality);
-    if (other.quality.seamless && (p < b || (p == b && other.quality.mean_distortion < best.quality.mean_distortion))) best = std::move(other);
+    if (better_map(other, best)) best = std::move(other);
   }
   const bool keep_strips = best.quality.strip_widths > 0;  // the rounding of the map kept
   if (problems(best.quality) > 0 && problems(best.quality) <= near_miss && !necessary)
@@ -2182,8 +2177,7 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
     if (problems(best.quality) == 0 && !stretched) break;
     Parametrization other = parametrize_at(designer, design, variants[v], 1.0, share(v));
     ++attempts;
-    const int p = problems(other.quality), b = problems(best.quality);
-    if (other.quality.seamless && (p < b || (p == b && other.quality.mean_distortion < best.quality.mean_distortion))) best = std::move(other);
+    if (better_map(other, best)) best = std::move(other);
   }
   best.quality.attempts = attempts;
   best.quality.first_factorizations = first_factorizations;
