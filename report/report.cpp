@@ -137,6 +137,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"untangling_regions", q.untangling_regions},
           {"rewound_regions", q.rewound_regions},
           {"relieved_regions", q.relieved_regions},
+          {"shaped_faces", q.shaped_faces},
           {"flipped_faces", q.flipped_faces},
           {"degenerate_faces", q.degenerate_faces},
           {"collapsed_faces", q.collapsed_faces},

@@ -87,6 +87,10 @@ struct ParamOptions {
   // last sizing variant, in (0, 1]; the variants that another follows get kUntangleShareFollowed. A search that
   // makes other maps after this one (trivcon's map requests while they screen placements) sets that share too.
   double untangle_share = 1.0;
+  // Last: the faces stretched past kMapDistortionGoal and their neighbours lower their σ_max/σ_min with the
+  // integers held, leaving the field's directions a little where that helps (docs/param.md, "Folds": Shape);
+  // false: the least squares' map, which follows the field as closely as the integers allow.
+  bool shape = true;
 };
 
 struct ParamQuality {
@@ -110,6 +114,7 @@ struct ParamQuality {
   int untangling_regions = 0; // regions untangled (each kept only when the map had fewer folds after it)
   int rewound_regions = 0;    // of those, regions untangled again from their least squares against a wrong winding
   int relieved_regions = 0;   // regions around a nearly flat face opened after the untangling (docs/param.md)
+  int shaped_faces = 0;       // faces the shape pass moved to lower their stretch (0: none kept; docs/param.md)
   int flipped_faces = 0;      // faces whose (u, v) triangle is inverted
   int degenerate_faces = 0;   // faces whose (u, v) triangle has (nearly) zero area
   int collapsed_faces = 0;    // faces with an edge of length 0 on the surface, not turned over (not counted above)

@@ -38,6 +38,10 @@ namespace {
 // of their region has det J > kReliefDeterminant (relative to the ideal unit square); a flat or folded face
 // counts as kReliefFlat in the region's stretch.
 constexpr double kReliefRatio = 10, kReliefDeterminant = 0.05, kReliefFlat = 1e6;
+// The shape pass (last, ParamOptions::shape): the faces whose σ_max/σ_min exceeds kMapDistortionGoal and the faces
+// within kShapeRings rings of them lower their stretch with the barrier's shape term alone, at most kShapeRounds
+// rounds of kShapeSteps L-BFGS steps.
+constexpr int kShapeRings = 4, kShapeRounds = 8, kShapeSteps = 100;
 
 using Terms = std::vector<std::pair<int, double>>;
 
@@ -1765,14 +1769,21 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     }
     return sum;
   };
-  // `relieve`: the region holds no fold but a face left nearly flat; the barrier runs until every face has
-  // det J > kReliefDeterminant, and the result is kept when no face folds that did not, no vertex winds wrong
-  // that did not, and the region's stretch (stretch_of) is lower.
-  auto untangle_around = [&](const std::vector<int>& seeds, int rings, bool restart = false, bool relieve = false) {
-    if (relieve ? relief_left <= 0 : regions_left <= 0 || work_left <= 0) return false;
-    --(relieve ? relief_left : regions_left);
+  // `pass`: `open` untangles folds (kept when the region is better, Badness::better_than). `relieve`: the
+  // region holds no fold but a face left nearly flat; the barrier runs until every face has
+  // det J > kReliefDeterminant. `shape`: the barrier's shape term alone, Σ area · |J|² / χ(det J, ε) (scale-free,
+  // so it lowers σ_max/σ_min, not the size), for the budget of rounds. Relief and shape are kept when no face folds
+  // that did not, no vertex winds wrong that did not, and the region's stretch (stretch_of) is lower.
+  enum class Pass { open, relieve, shape };
+  std::vector<int> shape_keep_out;  // vertices the shape pass leaves where they are (never in its region)
+  auto untangle_around = [&](const std::vector<int>& seeds, int rings, bool restart = false, Pass pass = Pass::open) {
+    const bool relieve = pass != Pass::open;
+    if (pass == Pass::relieve ? relief_left <= 0 : pass == Pass::open && (regions_left <= 0 || work_left <= 0)) return false;
+    if (pass != Pass::shape) --(relieve ? relief_left : regions_left);
     std::vector<char>& inside = inside_scratch;
     std::vector<int> frontier, region;
+    if (pass == Pass::shape)
+      for (int v : shape_keep_out) inside[v] = 1;
     for (int v : seeds)
       if (!inside[v]) inside[v] = 1, frontier.push_back(v), region.push_back(v);
     for (int r = 0; r < rings; ++r) {
@@ -1793,6 +1804,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     std::vector<int>& variable = variable_scratch;
     std::vector<int> variables;
     for (int v : region) inside[v] = 0;  // the scratch arrays are left clear for the next region
+    if (pass == Pass::shape)
+      for (int v : shape_keep_out) inside[v] = 0;
     for (int c : corners) {
       for (int r = 0; r < 2; ++r)
         for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(P_rows, 2 * wedge[c] + r); it; ++it) {
@@ -1844,7 +1857,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     for (size_t k = 0; k < variables.size(); ++k) z[static_cast<int>(k)] = y[variables[k]];
     const Eigen::VectorXd z0 = z;
     if (restart) z = quad::least_squares_start(problem, z);
-    const quad::UntangleResult result = quad::untangle(problem, z, relieve ? kReliefDeterminant : 1e-3, 0.5, 30, 30);
+    const quad::UntangleResult result = pass == Pass::shape ? quad::untangle(problem, z, 1e-3, 0.0, kShapeRounds, kShapeSteps)
+                                                            : quad::untangle(problem, z, relieve ? kReliefDeterminant : 1e-3, 0.5, 30, 30);
     if (!relieve) work_left -= static_cast<double>(faces.size()) * (result.inner_iterations + result.outer_iterations);
     for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z[static_cast<int>(k)];
     corner_uv_of(faces);
@@ -1852,7 +1866,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     if (relieve ? after.folds <= before.folds && std::includes(before.wrong.begin(), before.wrong.end(), after.wrong.begin(), after.wrong.end()) &&
                       stretch_of(faces) < stretch_before
                 : after.better_than(before)) {
-      ++(relieve ? q.relieved_regions : q.untangling_regions);
+      if (pass == Pass::shape) q.shaped_faces = static_cast<int>(faces.size());
+      else ++(relieve ? q.relieved_regions : q.untangling_regions);
       return true;
     }
     for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z0[static_cast<int>(k)];
@@ -2013,8 +2028,31 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       if (folded(f) || !(distortion(f) > kReliefRatio)) continue;  // relieved with an earlier one
       check_cancelled();
       for (int rings : {2, 4})
-        if (untangle_around({t.F(f, 0), t.F(f, 1), t.F(f, 2)}, rings, false, true)) break;
+        if (untangle_around({t.F(f, 0), t.F(f, 1), t.F(f, 2)}, rings, false, Pass::relieve)) break;
     }
+  }
+  // The shape pass: the least squares follow the field, and where the integers do not fit it (feature lines a
+  // whole number of units apart that the field's own lengths put elsewhere, thin walls, strips) the faces stretch
+  // along one direction; here they may also turn a little. None when the map is folded at large (it will be made
+  // again or refused); where a few faces fold or vertices wind wrong, the faces around them stay as the untangling
+  // left them (the barrier would spend its steps there, and the region could not be kept).
+  if (options.shape && count_folds() <= too_many_folds) {
+    std::vector<int> seeds;
+    std::vector<char> seeded(nV, 0);
+    std::vector<int> trouble = badness().wrong;
+    for (int f = 0; f < nF; ++f)
+      if (folded(f))
+        for (int k = 0; k < 3; ++k) trouble.push_back(t.F(f, k));
+    for (int v : trouble)
+      for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
+        for (int k = 0; k < 3; ++k)
+          if (const int u = t.F(t.vertex_faces[j], k); !seeded[u]) seeded[u] = 1, shape_keep_out.push_back(u);
+    for (int f = 0; f < nF; ++f)
+      if (const double ratio = distortion(f); !folded(f) && !collapsed[f] && ratio > kMapDistortionGoal)
+        for (int k = 0; k < 3; ++k)
+          if (const int v = t.F(f, k); !seeded[v]) seeded[v] = 1, seeds.push_back(v);
+    check_cancelled();
+    if (!seeds.empty()) untangle_around(seeds, kShapeRings, false, Pass::shape);
   }
   q.seconds_untangling = linalg::seconds_since(t5);
 
