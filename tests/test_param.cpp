@@ -239,33 +239,41 @@ TEST(Param, NarrowStripsBetweenAlignedLinesKeepAUnit) {
   EXPECT_GE(above, 3.9);
 }
 
-// The shape pass: on the plate with 27 round holes, its boundary aligned, at 900 squares (about three units
-// between neighbouring holes), the rims' iso-lines and the cones' integer points do not fit the field's own
-// lengths and the least squares' map stretches around the holes; with the pass the faces there take less of it,
-// every relation still exact and nothing folded, and the mean ratio read from the corners falls.
+// The shape pass: a closed plate 0.5 thick with 3 round holes, its sharp edges aligned, at 100 squares. Its walls
+// must be a whole unit high and the rims ring the holes on integer lines; the least squares' map stretches past the
+// goal. With the pass the stretched faces and their neighbours take less of it, every relation still exact and
+// nothing folded, and the mean ratio read from the corners falls below the goal. At 150 squares the map is within
+// the goal and the pass leaves it as it is.
 TEST(Param, ShapePassLowersTheStretch) {
-  const Mesh m = test::perforated_plate(9, 3, 8, 4, 0.3);
+  const Mesh m = test::extruded(test::perforated_plate(3, 1, 6, 3, 0.3), 0.5);
   FieldRequest req;
   req.auto_place = true;
-  req.align_boundary = true;
+  req.feature_degrees = 30;
   ParamOptions o;
-  o.target_faces = 900;
+  o.target_faces = 100;
   o.shape = false;
-  const MapRun plain = run(m, req, o);
+  const MapRun plain = run(m, req, o, true);
   o.shape = true;
-  const MapRun shaped = run(m, req, o);
-  for (const MapRun* r : {&plain, &shaped}) {
+  const MapRun shaped = run(m, req, o, true);
+  o.target_faces = 150;
+  const MapRun within = run(m, req, o, true);
+  for (const MapRun* r : {&plain, &shaped, &within}) {
     expect_seamless(*r);
     expect_cones_on_integer_points(*r);
     const ParamQuality& q = r->param.quality;
     EXPECT_EQ(q.flipped_faces + q.degenerate_faces + q.winding_errors, 0) << param_warning(r->param);
+    EXPECT_GT(q.aligned_edges, 0);
     EXPECT_LT(q.max_alignment_error, 1e-7);
     EXPECT_NEAR(mean_singular_value_ratio(m, r->param.uv), q.mean_distortion, 1e-6);
   }
   EXPECT_EQ(plain.param.quality.shaped_faces, 0);
   EXPECT_GT(shaped.param.quality.shaped_faces, 0);
   const double before = plain.param.quality.mean_distortion, after = shaped.param.quality.mean_distortion;
+  EXPECT_GT(before, kMapDistortionGoal);
   EXPECT_LT(after, before - 0.04) << before << " -> " << after;
+  EXPECT_LT(after, kMapDistortionGoal);
+  EXPECT_LT(within.param.quality.mean_distortion, kMapDistortionGoal);
+  EXPECT_EQ(within.param.quality.shaped_faces, 0);
 }
 // Relief: a plate with 27 round holes of radius 0.3, its boundary aligned, at 900 squares (about three units
 // between neighbouring holes). Its map keeps no fold, but where the rounding left a singularity's corner opened to

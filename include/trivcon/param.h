@@ -87,9 +87,10 @@ struct ParamOptions {
   // last sizing variant, in (0, 1]; the variants that another follows get kUntangleShareFollowed. A search that
   // makes other maps after this one (trivcon's map requests while they screen placements) sets that share too.
   double untangle_share = 1.0;
-  // Last: the faces stretched past kMapDistortionGoal and their neighbours lower their σ_max/σ_min with the
-  // integers held, leaving the field's directions a little where that helps (docs/param.md, "Folds": Shape);
-  // false: the least squares' map, which follows the field as closely as the integers allow.
+  // Last, on a map whose mean σ_max/σ_min is past kMapDistortionGoal: the faces stretched past it and their
+  // neighbours lower their ratio with the integers held, leaving the field's directions a little where that helps
+  // (docs/param.md, "Folds": Shape); false: the least squares' map, which follows the field as closely as the
+  // integers allow.
   bool shape = true;
 };
 

@@ -2033,10 +2033,12 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   }
   // The shape pass: the least squares follow the field, and where the integers do not fit it (feature lines a
   // whole number of units apart that the field's own lengths put elsewhere, thin walls, strips) the faces stretch
-  // along one direction; here they may also turn a little. None when the map is folded at large (it will be made
-  // again or refused); where a few faces fold or vertices wind wrong, the faces around them stay as the untangling
-  // left them (the barrier would spend its steps there, and the region could not be kept).
-  if (options.shape && count_folds() <= too_many_folds) {
+  // along one direction; here they may also turn a little. Only on a map past the distortion goal: within it the
+  // least squares' map, which follows the field more closely, is kept (and the pass's cost saved). None when the
+  // map is folded at large (it will be made again or refused); where a few faces fold or vertices wind wrong, the
+  // faces around them stay as the untangling left them (the barrier would spend its steps there, and the region
+  // could not be kept).
+  if (options.shape && count_folds() <= too_many_folds && mean_ratio() > kMapDistortionGoal) {
     std::vector<int> seeds;
     std::vector<char> seeded(nV, 0);
     std::vector<int> trouble = badness().wrong;
