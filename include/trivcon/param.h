@@ -139,6 +139,7 @@ struct ParamQuality {
   double target_squares = 0;           // mesh area / edge_length²
   int non_unimodular = 0;              // integer relations the elimination could not keep whole (0 expected)
   double seconds_cut = 0, seconds_setup = 0, seconds_rounding = 0, seconds_stiffening = 0, seconds_untangling = 0, seconds_check = 0;
+  // (seconds_untangling: the untangling, the relief and the shape pass)
   double seconds_retries = 0;  // the attempts not kept
   double seconds_total() const {  // every stage and the retries
     return seconds_cut + seconds_setup + seconds_rounding + seconds_stiffening + seconds_untangling + seconds_check + seconds_retries;

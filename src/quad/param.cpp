@@ -38,9 +38,9 @@ namespace {
 // of their region has det J > kReliefDeterminant (relative to the ideal unit square); a flat or folded face
 // counts as kReliefFlat in the region's stretch.
 constexpr double kReliefRatio = 10, kReliefDeterminant = 0.05, kReliefFlat = 1e6;
-// The shape pass (last, ParamOptions::shape): the faces whose σ_max/σ_min exceeds kMapDistortionGoal and the faces
-// within kShapeRings rings of them lower their stretch with the barrier's shape term alone, at most kShapeRounds
-// rounds of kShapeSteps L-BFGS steps.
+// The shape pass (last, ParamOptions::shape; on a map whose mean ratio is past kMapDistortionGoal): the faces whose
+// σ_max/σ_min exceeds it and the faces within kShapeRings rings of them lower their stretch with the barrier's shape
+// term alone, at most kShapeRounds rounds of kShapeSteps L-BFGS steps.
 constexpr int kShapeRings = 4, kShapeRounds = 8, kShapeSteps = 100;
 
 using Terms = std::vector<std::pair<int, double>>;
@@ -2040,7 +2040,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // could not be kept).
   if (options.shape && count_folds() <= too_many_folds && mean_ratio() > kMapDistortionGoal) {
     std::vector<int> seeds;
-    std::vector<char> seeded(nV, 0);
+    std::vector<char> taken(nV, 0);  // kept out, or a seed already
+    // Kept out: the vertices winding wrong and those of folded faces, with the ring of faces around them.
     std::vector<int> trouble = badness().wrong;
     for (int f = 0; f < nF; ++f)
       if (folded(f))
@@ -2048,11 +2049,12 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     for (int v : trouble)
       for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j)
         for (int k = 0; k < 3; ++k)
-          if (const int u = t.F(t.vertex_faces[j], k); !seeded[u]) seeded[u] = 1, shape_keep_out.push_back(u);
+          if (const int u = t.F(t.vertex_faces[j], k); !taken[u]) taken[u] = 1, shape_keep_out.push_back(u);
+    // Seeds: the vertices of the faces stretched past the goal.
     for (int f = 0; f < nF; ++f)
       if (const double ratio = distortion(f); !folded(f) && !collapsed[f] && ratio > kMapDistortionGoal)
         for (int k = 0; k < 3; ++k)
-          if (const int v = t.F(f, k); !seeded[v]) seeded[v] = 1, seeds.push_back(v);
+          if (const int v = t.F(f, k); !taken[v]) taken[v] = 1, seeds.push_back(v);
     check_cancelled();
     if (!seeds.empty()) untangle_around(seeds, kShapeRings, false, Pass::shape);
   }
