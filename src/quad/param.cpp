@@ -1344,11 +1344,14 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // those waiting, a bounded number of times.
   // Segment seg's length in the real map's sense with integer j1 changed by d1 and j2 by d2 (−1: none); `whole`
   // tells whether all its integers are fixed.
-  auto open_length = [&](const Segment& seg, bool& whole, int j1 = -1, double d1 = 0, int j2 = -1, double d2 = 0) {
+  // `signed_length`, when given, gets the length as the integers' sum (before the real map's sense).
+  auto open_length = [&](const Segment& seg, bool& whole, int j1 = -1, double d1 = 0, int j2 = -1, double d2 = 0,
+                         double* signed_length = nullptr) {
     double length = 0;
     whole = true;
     for (auto [i, coefficient] : seg.terms)
       whole &= fixed[i] != 0, length += coefficient * (value[i] + (i == j1 ? d1 : 0.0) + (i == j2 ? d2 : 0.0));
+    if (signed_length) *signed_length = length;
     return seg.either_sign ? std::abs(length) : seg.real > 0 ? length : -length;
   };
   // Whether those changes close segment k, whole and open before.
@@ -1370,9 +1373,8 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       const int k = queue[head];
       const Segment& seg = segments[k];
       bool whole = false;
-      if (open_length(seg, whole) > seg.least - 0.5 || !whole) continue;
       double length = 0;
-      for (auto [i, coefficient] : seg.terms) length += coefficient * value[i];
+      if (open_length(seg, whole, -1, 0, -1, 0, &length) > seg.least - 0.5 || !whole) continue;
       int pick = -1;
       double pick_coefficient = 0;
       bool pick_closes = true;
@@ -1777,9 +1779,10 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   enum class Pass { open, relieve, shape };
   std::vector<int> shape_keep_out;  // vertices the shape pass leaves where they are (never in its region)
   auto untangle_around = [&](const std::vector<int>& seeds, int rings, bool restart = false, Pass pass = Pass::open) {
-    const bool relieve = pass != Pass::open;
+    const bool by_stretch = pass != Pass::open;  // kept by the stretch rule (relief and shape), not Badness
     if (pass == Pass::relieve ? relief_left <= 0 : pass == Pass::open && (regions_left <= 0 || work_left <= 0)) return false;
-    if (pass != Pass::shape) --(relieve ? relief_left : regions_left);
+    if (pass == Pass::relieve) --relief_left;
+    if (pass == Pass::open) --regions_left;
     std::vector<char>& inside = inside_scratch;
     std::vector<int> frontier, region;
     if (pass == Pass::shape)
@@ -1830,7 +1833,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     const Badness before = badness_of(faces, touched);
-    const double stretch_before = relieve ? stretch_of(faces) : 0.0;
+    const double stretch_before = by_stretch ? stretch_of(faces) : 0.0;
     quad::UntangleProblem problem;
     problem.num_variables = static_cast<int>(variables.size());
     for (int f : faces) {
@@ -1858,16 +1861,17 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     const Eigen::VectorXd z0 = z;
     if (restart) z = quad::least_squares_start(problem, z);
     const quad::UntangleResult result = pass == Pass::shape ? quad::untangle(problem, z, 1e-3, 0.0, kShapeRounds, kShapeSteps)
-                                                            : quad::untangle(problem, z, relieve ? kReliefDeterminant : 1e-3, 0.5, 30, 30);
-    if (!relieve) work_left -= static_cast<double>(faces.size()) * (result.inner_iterations + result.outer_iterations);
+                                                            : quad::untangle(problem, z, by_stretch ? kReliefDeterminant : 1e-3, 0.5, 30, 30);
+    if (!by_stretch) work_left -= static_cast<double>(faces.size()) * (result.inner_iterations + result.outer_iterations);
     for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z[static_cast<int>(k)];
     corner_uv_of(faces);
     const Badness after = badness_of(faces, touched);
-    if (relieve ? after.folds <= before.folds && std::includes(before.wrong.begin(), before.wrong.end(), after.wrong.begin(), after.wrong.end()) &&
+    if (by_stretch ? after.folds <= before.folds && std::includes(before.wrong.begin(), before.wrong.end(), after.wrong.begin(), after.wrong.end()) &&
                       stretch_of(faces) < stretch_before
                 : after.better_than(before)) {
       if (pass == Pass::shape) q.shaped_faces = static_cast<int>(faces.size());
-      else ++(relieve ? q.relieved_regions : q.untangling_regions);
+      if (pass == Pass::relieve) ++q.relieved_regions;
+      if (pass == Pass::open) ++q.untangling_regions;
       return true;
     }
     for (size_t k = 0; k < variables.size(); ++k) y[variables[k]] = z0[static_cast<int>(k)];
@@ -2016,7 +2020,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // Relief: a face can be left nearly flat without folding (a corner at a singularity opened to about π, its
   // σ_max/σ_min in the thousands), which alone moves the area-weighted mean ratio by a whole unit. Around each
   // face above kReliefRatio, worst (area · ratio) first, the region of 2, then 4 rings is opened with the barrier
-  // (untangle_around with `relieve`), kept only when it stretches less and folds and winds no worse.
+  // (untangle_around with Pass::relieve), kept only when it stretches less and folds and winds no worse.
   {
     std::vector<std::pair<double, int>> strained;
     for (int f = 0; f < nF; ++f)
