@@ -142,18 +142,28 @@ TEST(CliAuto, AlignedDiskGetsFourQuarterSingularities) {
 }
 
 // --fix faces are held by the smoothest field too (Dirichlet values), then by the exact solve.
+// Under --auto every path's turn is read from the smoothest field (the sparse route); the same singularities given
+// back with -s take the dense route, whose turns are chosen with the cycles: the same field.
 TEST(CliAuto, FixedFacesAreHonoured) {
   const std::string mesh = mesh_file(make_icosphere(3), "sphere.obj"), report = temp_file("report.json");
-  const auto r = run_cli("solve " + mesh + " -N 4 --auto --fix 0:1,0,0 --fix 500:0,1,0 --report " + report);
+  const std::string sing = temp_file("sphere.sing"), given_report = temp_file("given.json");
+  const std::string fix = " --fix 0:1,0,0 --fix 500:0,1,0";
+  auto r = run_cli("solve " + mesh + " -N 4 --auto" + fix + " --sing-out " + sing + " --report " + report);
   ASSERT_EQ(r.status, 0) << r.err;
   const nlohmann::json j = read_json(report);
   int sum = 0;
   for (const auto& [v, index] : report_singularities(j)) sum += index == "1/4" ? 1 : index == "-1/4" ? -1 : 100;
   EXPECT_EQ(sum, 8);
   EXPECT_EQ(j["fixed"]["faces"], 2);
-  EXPECT_EQ(j["fixed"]["path_turns"], "with the cycles");
+  EXPECT_EQ(j["fixed"]["path_turns"], "from the guide");
   EXPECT_LE(j["fixed"]["max_error"].get<double>(), 1e-9);
   EXPECT_TRUE(j["verified"].get<bool>());
+  r = run_cli("solve " + mesh + " -N 4 -s " + sing + fix + " --report " + given_report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json g = read_json(given_report);
+  EXPECT_EQ(g["fixed"]["path_turns"], "with the cycles");
+  EXPECT_EQ(report_singularities(g), report_singularities(j));
+  EXPECT_NEAR(g["energy"].get<double>(), j["energy"].get<double>(), 1e-9 * j["energy"].get<double>());
 }
 
 // More fixed-face paths than the dense route takes (a plate with 27 round holes, its boundary aligned: 2,111):
@@ -171,6 +181,26 @@ TEST(CliAuto, ManyFixedFacePathsTakeTheirTurnsFromTheSmoothestField) {
   EXPECT_EQ(a["fixed"]["paths"], 2111);
   EXPECT_EQ(a["fixed"]["path_turns"], "from the guide");
   EXPECT_EQ(g["fixed"]["path_turns"], "from the guide");
+  EXPECT_EQ(report_singularities(a), report_singularities(g));
+  EXPECT_TRUE(a["verified"].get<bool>() && g["verified"].get<bool>());
+  EXPECT_NEAR(g["energy"].get<double>(), a["energy"].get<double>(), 1e-9 * a["energy"].get<double>());
+}
+
+// Sharp edges aligned on a closed plate with holes (hundreds of fixed-face paths, fewer than the dense route
+// takes): --auto reads their turns from the smoothest field; its singularities given back with -s, the dense
+// route chooses them with the cycles; the fields are the same.
+TEST(CliAuto, FeatureLinesUnderAutoMakeTheDenseRoutesField) {
+  const std::string mesh = mesh_file(test::extruded(test::perforated_plate(3, 1, 6, 3, 0.3), 0.5), "plate.obj");
+  const std::string auto_report = temp_file("auto.json"), given_report = temp_file("given.json"), sing = temp_file("plate.sing");
+  auto r = run_cli("solve " + mesh + " -N 4 --auto --align-features 30 --sing-out " + sing + " --report " + auto_report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = run_cli("solve " + mesh + " -N 4 -s " + sing + " --align-features 30 --report " + given_report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json a = read_json(auto_report), g = read_json(given_report);
+  EXPECT_GT(a["fixed"]["paths"].get<int>(), 100);
+  EXPECT_EQ(a["fixed"]["paths"], g["fixed"]["paths"]);
+  EXPECT_EQ(a["fixed"]["path_turns"], "from the guide");
+  EXPECT_EQ(g["fixed"]["path_turns"], "with the cycles");
   EXPECT_EQ(report_singularities(a), report_singularities(g));
   EXPECT_TRUE(a["verified"].get<bool>() && g["verified"].get<bool>());
   EXPECT_NEAR(g["energy"].get<double>(), a["energy"].get<double>(), 1e-9 * a["energy"].get<double>());

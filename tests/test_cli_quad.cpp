@@ -227,8 +227,8 @@ TEST(CliQuad, BunnyAt1000QuadsIsPlacedAgainWhenAQuadTurnsOver) {
 }
 
 // A plate with 27 round holes (radius 0.15 in unit cells), its boundary aligned, at 1,000 quads (about 6 quad edges
-// around a hole): with every fixed-face path's turn chosen with the cycles (the dense route, 1,055 paths) the
-// field's fans along the holes turn as the holes do, and the first placement's map is clean, within the goal, and
+// around a hole): with every fixed-face path's turn as the smoothest field's (read from it under --auto; the dense
+// route's choice with the cycles, 1,055 paths, is the same field) the field's fans along the holes turn as the holes do, and the first placement's map is clean, within the goal, and
 // every quad convex (rounded path by path, 34 fans turned a quarter off: dozens of folds, ratio 2.7, and after the
 // relaxed placements still 12 quads with a reflex corner at a jog of a hole's iso-line). The boundary is aligned
 // without being asked.
