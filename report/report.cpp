@@ -34,6 +34,10 @@ nlohmann::ordered_json solve_report(const ReportRun& run, const MeshData& mesh, 
     const char* timeout = std::getenv("OPENBLAS_THREAD_TIMEOUT");
     report["blas_thread_timeout"] = timeout ? nlohmann::ordered_json(timeout) : nlohmann::ordered_json(nullptr);
   }
+  {  // how long OpenMP's idle threads spin (trivcon/tuned_process.h): null where GOMP_SPINCOUNT is unset
+    const char* spin = std::getenv("GOMP_SPINCOUNT");
+    report["openmp_spin_count"] = spin ? nlohmann::ordered_json(spin) : nlohmann::ordered_json(nullptr);
+  }
   report["ordering"] = designer.solver().ordering();
   nlohmann::ordered_json sing = nlohmann::ordered_json::array();
   for (auto [v, n] : prescription.vertex) sing.push_back({{"vertex", v}, {"index", format_index(n, prescription.N)}});

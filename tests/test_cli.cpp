@@ -556,6 +556,15 @@ TEST(CliSolve, SphereWithTwoPoles) {
   } else if (!blas_kernels().empty()) {
     EXPECT_EQ(rep["blas_thread_timeout"], "4");
   }
+  // OpenMP's idle threads sleep after microseconds (trivcon/tuned_process.h), unless GOMP_SPINCOUNT or
+  // OMP_WAIT_POLICY chooses.
+  if (const char* spin = std::getenv("GOMP_SPINCOUNT")) {
+    EXPECT_EQ(rep["openmp_spin_count"], spin);
+  } else if (std::getenv("OMP_WAIT_POLICY") == nullptr) {
+    EXPECT_EQ(rep["openmp_spin_count"], "10000");
+  } else {
+    EXPECT_TRUE(rep["openmp_spin_count"].is_null());
+  }
 
   // Field text: header, one unit vector per face.
   const std::vector<std::string> field = lines_of(slurp(s.field_txt));

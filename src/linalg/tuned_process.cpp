@@ -14,6 +14,7 @@ namespace trivcon {
 
 namespace {
 constexpr const char* kBlasThreadTimeout = "4";  // OpenBLAS's smallest: its idle threads spin 2^4 cycles
+constexpr const char* kOpenMpSpinCount = "10000";  // libgomp's idle threads: 10,000 spins (microseconds), then sleep
 }  // namespace
 
 const char* transparent_huge_pages_mode() {
@@ -32,7 +33,7 @@ const char* transparent_huge_pages_mode() {
 void use_tuned_process(char** argv) {
   const char* old_tunables = std::getenv("GLIBC_TUNABLES");
   const std::string tunables = old_tunables ? old_tunables : "";
-  bool set_coretype = false, set_tunables = false, set_timeout = false;
+  bool set_coretype = false, set_tunables = false, set_timeout = false, set_spin = false;
   const std::string kernels = blas_kernels();  // "" when the BLAS is not OpenBLAS
   if (std::getenv("OPENBLAS_CORETYPE") == nullptr && kernels == "Prescott") {  // OpenBLAS's generic fallback
     const std::string native = native_blas_kernels();
@@ -45,11 +46,15 @@ void use_tuned_process(char** argv) {
   // OpenBLAS's idle threads wait 2^4 cycles, not 2^28 (about 0.1 s), for more work (trivcon/tuned_process.h).
   if (std::getenv("OPENBLAS_THREAD_TIMEOUT") == nullptr && !kernels.empty())
     set_timeout = setenv("OPENBLAS_THREAD_TIMEOUT", kBlasThreadTimeout, 1) == 0;
-  if (!set_coretype && !set_tunables && !set_timeout) return;
+  // OpenMP's idle threads spin for microseconds, not libgomp's default 300,000 spins, before they sleep (trivcon/tuned_process.h).
+  if (std::getenv("GOMP_SPINCOUNT") == nullptr && std::getenv("OMP_WAIT_POLICY") == nullptr)
+    set_spin = setenv("GOMP_SPINCOUNT", kOpenMpSpinCount, 1) == 0;
+  if (!set_coretype && !set_tunables && !set_timeout && !set_spin) return;
   execv("/proc/self/exe", argv);
   // The re-execution failed: carry on as we are, with the environment as it was.
   if (set_coretype) unsetenv("OPENBLAS_CORETYPE");
   if (set_timeout) unsetenv("OPENBLAS_THREAD_TIMEOUT");
+  if (set_spin) unsetenv("GOMP_SPINCOUNT");
   if (set_tunables) {
     if (old_tunables)
       setenv("GLIBC_TUNABLES", tunables.c_str(), 1);
