@@ -183,7 +183,15 @@ void run_solve(const SolveOptions& o) {
     throw Error(o.mesh + " was repaired, and the connection and matching files name edges by the vertices of the repaired mesh: " +
                 "write it with --mesh-out (or give --no-repair)");
   const double read_seconds = seconds_since(t0);
-  FieldDesigner designer(mesh.V, mesh.F, o.field.solver_options());
+  SolverOptions solver_options = o.field.solver_options();
+  // With --auto alone the field's singularities are the smoothest field's own, and the request layer reads every
+  // fixed-face path's turn from that field (docs/solver.md, "A guide for the turns"): the sparse route then makes
+  // the dense route's field at a fraction of its cost (BENCHMARKS.md, "Fixed-face paths under --auto"). Where they
+  // differ from its own (pairs cancelled, relaxed, a batch of others) its turns need not fit them, and a refined
+  // mesh is solved without a guide: the dense route stays.
+  if (o.field.auto_place && o.field.auto_cancel == 0 && !o.field.relax && !o.field.split_large_turns && o.sing_batch.empty())
+    solver_options.max_dense_paths = 0;
+  FieldDesigner designer(mesh.V, mesh.F, solver_options);
   FieldRequest request = o.field.request(designer, repair);
   std::vector<BatchItem> batch;
   if (!o.sing_batch.empty()) batch = read_batch(o.sing_batch, request.prescription);

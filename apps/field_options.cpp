@@ -107,11 +107,6 @@ SolverOptions FieldOptions::solver_options() const {
   options.weight_floor = weight_floor;
   options.solver = solver == "qr" ? SolverKind::QR : SolverKind::Cholesky;
   options.factorization = factorization == "cholmod" ? Factorization::Cholmod : Factorization::Parallel;
-  // Under --auto the request layer reads every fixed-face path's turn from the smoothest field (docs/solver.md,
-  // "A guide for the turns"): the sparse route then makes the dense route's field at a fraction of its cost
-  // (BENCHMARKS.md, "Fixed-face paths under --auto"). Splitting large turns refines the mesh and solves it without
-  // a guide: the dense route stays.
-  if (auto_place && !split_large_turns) options.max_dense_paths = 0;
   return options;
 }
 

@@ -66,6 +66,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   run.retried_maps = made.retried_maps;
   run.onto_units = made.onto_units;
   run.onto_flat = made.onto_flat;
+  run.scale = made.scale;
   run.quads = std::move(made.quads);
   run.refined_edges = made.refined_edges;
   return run;
@@ -128,6 +129,7 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                            {"first_problems", run.first_problems},
                            {"first_distortion", run.first_distortion},
                            {"retried_maps", run.retried_maps}};
+  report["map_scale"] = run.scale;
   for (size_t i = 0; i < param.cones.size(); ++i)
     report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
   return report;
@@ -149,6 +151,13 @@ std::string placement_line(const MapRun& run) {
   return line.str();
 }
 
+std::string scale_line(double scale) {
+  std::ostringstream line;
+  line << "scale: the map at the edge length asked for kept problems; made at " << scale << " times that length (about "
+       << std::setprecision(2) << 1 / (scale * scale) << " times the quads)\n";
+  return line.str();
+}
+
 }  // namespace
 
 std::string map_summary(const MapCommand& o, const MapRun& run) {
@@ -160,6 +169,7 @@ std::string map_summary(const MapCommand& o, const MapRun& run) {
                                                   : loose_edges_line(run.out.constraints.loose_edges.size(), *run.request.feature_min_length)) +
          (run.out.relax_result ? relax_summary_line(*run.out.relax_result) + "\n" : std::string()) +
          (run.placements > 1 ? placement_line(run) : std::string()) +
+         (run.scale != 1 ? scale_line(run.scale) : std::string()) +
          (run.out.refined ? "refined: " + std::to_string(run.refined_edges) +
                                 " edges whose ends lie on aligned lines split at their midpoints (the map folded beside them): " +
                                 std::to_string(run.out.V.rows()) + " vertices, " + std::to_string(run.out.F.rows()) +

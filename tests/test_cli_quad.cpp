@@ -227,8 +227,8 @@ TEST(CliQuad, BunnyAt1000QuadsIsPlacedAgainWhenAQuadTurnsOver) {
 }
 
 // A plate with 27 round holes (radius 0.15 in unit cells), its boundary aligned, at 1,000 quads (about 6 quad edges
-// around a hole): with every fixed-face path's turn as the smoothest field's (read from it under --auto; the dense
-// route's choice with the cycles, 1,055 paths, is the same field) the field's fans along the holes turn as the holes do, and the first placement's map is clean, within the goal, and
+// around a hole): with every fixed-face path's turn chosen with the cycles (the dense route, 1,055 paths) the
+// field's fans along the holes turn as the holes do, and the first placement's map is clean, within the goal, and
 // every quad convex (rounded path by path, 34 fans turned a quarter off: dozens of folds, ratio 2.7, and after the
 // relaxed placements still 12 quads with a reflex corner at a jog of a hole's iso-line). The boundary is aligned
 // without being asked.
@@ -411,6 +411,31 @@ TEST(CliQuad, UsageErrors) {
   const auto split = run_cli("quad " + mesh + " --auto --split-large-turns --target-faces 100 -o " + out);
   EXPECT_EQ(split.status, 2);
   EXPECT_NE(split.err.find("not needed by quad"), std::string::npos) << split.err;
+}
+
+// The closed plate 0.3 thick with 27 round holes, sharp edges aligned, at 900 quads: the placement's map keeps
+// problems at the edge length asked for, the kept field's map at another edge length (kMapScales, never 1: it is
+// kept only when better) is clean, and the quad mesh passes every check with the singularities where they were placed.
+TEST(CliQuad, PlateFoldingAtTheTargetIsMappedAtAnotherScale) {
+  const std::string mesh = mesh_file(test::extruded(perforated_plate(9, 3, 8, 4, 0.3), 0.3), "plate27x.obj");
+  const std::string out = temp_file("q.obj"), report = temp_file("r.json");
+  const auto r = run_cli("quad " + mesh + " --auto --align-features 30 --target-faces 900 -o " + out + " --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  const double scale = j["map_scale"].get<double>();
+  EXPECT_TRUE(std::find(std::begin(kMapScales), std::end(kMapScales), scale) != std::end(kMapScales)) << scale;
+  EXPECT_NE(r.out.find("scale: the map at the edge length asked for kept problems; made at"), std::string::npos) << r.out;
+  EXPECT_EQ(j["param"]["flipped_faces"], 0);
+  EXPECT_EQ(j["param"]["winding_errors"], 0);
+  EXPECT_LE(j["param"]["mean_distortion"].get<double>(), 1.5);
+  EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
+  EXPECT_EQ(j["quad"]["inverted_quads"], 0);
+  EXPECT_NEAR(j["quad"]["quads"].get<double>(), 900, 0.3 * 900);
+  const QuadFile q = read_quads(out);
+  const Census c = census(q);
+  EXPECT_EQ(c.euler, -52);
+  EXPECT_EQ(c.over_shared_edges, 0);
+  EXPECT_EQ(j["quad"]["irregular_vertices"], 224);
 }
 
 }  // namespace

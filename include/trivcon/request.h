@@ -152,6 +152,7 @@ struct MapOutcome {
   bool periods = false;    // and with the periods in the objective (kMapPeriodWeight)
   double onto_units = 0;   // with automatic placement and sharp edges: the distance singularities were moved onto them from, in units
   bool onto_flat = false;  // and onto sectors where a quad gets a flat corner (AutoOptions::onto_flat_sectors)
+  double scale = 1;        // the kept map's edge length over the one asked for (kMapScales; 1: the one asked for)
   std::optional<QuadMesh> quads;  // with quads = true: the kept map's quad mesh (extract_quads)
   // Edges split at their midpoints (map_request): then field.refined, V, F and parent_face hold the refined mesh.
   int refined_edges = 0;
@@ -161,6 +162,10 @@ struct MapOutcome {
 // two feature lines, where the map has one unit across it, has no integer point off both lines).
 inline constexpr double kMapOntoFeatures = 1.5;
 inline constexpr double kMapOntoFeaturesFar = 2;
+// When every placement's map keeps problems, map_request makes the kept field's map again at these edge lengths,
+// relative to the one asked for (the rounding's outcome is sensitive to the scale, also where a map has too many
+// problems for the near-miss retries, ParamOptions::retries); the quad count moves by about 1/scale².
+inline constexpr double kMapScales[] = {0.95, 1.05, 0.9, 1.1};
 // The weight of the periods (RelaxOptions::period_weight) in map_request's second relaxed attempt.
 inline constexpr double kMapPeriodWeight = 3;
 // The reach (RelaxOptions::reach) of map_request's relaxed attempts.

@@ -520,6 +520,22 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
       }
     }
   }
+  // Problems left after every placement and the retries: the kept field's map at other edge lengths (kMapScales),
+  // kept when it has fewer problems, or as few and less stretch (each without near-miss retries of its own: those
+  // are at edge lengths between these; each but the last with the untangling's share of a map that others follow).
+  if (best.field.verified && map_problems(best) > 0) {
+    if (designer.fixed_faces() != best.field.constraints.fixed_faces) designer.set_fixed_faces(best.field.constraints.fixed_faces);
+    for (double scale : kMapScales) {
+      if (map_problems(best) == 0) break;
+      ParamOptions options = request_param_options(designer, kept, best.field, edge_length * scale, target_faces / (scale * scale));
+      options.retries = 0;
+      if (scale != std::end(kMapScales)[-1]) options.untangle_share = kUntangleShareFollowed;  // the next scale is the cheaper remedy
+      MapOutcome m;
+      m.param = parametrize(best.field.designer(designer), best.field.design, options);
+      if (quads) m.quads = extract_quads(best.field.designer(designer), m.param);
+      if (better(m, best)) best.param = std::move(m.param), best.quads = std::move(m.quads), best.scale = scale;
+    }
+  }
   // The designer holds the last set-up (an attempt's or a retry's: fixed faces turned for singularities moved onto
   // features): it takes the kept field's fixed faces back, so that the designer is the kept field's (its design is
   // kept as it was made; solving the kept request again would place and relax again for the same result).
