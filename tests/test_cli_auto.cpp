@@ -30,6 +30,19 @@ std::string mesh_file(const Mesh& m, const std::string& name) {
   return path;
 }
 
+// `solve MESH -N 4 --auto OPTIONS` and then `solve MESH -N 4 -s (its singularities) OPTIONS`: the two reports.
+struct AutoThenGiven {
+  nlohmann::json automatic, given;
+};
+AutoThenGiven solve_auto_then_given(const std::string& mesh, const std::string& options) {
+  const std::string auto_report = temp_file("auto.json"), given_report = temp_file("given.json"), sing = temp_file("auto.sing");
+  auto r = run_cli("solve " + mesh + " -N 4 --auto " + options + " --sing-out " + sing + " --report " + auto_report);
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = run_cli("solve " + mesh + " -N 4 -s " + sing + " " + options + " --report " + given_report);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return {read_json(auto_report), read_json(given_report)};
+}
+
 TEST(CliAuto, CubeGetsEightCornersAndSolvesExactly) {
   const std::string mesh = mesh_file(make_cube_sphere(8, false), "cube.obj");
   const std::string report = temp_file("report.json"), sings = temp_file("auto.sing"), field = temp_file("field.txt");
@@ -145,12 +158,8 @@ TEST(CliAuto, AlignedDiskGetsFourQuarterSingularities) {
 // Under --auto every path's turn is read from the smoothest field (the sparse route); the same singularities given
 // back with -s take the dense route, whose turns are chosen with the cycles: the same field.
 TEST(CliAuto, FixedFacesAreHonoured) {
-  const std::string mesh = mesh_file(make_icosphere(3), "sphere.obj"), report = temp_file("report.json");
-  const std::string sing = temp_file("sphere.sing"), given_report = temp_file("given.json");
-  const std::string fix = " --fix 0:1,0,0 --fix 500:0,1,0";
-  auto r = run_cli("solve " + mesh + " -N 4 --auto" + fix + " --sing-out " + sing + " --report " + report);
-  ASSERT_EQ(r.status, 0) << r.err;
-  const nlohmann::json j = read_json(report);
+  const std::string mesh = mesh_file(make_icosphere(3), "sphere.obj");
+  const auto [j, g] = solve_auto_then_given(mesh, "--fix 0:1,0,0 --fix 500:0,1,0");
   int sum = 0;
   for (const auto& [v, index] : report_singularities(j)) sum += index == "1/4" ? 1 : index == "-1/4" ? -1 : 100;
   EXPECT_EQ(sum, 8);
@@ -158,9 +167,6 @@ TEST(CliAuto, FixedFacesAreHonoured) {
   EXPECT_EQ(j["fixed"]["path_turns"], "from the guide");
   EXPECT_LE(j["fixed"]["max_error"].get<double>(), 1e-9);
   EXPECT_TRUE(j["verified"].get<bool>());
-  r = run_cli("solve " + mesh + " -N 4 -s " + sing + fix + " --report " + given_report);
-  ASSERT_EQ(r.status, 0) << r.err;
-  const nlohmann::json g = read_json(given_report);
   EXPECT_EQ(g["fixed"]["path_turns"], "with the cycles");
   EXPECT_EQ(report_singularities(g), report_singularities(j));
   EXPECT_NEAR(g["energy"].get<double>(), j["energy"].get<double>(), 1e-9 * j["energy"].get<double>());
@@ -172,12 +178,7 @@ TEST(CliAuto, FixedFacesAreHonoured) {
 // "Fixed-face paths").
 TEST(CliAuto, ManyFixedFacePathsTakeTheirTurnsFromTheSmoothestField) {
   const std::string mesh = mesh_file(test::perforated_plate(9, 3, 16, 4, 0.3), "plate.obj");
-  const std::string auto_report = temp_file("auto.json"), given_report = temp_file("given.json"), sing = temp_file("plate.sing");
-  auto r = run_cli("solve " + mesh + " -N 4 --auto --align-boundary --sing-out " + sing + " --report " + auto_report);
-  ASSERT_EQ(r.status, 0) << r.err;
-  r = run_cli("solve " + mesh + " -N 4 -s " + sing + " --align-boundary --report " + given_report);
-  ASSERT_EQ(r.status, 0) << r.err;
-  const nlohmann::json a = read_json(auto_report), g = read_json(given_report);
+  const auto [a, g] = solve_auto_then_given(mesh, "--align-boundary");
   EXPECT_EQ(a["fixed"]["paths"], 2111);
   EXPECT_EQ(a["fixed"]["path_turns"], "from the guide");
   EXPECT_EQ(g["fixed"]["path_turns"], "from the guide");
@@ -191,12 +192,7 @@ TEST(CliAuto, ManyFixedFacePathsTakeTheirTurnsFromTheSmoothestField) {
 // route chooses them with the cycles; the fields are the same.
 TEST(CliAuto, FeatureLinesUnderAutoMakeTheDenseRoutesField) {
   const std::string mesh = mesh_file(test::extruded(test::perforated_plate(3, 1, 6, 3, 0.3), 0.5), "plate.obj");
-  const std::string auto_report = temp_file("auto.json"), given_report = temp_file("given.json"), sing = temp_file("plate.sing");
-  auto r = run_cli("solve " + mesh + " -N 4 --auto --align-features 30 --sing-out " + sing + " --report " + auto_report);
-  ASSERT_EQ(r.status, 0) << r.err;
-  r = run_cli("solve " + mesh + " -N 4 -s " + sing + " --align-features 30 --report " + given_report);
-  ASSERT_EQ(r.status, 0) << r.err;
-  const nlohmann::json a = read_json(auto_report), g = read_json(given_report);
+  const auto [a, g] = solve_auto_then_given(mesh, "--align-features 30");
   EXPECT_GT(a["fixed"]["paths"].get<int>(), 100);
   EXPECT_EQ(a["fixed"]["paths"], g["fixed"]["paths"]);
   EXPECT_EQ(a["fixed"]["path_turns"], "from the guide");
