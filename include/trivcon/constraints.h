@@ -80,7 +80,8 @@ std::vector<AlignedLoop> aligned_loop_indices(const Topology& topology, const Ge
 // boundary vertex (a singularity on the boundary, which trivcon does not place: boundary vertices carry no
 // index). For each boundary vertex whose fan's end faces are fixed (and whose reading is not ambiguous), the
 // difference between `field`'s own reading of the fan (each jump by the closest matching, as field_indices)
-// and the reading above, in units of 2π/N, is moved to the smallest interior vertex joined to it by an edge:
+// and the reading above, in units of 2π/N, is moved to the smallest interior vertex joined to it by an edge (with
+// none, the smallest of the nearest interior vertices by edges):
 // returns those vertices and the indices (n, index n/N) to add to their singularities so that the vertex
 // indices sum to what check_aligned_index_sums asks (auto_singularities does this).
 std::map<int, int> boundary_turns_moved_inside(const Topology& topology, const Geometry& geometry, const std::map<int, double>& fixed,

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <unordered_set>
+#include <vector>
 
 #include "trivcon/error.h"
 #include "trivcon/field.h"
@@ -213,6 +215,31 @@ std::vector<AlignedLoop> aligned_loop_indices(const Topology& t, const Geometry&
   return out;
 }
 
+namespace {
+
+// The interior vertex nearest to v by edges (the smallest id among the nearest), or −1 when its component has none.
+int nearest_interior_vertex(const Topology& t, int v) {
+  std::vector<int> layer{v}, next;
+  std::unordered_set<int> seen{v};
+  while (!layer.empty()) {
+    int best = -1;
+    next.clear();
+    for (int u : layer)
+      for (int j = t.vertex_edge_offsets[u]; j < t.vertex_edge_offsets[u + 1]; ++j) {
+        const int e = t.vertex_edges[j];
+        const int w = t.edge_vertices(e, 0) == u ? t.edge_vertices(e, 1) : t.edge_vertices(e, 0);
+        if (!seen.insert(w).second) continue;
+        if (t.is_interior_vertex(w) && (best < 0 || w < best)) best = w;
+        next.push_back(w);
+      }
+    if (best >= 0) return best;
+    layer.swap(next);
+  }
+  return -1;
+}
+
+}  // namespace
+
 std::map<int, int> boundary_turns_moved_inside(const Topology& t, const Geometry& g, const std::map<int, double>& fixed, const Field& field) {
   std::map<int, int> moved;
   if (fixed.empty()) return moved;
@@ -233,7 +260,11 @@ std::map<int, int> boundary_turns_moved_inside(const Topology& t, const Geometry
       if (t.is_interior_vertex(other) && (inside < 0 || other < inside)) inside = other;
     }
     const int excess = static_cast<int>(std::lround((read - closest) / period));
-    if (excess == 0 || inside < 0) continue;
+    if (excess == 0) continue;
+    // No interior neighbour (a strip one triangle wide, as a scan's holes leave): the nearest interior vertex by
+    // edges, the smallest id among those as near; none in a component without interior vertices.
+    if (inside < 0) inside = nearest_interior_vertex(t, v);
+    if (inside < 0) continue;
     if ((moved[inside] += excess) == 0) moved.erase(inside);
   }
   return moved;
