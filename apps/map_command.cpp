@@ -154,7 +154,7 @@ std::string placement_line(const MapRun& run) {
 std::string scale_line(double scale) {
   std::ostringstream line;
   line << "scale: the map at the edge length asked for kept problems; made at " << scale << " times that length (about "
-       << std::setprecision(2) << 1 / (scale * scale) << " times the quads)\n";
+       << std::setprecision(2) << 1 / (scale * scale) << " times the unit squares asked for)\n";
   return line.str();
 }
 
