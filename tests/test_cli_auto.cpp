@@ -43,6 +43,13 @@ AutoThenGiven solve_auto_then_given(const std::string& mesh, const std::string& 
   return {read_json(auto_report), read_json(given_report)};
 }
 
+// The two reports name the same singularities, both are verified, and their energies agree to 1e-9: the same field.
+void expect_same_field(const nlohmann::json& a, const nlohmann::json& g) {
+  EXPECT_EQ(report_singularities(a), report_singularities(g));
+  EXPECT_TRUE(a["verified"].get<bool>() && g["verified"].get<bool>());
+  EXPECT_NEAR(g["energy"].get<double>(), a["energy"].get<double>(), 1e-9 * a["energy"].get<double>());
+}
+
 TEST(CliAuto, CubeGetsEightCornersAndSolvesExactly) {
   const std::string mesh = mesh_file(make_cube_sphere(8, false), "cube.obj");
   const std::string report = temp_file("report.json"), sings = temp_file("auto.sing"), field = temp_file("field.txt");
@@ -182,9 +189,7 @@ TEST(CliAuto, ManyFixedFacePathsTakeTheirTurnsFromTheSmoothestField) {
   EXPECT_EQ(a["fixed"]["paths"], 2111);
   EXPECT_EQ(a["fixed"]["path_turns"], "from the guide");
   EXPECT_EQ(g["fixed"]["path_turns"], "from the guide");
-  EXPECT_EQ(report_singularities(a), report_singularities(g));
-  EXPECT_TRUE(a["verified"].get<bool>() && g["verified"].get<bool>());
-  EXPECT_NEAR(g["energy"].get<double>(), a["energy"].get<double>(), 1e-9 * a["energy"].get<double>());
+  expect_same_field(a, g);
 }
 
 // Sharp edges aligned on a closed plate with holes (hundreds of fixed-face paths, fewer than the dense route
@@ -197,9 +202,7 @@ TEST(CliAuto, FeatureLinesUnderAutoMakeTheDenseRoutesField) {
   EXPECT_EQ(a["fixed"]["paths"], g["fixed"]["paths"]);
   EXPECT_EQ(a["fixed"]["path_turns"], "from the guide");
   EXPECT_EQ(g["fixed"]["path_turns"], "with the cycles");
-  EXPECT_EQ(report_singularities(a), report_singularities(g));
-  EXPECT_TRUE(a["verified"].get<bool>() && g["verified"].get<bool>());
-  EXPECT_NEAR(g["energy"].get<double>(), a["energy"].get<double>(), 1e-9 * a["energy"].get<double>());
+  expect_same_field(a, g);
 }
 
 // A scan whose holes leave boundary vertices without an interior neighbour (strips one triangle wide): the field's

@@ -175,6 +175,10 @@ Parametrization parametrize(const FieldDesigner& designer, const Design& design,
 Parametrization parametrize_retries(const FieldDesigner& designer, const Design& design, const ParamOptions& options,
                                     const Parametrization& screened);
 
+// Whether a cone of index ≥ 1 makes the map's folds necessary (a quad corner cannot open to 2π or more): no
+// retry at another scale removes them, so the retries (ParamOptions::retries, map_request's other scales) skip it.
+bool folds_necessary(const Parametrization& param);
+
 // The (u, v) of the corners of the input's faces `F` (the faces the designer was built from), F × 6: (u, v)
 // of corner 0, 1, 2 in the input's corner order.
 Eigen::MatrixXd input_corner_uv(const Parametrization& param, const Topology& topology, const MatrixX3i& F);

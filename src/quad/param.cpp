@@ -2165,8 +2165,7 @@ Parametrization retry_near_miss(const FieldDesigner& designer, const Design& des
   const int first_factorizations = best.quality.first_factorizations;
   int retry_factorizations = 0;
   const int near_miss = std::max(16, best.quality.faces / 20000);
-  bool necessary = false;
-  for (int n : best.cone_index) necessary |= n >= 4;
+  const bool necessary = folds_necessary(best);
   std::vector<ParamOptions> variants = size_variants(options);
   variants.erase(std::remove_if(variants.begin(), variants.end(), [](const ParamOptions& o) { return o.sizing == Sizing::connection; }),
                  variants.end());  // the map's sizing and the unit size
@@ -2234,6 +2233,10 @@ Parametrization parametrize_retries(const FieldDesigner& designer, const Design&
                                     const Parametrization& screened) {
   if (screened.quality.first_factorizations <= 0) throw Error("param: the map to resume was not made by parametrize");
   return retry_near_miss(designer, design, options, screened, linalg::Clock::now(), screened.quality.seconds_total());
+}
+
+bool folds_necessary(const Parametrization& param) {
+  return std::any_of(param.cone_index.begin(), param.cone_index.end(), [](int n) { return n >= 4; });  // index n/4 ≥ 1
 }
 
 Eigen::MatrixXd input_corner_uv(const Parametrization& param, const Topology& topology, const MatrixX3i& F) {

@@ -523,9 +523,8 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   // Problems left after every placement and the retries: the kept field's map at other edge lengths (kMapScales),
   // kept when it has fewer problems, or as few and less stretch (each without near-miss retries of its own: those
   // are at edge lengths between these; each but the last with the untangling's share of a map that others follow).
-  // Not where a singularity of index ≥ 1 makes its folds necessary (as the retries, ParamOptions::retries).
-  const auto necessary = [](const Parametrization& p) { return std::any_of(p.cone_index.begin(), p.cone_index.end(), [](int n) { return n >= 4; }); };
-  if (best.field.verified && map_problems(best) > 0 && !necessary(best.param)) {
+  // Not where a singularity of index ≥ 1 makes its folds necessary (folds_necessary).
+  if (best.field.verified && map_problems(best) > 0 && !folds_necessary(best.param)) {
     if (designer.fixed_faces() != best.field.constraints.fixed_faces) designer.set_fixed_faces(best.field.constraints.fixed_faces);
     for (double scale : kMapScales) {
       if (map_problems(best) == 0) break;
