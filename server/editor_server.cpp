@@ -1282,8 +1282,7 @@ struct EditorServer::Impl {
                 } catch (const Error& e) {
                   throw BadRequest{400, e.what()};
                 }
-                Parametrization map;
-                QuadMesh quads;
+                ScaledMap made;  // at another scale when the one asked for keeps problems, as `trivcon quad` keeps it
                 {
                   Deadline deadline(options.quad_seconds, stopping);
                   try {
@@ -1296,8 +1295,7 @@ struct EditorServer::Impl {
                       const Design design = request_design(d, r.prescription, {}, guide ? &*guide : nullptr);
                       if (!design_verified(design))
                         throw Error("the field did not pass verification, so no map was made: " + verification_failure(d, design));
-                      map = parametrize(d, design, request_param_options(d, r.field, r.sharp_edges, 0, target->get<double>()));
-                      quads = extract_quads(d, map);
+                      made = map_field(d, design, request_param_options(d, r.field, r.sharp_edges, 0, target->get<double>()), true);
                       return 0;
                     });
                   } catch (const Cancelled&) {
@@ -1307,6 +1305,8 @@ struct EditorServer::Impl {
                     throw BadRequest{503, "the editor is stopping"};
                   }
                 }
+                const Parametrization& map = made.param;
+                const QuadMesh& quads = *made.quads;
                 std::vector<float> V(3 * static_cast<size_t>(quads.V.rows()));
                 for (Eigen::Index v = 0; v < quads.V.rows(); ++v)
                   for (int k = 0; k < 3; ++k) V[3 * v + k] = static_cast<float>(quads.V(v, k));
@@ -1315,7 +1315,8 @@ struct EditorServer::Impl {
                   for (int k = 0; k < 4; ++k) Q[4 * f + k] = static_cast<uint32_t>(quads.Q(f, k));
                 std::string warning = param_warning(map);
                 if (const std::string w = quad_warning(quads); !w.empty()) warning += (warning.empty() ? "" : "; ") + w;
-                const ojson header = {{"quad", cli::quad_report(quads)}, {"param", cli::param_report(map)}, {"warning", warning}};
+                const ojson header = {
+                    {"quad", cli::quad_report(quads)}, {"param", cli::param_report(map)}, {"map_scale", made.scale}, {"warning", warning}};
                 res.set_content(binary_container(header.dump(), {{V.data(), V.size() * 4}, {Q.data(), Q.size() * 4}}),
                                 "application/octet-stream");
               }));

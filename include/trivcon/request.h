@@ -166,6 +166,26 @@ inline constexpr double kMapOntoFeaturesFar = 2;
 // relative to the one asked for (the rounding's outcome is sensitive to the scale, also where a map has too many
 // problems for the near-miss retries, ParamOptions::retries); the quad count moves by about 1/scale².
 inline constexpr double kMapScales[] = {0.95, 1.05, 0.9, 1.1};
+// A field's map at one edge length, with its quad mesh when asked for.
+struct ScaledMap {
+  Parametrization param;
+  std::optional<QuadMesh> quads;
+  double scale = 1;  // the map's edge length over the one asked for (kMapScales; 1: the one asked for)
+};
+// The map of a field as every front end keeps it (param, quad, Python's Result.parametrize/quad, the editor's quads):
+// parametrize with `options` (and with `quads` its quad mesh, extract_quads); when that map keeps problems (folded
+// or degenerate faces, wrong windings, and with `quads` the quad mesh's failed checks) and no singularity of
+// index ≥ 1 makes its folds necessary (folds_necessary), made again at kMapScales times the options' edge length
+// (their target's squares over scale²), each without near-miss retries of its own (ParamOptions::retries: those
+// are at lengths between these) and, but the last, with the untangling's share of a map that others follow
+// (kUntangleShareFollowed); a map is kept when it has fewer problems, or as few and less stretch beyond
+// kMapDistortionGoal, and the first without problems ends the loop. Throws what parametrize throws.
+ScaledMap map_field(const FieldDesigner& designer, const Design& design, const ParamOptions& options, bool quads = false);
+// The loop over kMapScales alone, from `map` made with `options` at their own scale (map.scale = 1).
+void map_at_other_scales(const FieldDesigner& designer, const Design& design, const ParamOptions& options, ScaledMap& map);
+// A map's problems as map_field counts them.
+int map_problems(const Parametrization& param, const std::optional<QuadMesh>& quads);
+
 // The weight of the periods (RelaxOptions::period_weight) in map_request's second relaxed attempt.
 inline constexpr double kMapPeriodWeight = 3;
 // The reach (RelaxOptions::reach) of map_request's relaxed attempts.

@@ -274,6 +274,15 @@ py::object json_to_python(const nlohmann::ordered_json& j) { return py::module_:
 
 py::tuple mesh_tuple(const Mesh& mesh) { return py::make_tuple(double_matrix3(mesh.V), int64_matrix(mesh.F)); }
 
+// A quad mesh as QuadMesh's arguments: (V, Q, face of each vertex, input vertex under each vertex or -1, quality
+// dict (quad's report), warning).
+py::tuple quads_tuple(const QuadMesh& q) {
+  return py::make_tuple(double_matrix3(q.V), int64_matrix(q.Q),
+                        int64_vector(std::vector<int>(q.vertex_face.data(), q.vertex_face.data() + q.vertex_face.size())),
+                        int64_vector(std::vector<int>(q.vertex_cone.data(), q.vertex_cone.data() + q.vertex_cone.size())),
+                        json_to_python(cli::quad_report(q)), quad_warning(q));
+}
+
 // --- Shared pieces.
 
 Image to_image(const py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>& pixels) {
@@ -1256,7 +1265,7 @@ PYBIND11_MODULE(_core, m) {
       .def(
           "parametrize",
           [](const DesignResultPtr& r, double edge_length, double target_faces, bool align_boundary,
-             const std::vector<std::pair<int, int>>& aligned_pairs, const std::string& sizing) {
+             const std::vector<std::pair<int, int>>& aligned_pairs, const std::string& sizing, bool quads) {
             const Topology& t = r->state->topology();
             ParamOptions o;
             o.edge_length = edge_length, o.target_faces = target_faces;
@@ -1269,8 +1278,9 @@ PYBIND11_MODULE(_core, m) {
               if (e < 0) throw Error("aligned edge (" + std::to_string(a) + ", " + std::to_string(b) + ") is not an edge of the mesh");
               o.aligned_edges.push_back(e);
             }
-            auto p = std::make_shared<Parametrization>(
-                interruptible(r->state->threads, [r, o] { return parametrize(*r->state->designer, r->design, o); }));
+            // As every front end keeps it (map_field: at other scales when the one asked for keeps problems).
+            ScaledMap map = interruptible(r->state->threads, [r, o, quads] { return map_field(*r->state->designer, r->design, o, quads); });
+            auto p = std::make_shared<Parametrization>(std::move(map.param));
             const Eigen::MatrixXd corners = input_corner_uv(*p, t, r->state->F);
             DoubleArray uv({static_cast<py::ssize_t>(corners.rows()), static_cast<py::ssize_t>(3), static_cast<py::ssize_t>(2)});
             auto U = uv.mutable_unchecked<3>();
@@ -1286,21 +1296,21 @@ PYBIND11_MODULE(_core, m) {
               C(k, 0) = t.edge_vertices(e, 0), C(k, 1) = t.edge_vertices(e, 1);
               R(k) = p->rotation[e], T(k, 0) = p->translation(e, 0), T(k, 1) = p->translation(e, 1);
             }
-            return py::make_tuple(uv, cut, rotation, translation, int64_vector(p->cones), int64_vector(p->cone_index), p->edge_length,
-                                  json_to_python(cli::param_report(*p)), param_warning(*p), p);
+            const py::tuple param = py::make_tuple(uv, cut, rotation, translation, int64_vector(p->cones), int64_vector(p->cone_index),
+                                                   p->edge_length, json_to_python(cli::param_report(*p)), param_warning(*p), p);
+            return py::make_tuple(param, map.scale, map.quads ? quads_tuple(*map.quads) : py::object(py::none()));
           },
           py::arg("edge_length"), py::arg("target_faces"), py::arg("align_boundary"), py::arg("aligned_edges"), py::arg("sizing") = "map",
-          "The integer-grid map (trivcon/param.h): (uv (F, 3, 2) in the input's corner order, cut edges (n, 2), their rotations, "
-          "translations (n, 2), cone vertices, their numerators (index n/4), edge length, quality dict (param's report), warning, "
-          "the map itself for quads).")
+          py::arg("quads") = false,
+          "The integer-grid map as the program keeps it (trivcon/request.h map_field): ((uv (F, 3, 2) in the input's corner order, "
+          "cut edges (n, 2), their rotations, translations (n, 2), cone vertices, their numerators (index n/4), edge length, quality "
+          "dict (param's report), warning, the map itself for quads), its edge length over the one asked for, and with quads=True the "
+          "tuple of quads() for its quad mesh, else None).")
       .def(
           "quads",
           [](const DesignResultPtr& r, const std::shared_ptr<Parametrization>& p) {
             if (!p) throw Error("quads: no map given");
-            QuadMesh q = interruptible(r->state->threads, [r, p] { return extract_quads(*r->state->designer, *p); });
-            return py::make_tuple(double_matrix3(q.V), int64_matrix(q.Q), int64_vector(std::vector<int>(q.vertex_face.data(), q.vertex_face.data() + q.vertex_face.size())),
-                                  int64_vector(std::vector<int>(q.vertex_cone.data(), q.vertex_cone.data() + q.vertex_cone.size())),
-                                  json_to_python(cli::quad_report(q)), quad_warning(q));
+            return quads_tuple(interruptible(r->state->threads, [r, p] { return extract_quads(*r->state->designer, *p); }));
           },
           py::arg("param"),
           "The quad mesh of a map (trivcon/quad.h): (V (n, 3), Q (m, 4), face of each vertex, input vertex under each vertex or -1, "

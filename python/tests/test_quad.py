@@ -185,3 +185,67 @@ def test_uniform_size_turns_the_sizing_off():
     q = r.quad(target_faces=400, uniform_size=True)
     chi, boundary, over, _ = census(*q)
     assert (chi, over) == (0, 0) and boundary > 0
+
+
+def perforated_plate(nx, ny, m, layers, r, height):
+    """A plate of nx x ny unit cells, each with a round hole of radius r (m edges per cell side, `layers` rings of
+    triangles from the hole to the cell's square), extruded `height` down into a closed solid (tests/support.cpp's
+    perforated_plate and extruded, for the same mesh from Python)."""
+    index, points, faces = {}, [], []
+
+    def vertex(x, y):
+        key = (round(x * 1e6), round(y * 1e6))
+        if key not in index:
+            index[key] = len(points)
+            points.append((x, y, 0.0))
+        return index[key]
+
+    for cx in range(nx):
+        for cy in range(ny):
+            square = []
+            for side in range(4):
+                for k in range(m):
+                    a = k / m
+                    square.append((cx + (a, 1, 1 - a, 0)[side], cy + (0, a, 1, 1 - a)[side]))
+            n = 4 * m
+            ring = []
+            for j in range(layers + 1):
+                w, row = j / layers, []
+                for k in range(n):
+                    angle = np.arctan2(square[k][1] - cy - 0.5, square[k][0] - cx - 0.5)
+                    hx, hy = cx + 0.5 + r * np.cos(angle), cy + 0.5 + r * np.sin(angle)
+                    row.append(vertex((1 - w) * hx + w * square[k][0], (1 - w) * hy + w * square[k][1]))
+                ring.append(row)
+            for j in range(layers):
+                for k in range(n):
+                    a, b, c, d = ring[j][k], ring[j][(k + 1) % n], ring[j + 1][(k + 1) % n], ring[j + 1][k]
+                    faces += [(a, b, c), (a, c, d)] if (j + k) % 2 else [(a, b, d), (b, c, d)]
+    V, F = np.array(points), np.array(faces)
+    directed = {(int(f[k]), int(f[(k + 1) % 3])) for f in F for k in range(3)}
+    boundary = sorted((a, b) for a, b in directed if (b, a) not in directed)
+    n = len(V)
+    walls = [w for a, b in boundary for w in ((b, a, a + n), (b, a + n, b + n))]
+    return np.vstack([V, V - [0, 0, height]]), np.vstack([F, F[:, ::-1] + n, np.array(walls)])
+
+
+def test_a_map_folding_at_the_target_is_made_at_another_scale_as_the_program_makes_it(cli, tmp_path):
+    # The closed 27-hole plate 0.3 thick at 700 quads: every placement's map keeps a fold at a hole's rim at the
+    # edge length asked for, and the program makes it again at another (kMapScales). Result.parametrize (and
+    # Result.quad) keep the field's map the same way (map_field), so Python gives the program's quads.
+    V, F = perforated_plate(9, 3, 8, 4, 0.3, 0.3)
+    mesh = tmp_path / "plate.obj"
+    trivcon.write_mesh(str(mesh), V, F)
+    report, out = tmp_path / "r.json", tmp_path / "q.obj"
+    cli("quad", mesh, "--auto", "--align-features", 30, "--target-faces", 700, "-o", out, "--report", report)
+    j = json.loads(report.read_text())
+    assert j["map_scale"] in (0.95, 1.05, 0.9, 1.1)
+    r = trivcon.FieldDesigner(V, F).solve(4, "auto", align_features=30, map_target_faces=700)
+    p = r.parametrize(target_faces=700)
+    assert p.scale == j["map_scale"] and p.quality["flipped_faces"] == 0 and p.warning == ""
+    assert p.edge_length == pytest.approx(j["param"]["edge_length"], rel=1e-9)
+    q = p.quads()
+    assert q.ok and q.quality["quads"] == j["quad"]["quads"] and q.quality["irregular_vertices"] == j["quad"]["irregular_vertices"]
+    chi, boundary, over, valence = census(*q)
+    assert (chi, boundary, over) == (-52, 0, 0)
+    # A map clean at the target keeps its scale.
+    assert trivcon.FieldDesigner(*trivcon.make_torus(48, 16)).solve(4, {}).parametrize(target_faces=500).scale == 1

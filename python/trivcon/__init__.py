@@ -1353,7 +1353,13 @@ class Result(_Cached):
         The mathematics and what is checked: docs/param.md. Raises trivcon.Error for N other than 4, a
         missing or non-positive scale, an aligned edge that is not an edge of the mesh, a sizing other than the
         three, or uniform_size=True with another sizing.
+        When the map at the scale asked for keeps problems, it is made again at 0.95, 1.05, 0.9 and 1.1 times the
+        edge length, as the program does, and the one with the fewest is kept (Parametrization.scale says which).
         """
+        return self._map(*self._map_args(target_faces, edge_length, align_boundary, aligned_edges, uniform_size, sizing), False)[0]
+
+    def _map_args(self, target_faces, edge_length, align_boundary, aligned_edges, uniform_size, sizing):
+        # parametrize's arguments checked, as the core's: (edge_length, target_faces, align_boundary, pairs, sizing).
         if self.N != 4:
             raise Error(f"param: a seamless parametrization needs a cross field (N = 4), got N = {self.N}")
         if (target_faces is None) == (edge_length is None):
@@ -1374,20 +1380,26 @@ class Result(_Cached):
             sizing = "uniform" if uniform_size else "map"
         elif uniform_size and sizing != "uniform":
             raise Error(f"parametrize: uniform_size=True and sizing={sizing!r} disagree")
-        args = (float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs, sizing)
-        return Parametrization(self, *self._r.parametrize(*args), args=args)
+        return (float(edge_length or 0.0), float(target_faces or 0.0), bool(align_boundary), edge_pairs, sizing)
+
+    def _map(self, *args):
+        # The map as the program keeps it (trivcon/request.h map_field), and with args[-1] its quad mesh's tuple.
+        param, scale, quads = self._r.parametrize(*args)
+        return Parametrization(self, *param, scale=scale, args=args), quads
 
     def quad(self, target_faces=None, edge_length=None, align_boundary=None, aligned_edges=None, uniform_size=False, sizing=None):
         """The quad mesh of this cross field (N = 4), as `trivcon quad`: a QuadMesh (V, Q = result.quad(...) works too).
 
-        The map is made as by parametrize (same arguments), then its integer grid is extracted (trivcon/quad.h,
+        The map is made as by parametrize (same arguments; its quad mesh's failed checks count among the problems
+        that make it again at another scale), then its integer grid is extracted (trivcon/quad.h,
         docs/quad.md): the quads' irregular vertices are this field's singularities, valence 4 - n at index n/4.
         QuadMesh.quality has every guarantee checked on the result and QuadMesh.warning says what failed ("" when
         nothing did); nothing is raised for a failed guarantee, so that the mesh can be looked at. Quads end on a
         boundary only where it is aligned: on a mesh with boundary, solve with align_boundary=True (as
         `trivcon quad --auto` does unasked), or the quads along it are missing (reported).
         """
-        return self.parametrize(target_faces, edge_length, align_boundary, aligned_edges, uniform_size, sizing).quads()
+        args = self._map_args(target_faces, edge_length, align_boundary, aligned_edges, uniform_size, sizing)
+        return QuadMesh(*self._map(*args, True)[1])
 
     def render(self, size=(1200, 900), view=(30, 20), up="y", style="hedgehog", spacing=11, flat=False, legend=True,
                singularities=None, supersampling=3):
@@ -1496,6 +1508,9 @@ class Parametrization:
                    differ by the rotation by r quarter turns and then the translation
       cones        int64 (k,): the singular vertices; cone_index int64 (k,): n per cone (index n / 4)
       edge_length  the mesh length of one unit of (u, v)
+      scale        edge_length over the one asked for: 1, or when the map at that length kept problems (folds,
+                   wrong windings) one of 0.95, 1.05, 0.9, 1.1 whose map has fewer (as `trivcon param`'s `scale:`
+                   line, the report's map_scale); the squares move by about 1/scale^2
       quality      dict: seamless, flipped_faces, degenerate_faces, max_transition_residual, max_cone_offset,
                    max_cone_angle_error, max_alignment_error, mean_distortion, unit_squares, target_squares,
                    seconds, ... (the `param` object of `trivcon param --report`)
@@ -1503,8 +1518,10 @@ class Parametrization:
     write_obj(path) writes what `trivcon param -o` writes.
     """
 
-    def __init__(self, result, uv, cut, rotations, translations, cones, cone_index, edge_length, quality, warning, core=None, args=None):
+    def __init__(self, result, uv, cut, rotations, translations, cones, cone_index, edge_length, quality, warning, core=None, args=None,
+                 scale=1.0):
         self._result = result
+        self.scale = scale
         self.uv, self.cut_edges, self.rotations, self.translations = (_frozen(a) for a in (uv, cut, rotations, translations))
         self.cones, self.cone_index = _frozen(cones), _frozen(cone_index)
         self.edge_length, self.quality, self.warning = edge_length, quality, warning
@@ -1518,7 +1535,7 @@ class Parametrization:
     def quads(self):
         """The quad mesh of this map (trivcon/quad.h): a QuadMesh. See Result.quad."""
         if self._core is None:
-            self._core = self._result._r.parametrize(*self._args)[-1]
+            self._core = self._result._r.parametrize(*self._args)[0][-1]
         return QuadMesh(*self._result._r.quads(self._core))
 
     @property

@@ -322,6 +322,7 @@ class Parametrization:
     cones: _IntArray
     cone_index: _IntArray
     edge_length: float
+    scale: float
     quality: Dict[str, Any]
     warning: str
     def __init__(
@@ -338,6 +339,7 @@ class Parametrization:
         warning: str,
         core: Any = ...,
         args: Any = ...,
+        scale: float = ...,
     ) -> None: ...
     @property
     def seamless(self) -> bool: ...

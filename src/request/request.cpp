@@ -347,10 +347,11 @@ std::vector<int> vertices_near_edges(const FieldDesigner& designer, const std::v
 
 namespace {
 
-// The map's folded and degenerate faces and wrong windings, and with quads the quad mesh's failed checks.
-int map_problems(const MapOutcome& m) {
-  const ParamQuality& q = m.param.quality;
-  return q.flipped_faces + q.degenerate_faces + q.winding_errors + (m.quads ? static_cast<int>(m.quads->quality.problems.size()) : 0);
+int map_problems(const MapOutcome& m) { return map_problems(m.param, m.quads); }
+
+// A map's stretch beyond the goal: 0 when its mean singular-value ratio is within kMapDistortionGoal.
+double map_stretch(const Parametrization& param) {
+  return std::max(param.quality.mean_distortion, kMapDistortionGoal) - kMapDistortionGoal;
 }
 
 // map_request's search on one mesh (map_request adds the refinement).
@@ -361,8 +362,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   const bool own_onto = escalate && request.auto_options.onto_features == 0;
   cancel_for_map(request, designer, edge_length, target_faces);
   const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
-  // Its stretch beyond the goal: 0 when the mean singular-value ratio is within kMapDistortionGoal.
-  auto stretch = [&](const MapOutcome& m) { return std::max(m.param.quality.mean_distortion, kMapDistortionGoal) - kMapDistortionGoal; };
+  auto stretch = [&](const MapOutcome& m) { return map_stretch(m.param); };
   auto better = [&](const MapOutcome& a, const MapOutcome& b) {
     return map_problems(a) != map_problems(b) ? map_problems(a) < map_problems(b) : stretch(a) < stretch(b);
   };
@@ -520,22 +520,13 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
       }
     }
   }
-  // Problems left after every placement and the retries: the kept field's map at other edge lengths (kMapScales),
-  // kept when it has fewer problems, or as few and less stretch (each without near-miss retries of its own: those
-  // are at edge lengths between these; each but the last with the untangling's share of a map that others follow).
-  // Not where a singularity of index ≥ 1 makes its folds necessary (folds_necessary).
-  if (best.field.verified && map_problems(best) > 0 && !folds_necessary(best.param)) {
+  // Problems left after every placement and the retries: the kept field's map at other edge lengths (map_field).
+  if (best.field.verified && map_problems(best) > 0) {
     if (designer.fixed_faces() != best.field.constraints.fixed_faces) designer.set_fixed_faces(best.field.constraints.fixed_faces);
-    for (double scale : kMapScales) {
-      if (map_problems(best) == 0) break;
-      ParamOptions options = request_param_options(designer, kept, best.field, edge_length * scale, target_faces / (scale * scale));
-      options.retries = 0;
-      if (scale != std::end(kMapScales)[-1]) options.untangle_share = kUntangleShareFollowed;  // the next scale is the cheaper remedy
-      MapOutcome m;
-      m.param = parametrize(best.field.designer(designer), best.field.design, options);
-      if (quads) m.quads = extract_quads(best.field.designer(designer), m.param);
-      if (better(m, best)) best.param = std::move(m.param), best.quads = std::move(m.quads), best.scale = scale;
-    }
+    ScaledMap scaled{std::move(best.param), std::move(best.quads), 1.0};
+    map_at_other_scales(best.field.designer(designer), best.field.design,
+                        request_param_options(designer, kept, best.field, edge_length, target_faces), scaled);
+    best.param = std::move(scaled.param), best.quads = std::move(scaled.quads), best.scale = scaled.scale;
   }
   // The designer holds the last set-up (an attempt's or a retry's: fixed faces turned for singularities moved onto
   // features): it takes the kept field's fixed faces back, so that the designer is the kept field's (its design is
@@ -581,6 +572,33 @@ FieldRequest request_on_refined(const FieldRequest& asked, const FieldDesigner& 
 }
 
 }  // namespace
+
+int map_problems(const Parametrization& param, const std::optional<QuadMesh>& quads) {
+  const ParamQuality& q = param.quality;
+  return q.flipped_faces + q.degenerate_faces + q.winding_errors + (quads ? static_cast<int>(quads->quality.problems.size()) : 0);
+}
+
+void map_at_other_scales(const FieldDesigner& designer, const Design& design, const ParamOptions& options, ScaledMap& map) {
+  if (map_problems(map.param, map.quads) == 0 || folds_necessary(map.param)) return;
+  for (double scale : kMapScales) {
+    ParamOptions o = options;
+    o.edge_length *= scale, o.target_faces /= scale * scale;
+    o.retries = 0;
+    if (scale != std::end(kMapScales)[-1]) o.untangle_share = kUntangleShareFollowed;  // the next scale is the cheaper remedy
+    ScaledMap m{parametrize(designer, design, o), std::nullopt, scale};
+    if (map.quads) m.quads = extract_quads(designer, m.param);
+    const int problems = map_problems(m.param, m.quads), kept = map_problems(map.param, map.quads);
+    if (problems < kept || (problems == kept && map_stretch(m.param) < map_stretch(map.param))) map = std::move(m);
+    if (map_problems(map.param, map.quads) == 0) break;
+  }
+}
+
+ScaledMap map_field(const FieldDesigner& designer, const Design& design, const ParamOptions& options, bool quads) {
+  ScaledMap map{parametrize(designer, design, options), std::nullopt, 1.0};
+  if (quads) map.quads = extract_quads(designer, map.param);
+  map_at_other_scales(designer, design, options, map);
+  return map;
+}
 
 MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
                        bool quads) {

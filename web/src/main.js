@@ -644,6 +644,7 @@ async function makeQuads() {
     $('quadinfo').textContent = `${q.quads} quads (target ${target}), ${q.irregular_vertices} irregular vertices (${irregular}), ` +
       `chi ${q.euler_characteristic}, scaled Jacobian min ${q.min_scaled_jacobian.toFixed(3)}, mean ${q.mean_scaled_jacobian.toFixed(3)}, ` +
       `${q.nonconvex_quads} with a flat or reflex corner` +
+      (r.report.map_scale !== 1 ? `; the map at the target kept problems, made at ${r.report.map_scale} times its edge length` : '') +
       (r.report.warning ? `. ${r.report.warning}` : '');
     $('dl-quads').disabled = false;
     status(r.report.warning ? 'quads: made, with problems (see Quads)' : `quads: ${q.quads} made`);

@@ -376,6 +376,9 @@ async function main() {
       // The worst corners: how many quads have a flat or reflex one (the report's count).
       assert.ok(Number.isInteger(r.nonconvex_quads));
       assert.match(await T(() => window.__trivcon.quadInfo), new RegExp(`, ${r.nonconvex_quads} with a flat or reflex corner`));
+      // Clean at the target: made at the edge length asked for (map_field tries others only when it keeps problems).
+      assert.equal(q.report.map_scale, 1);
+      assert.doesNotMatch(await T(() => window.__trivcon.quadInfo), /made at/);
       assert.equal(await T(() => document.getElementById('dl-quads').disabled), false);
       await page.click('#showquads');
       assert.equal(await T(() => window.__trivcon.quadSegments), 0);
