@@ -994,6 +994,55 @@ TEST(Quad, RelaxationUndoesAnInvertedQuad) {
   EXPECT_EQ(q.quality.nonconvex_quads, 0);
 }
 
+// A quad at a cone twisted: the two edge-neighbours of a valence-3 vertex of the cube sphere trade places, so that
+// the quads between them turn over or get reflex corners. The relaxation untwists them on the surface; the cone's
+// vertex, which it never moves, stays where it was.
+TEST(Quad, RelaxationUntwistsQuadsAtACone) {
+  const Mesh m = make_cube_sphere(12, true);
+  FieldRequest req;
+  req.auto_place = true;
+  ParamOptions o;
+  o.target_faces = 6 * 36;
+  Pipeline r = run(m, req, o);
+  ASSERT_TRUE(r.quads.quality.problems.empty()) << quad_warning(r.quads);
+  QuadMesh& q = r.quads;
+  int cone = -1;
+  for (int v = 0; v < q.V.rows() && cone < 0; ++v)
+    if (q.vertex_cone[v] >= 0 && std::count(r.param.cones.begin(), r.param.cones.end(), q.vertex_cone[v])) cone = v;
+  ASSERT_GE(cone, 0);
+  int i = 0, k = 0;
+  for (; i < q.Q.rows(); ++i) {
+    for (k = 0; k < 4 && q.Q(i, k) != cone; ++k) {
+    }
+    if (k < 4) break;
+  }
+  ASSERT_LT(i, q.Q.rows());
+  const int a = q.Q(i, (k + 1) % 4), d = q.Q(i, (k + 3) % 4);
+  const Eigen::RowVector3d cone_at = q.V.row(cone);
+  const Eigen::MatrixX4i Q = q.Q;
+  for (auto* rows : {&q.V, &q.vertex_barycentric}) {
+    const Eigen::RowVectorXd x = rows->row(a);
+    rows->row(a) = rows->row(d);
+    rows->row(d) = x;
+  }
+  std::swap(q.vertex_face[a], q.vertex_face[d]);
+  q.vertex_cone[a] = q.vertex_cone[d] = -1;
+  q.quality = {};
+  check_quads(*r.designer, r.param, q);
+  ASSERT_GE(q.quality.nonconvex_quads + q.quality.inverted_quads, 1);
+  q.quality = {};
+  EXPECT_GE(quad::relax_quads(*r.designer, r.param, q), 2);
+  EXPECT_EQ(inverted(r), 0);
+  EXPECT_TRUE(q.Q == Q);
+  EXPECT_EQ(q.V.row(cone), cone_at);
+  EXPECT_LT(farthest_vertex(r), 1e-9);
+  expect_located(*r.designer, q);
+  check_quads(*r.designer, r.param, q);
+  EXPECT_TRUE(q.quality.problems.empty()) << quad_warning(q);
+  EXPECT_EQ(q.quality.nonconvex_quads, 0);
+  EXPECT_GT(q.quality.min_scaled_jacobian, 0.2);
+}
+
 TEST(Quad, RefusesAMapOfAnotherMesh) {
   const Mesh m = make_torus(48, 16), other = make_torus(24, 8);
   ParamOptions o;

@@ -13,6 +13,12 @@
 
 namespace trivcon::quad {
 
+namespace {
+// Directions in the tangent plane a vertex of a bad quad tries, besides its neighbours' mean and the
+// parallelograms' corners.
+constexpr int kRelaxDirections = 8;
+}  // namespace
+
 int relax_quads(const FieldDesigner& designer, const Parametrization& param, QuadMesh& quads, double threshold, int sweeps) {
   const Topology& t = designer.topology();
   const MatrixX3d& Vin = designer.V();
@@ -152,11 +158,38 @@ int relax_quads(const FieldDesigner& designer, const Parametrization& param, Qua
       }
       if (targets.size() == 1) continue;
       targets[0] = centre / (2.0 * static_cast<double>(targets.size() - 1));
+      // Where a quad around v has a flat or reflex corner: also points around v in the surface's tangent plane, in
+      // kRelaxDirections directions at a quarter, half and whole of its mean quad edge (a twisted quad beside a
+      // cone, two of its corners reflex, is not mended by moves toward the neighbours, each of which makes one of
+      // its corners worse). Not for quads that are only tilted against the surface: there such moves trade
+      // their corners for the tilt.
+      bool reflex = false;
+      double reach = 0;
+      for (int j = quad_start[v]; j < quad_start[v + 1]; ++j) {
+        const int i = quad_list[j];
+        std::array<Eigen::Vector3d, 4> x;
+        for (int k = 0; k < 4; ++k) x[k] = quads.V.row(quads.Q(i, k)).transpose();
+        const Eigen::Vector3d own = quad_normal(x);
+        for (int k = 0; k < 4; ++k) {
+          reflex = reflex || !(own.norm() > 0) || corner_sine(x, k, own.normalized()) <= 0;
+          if (quads.Q(i, k) == v) reach += (x[(k + 1) % 4] - p).norm();
+        }
+      }
+      if (reflex) {
+        reach /= static_cast<double>(quad_start[v + 1] - quad_start[v]);
+        const Eigen::Vector3d n = normal.row(quads.vertex_face[v]).transpose();
+        const Eigen::Vector3d t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+        for (int d = 0; d < kRelaxDirections; ++d) {
+          const double angle = 2 * M_PI * d / kRelaxDirections;
+          targets.push_back(p + reach * (std::cos(angle) * t1 + std::sin(angle) * t2));
+        }
+      }
       Score best = score_around(v, p, quads.vertex_face[v]);
       const double best_before = best.penalty;
       Eigen::Vector3d best_point = p, best_bary = quads.vertex_barycentric.row(v).transpose();
       int best_face = quads.vertex_face[v];
-      for (const Eigen::Vector3d& target : targets)
+      for (size_t c = 0; c < targets.size(); ++c) {
+        const Eigen::Vector3d& target = targets[c];
         for (double step : {1.0, 0.5, 0.25}) {
           Eigen::Vector3d bary;
           const Eigen::Vector3d aim = p + step * (target - p);
@@ -164,6 +197,7 @@ int relax_quads(const FieldDesigner& designer, const Parametrization& param, Qua
           if (face < 0) continue;
           if (const Score s = score_around(v, q, face); s.better_than(best)) best = s, best_point = q, best_face = face, best_bary = bary;
         }
+      }
       if (best.penalty < best_before) {
         quads.V.row(v) = best_point.transpose();
         quads.vertex_face[v] = best_face;
