@@ -115,6 +115,7 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                           {"conflicts", a.conflicts.size()},
                           {"narrow_corners", a.narrow.size()},
                           {"singularities_moved_onto_them", a.snapped.size()},
+                          {"sectors_turned_for_singularities", a.given_sectors.size()},
                           {"loose_edges", run.out.constraints.loose_edges.size()}};
     if (run.request.feature_min_length) report["features"]["min_length"] = *run.request.feature_min_length;
   }

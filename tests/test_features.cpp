@@ -452,6 +452,74 @@ TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
   EXPECT_EQ(alone, (std::map<int, int>{{junction, -1}}));
 }
 
+TEST(FeatureAlignment, SingularityGivenOnALineGetsItsSector) {
+  // A flat 12×12 grid with a straight feature line at y = 1/2 and a −1/4 given at a vertex w of the line (as
+  // `quad --auto --sing-out` writes a singularity it moved onto the line). Following the line, each half-plane
+  // turns by π less two quarter turns, so w reads 0 with no turn of its own, and the exact field makes up the
+  // −1/4 with a turn of π/2 across one edge: a field that is not what it reads. turn_sectors_for_singularities
+  // turns one half-plane through with one step more, and the field is exact and follows the line, as after the
+  // move onto it (move_singularities_onto_features) from one edge below.
+  const int n = 12;
+  const Mesh m = make_holed_grid(n, 0);
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  auto at = [&](int x, int y) { return grid_vertex(m, n, x, y); };
+  std::vector<int> edges;
+  for (int e = 0; e < t.num_edges; ++e) {
+    const Eigen::Vector3d a = m.V.row(t.edge_vertices(e, 0)), b = m.V.row(t.edge_vertices(e, 1));
+    if (std::abs(a.y() - 0.5) < 1e-12 && std::abs(b.y() - 0.5) < 1e-12 && std::min(a.x(), b.x()) > 0.5 / n &&
+        std::max(a.x(), b.x()) < 1 - 0.5 / n)
+      edges.push_back(e);
+  }
+  const int w = at(n / 2, n / 2), below = at(n / 2, n / 2 - 1);
+  Solved plain;
+  plain.edges = edges;
+  plain.alignment = feature_alignment(m.V, t, designer.geometry(), edges, 4);
+  plain.singularities = {{w, -1}};
+  design_aligned(designer, plain);
+  EXPECT_GE(plain.design.large_turn_edges, 1);
+  EXPECT_FALSE(plain.design.field_exact);
+
+  Solved turned = plain;
+  turn_sectors_for_singularities(t, designer.geometry(), edges, 4, turned.singularities, turned.alignment);
+  ASSERT_EQ(turned.alignment.given_sectors.size(), 1u);
+  const FeatureSnap& sector = turned.alignment.given_sectors[0];
+  EXPECT_EQ(sector.from, w);
+  EXPECT_EQ(sector.to, w);
+  // The sector is a half-plane: every face of w's star on one side of the line.
+  int above = 0, under = 0;
+  for (int f : sector.faces) {
+    double cy = 0;
+    for (int k = 0; k < 3; ++k) cy += m.V(t.F(f, k), 1) / 3;
+    (cy > 0.5 ? above : under) += 1;
+  }
+  EXPECT_TRUE(above == 0 || under == 0);
+  EXPECT_EQ(static_cast<int>(sector.faces.size()), above + under);
+  design_aligned(designer, turned);
+  EXPECT_EQ(turned.design.large_turn_edges, 0);
+  EXPECT_TRUE(turned.design.field_exact);
+  turned.alignment.narrow.push_back({w, -1, -1, kPi, sector.faces});  // its inner faces follow neither side, by design
+  expect_exact_and_aligned(designer, turned);
+  // The move onto the line from below turns the lower half-plane; where the given one turned it too, the
+  // fields are the same.
+  Solved moved = plain;
+  moved.singularities = {{below, -1}};
+  move_singularities_onto_features(m.V, t, designer.geometry(), edges, 4, 1.5 / n, false, moved.singularities, moved.alignment);
+  ASSERT_EQ(moved.singularities, (std::map<int, int>{{w, -1}}));
+  design_aligned(designer, moved);
+  if (under > 0) {
+    EXPECT_EQ(moved.alignment.snapped[0].faces, sector.faces);
+    EXPECT_NEAR(moved.design.connection.energy, turned.design.connection.energy, 1e-9 * turned.design.connection.energy);
+  }
+  // Given where the sectors make it already (a vertex off the line; the index the line gives), nothing turns.
+  FeatureAlignment untouched = plain.alignment;
+  turn_sectors_for_singularities(t, designer.geometry(), edges, 4, {{below, -1}}, untouched);
+  EXPECT_TRUE(untouched.given_sectors.empty());
+  // And a singularity a move turned a sector for already is not turned again.
+  turn_sectors_for_singularities(t, designer.geometry(), edges, 4, moved.singularities, moved.alignment);
+  EXPECT_TRUE(moved.alignment.given_sectors.empty());
+}
+
 TEST(FeatureAlignment, SingularitiesMovedOntoALineKeepTheirSeparation) {
   // Two −1/4 three edges apart, one edge below a straight feature line (a 12×12 grid, the line at y = 1/2): each
   // moves onto the line vertex above it, three edges from the other. With a separation of 3.5 edges the second

@@ -106,6 +106,7 @@ struct FeatureAlignment {
   std::vector<FeatureConflict> conflicts;  // one per (face, disagreeing edge), by face
   std::vector<NarrowCorner> narrow;        // by vertex
   std::vector<FeatureSnap> snapped;        // by `from`
+  std::vector<FeatureSnap> given_sectors;  // turned for singularities given (turn_sectors_for_singularities), by vertex
   int corner_faces = 0;                    // faces beside two or more feature edges (compatible or not)
 };
 // The fixed directions for `edges` (interior edge ids) and symmetry N ≥ 1.
@@ -130,6 +131,19 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& topology,
 void move_singularities_onto_features(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
                                       int N, double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment,
                                       double separation = 0);
+
+// For singularities given (vertex → n, index n/N; N even, N ≥ 4) on feature vertices (two or more sharp edges,
+// interior): a sector at w whose faces follow its two edges turns through by the nearest whole number of steps
+// k = round(θ/(2π/N)) (a narrow corner's by one), so w reads N − Σk without a turn of its own; where the index
+// given differs from that by a step or more, as many plain sectors as the difference (beside no other sharp edge,
+// not turned already) are turned through with one step fewer (+1/N) or more (−1/N), the sectors whose angle
+// fits the new count best first (and not ones whose quad corners would open wider than 1.5 steps, while others
+// fit). Otherwise the field makes up the difference with a turn of π/N or more across one edge of the sector,
+// a large turn the map folds around: a placement of `quad --auto` written with --sing-out (a singularity moved
+// onto a line, whose sector that move turned) and given back with -s. Updates `alignment.fixed` (the sectors'
+// faces) and lists the sectors in `alignment.given_sectors` (from = to = the vertex, distance 0).
+void turn_sectors_for_singularities(const Topology& topology, const Geometry& geometry, const std::vector<int>& edges, int N,
+                                    const std::map<int, int>& vertex, FeatureAlignment& alignment);
 
 // One line of a .sharp file.
 struct SharpFaceEdge {

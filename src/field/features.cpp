@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 #include <sstream>
 
 #include "trivcon/error.h"
@@ -364,6 +365,58 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
         break;
       }
       break;  // the nearest eligible candidate only, moved or not
+    }
+  }
+}
+
+void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const std::vector<int>& edges, int N, const std::map<int, int>& vertex,
+                                    FeatureAlignment& alignment) {
+  if (N < 4 || N % 2 != 0 || edges.empty()) return;
+  const std::vector<char> sharp = sharp_flags(t, edges);
+  const std::map<int, std::vector<int>> beside = sharp_faces(t, edges);
+  std::vector<char> claimed(t.num_faces, 0);
+  std::set<int> narrow_faces;
+  for (const NarrowCorner& k : alignment.narrow)
+    for (int f : k.faces) claimed[f] = 1, narrow_faces.insert(f);
+  for (const auto* list : {&alignment.snapped, &alignment.given_sectors})
+    for (const FeatureSnap& k : *list)
+      for (int f : k.faces) claimed[f] = 1;
+  const double step = 2 * kPi / N;
+  for (auto [w, n] : vertex) {
+    if (w < 0 || w >= t.num_vertices) continue;
+    std::vector<Sector> sectors = sectors_at(t, g, w, sharp);
+    if (sectors.empty()) continue;
+    // The sectors' whole steps as the alignment turns them now (a narrow corner's one, a sector turned by a
+    // move onto the line one off its nearest: such a vertex holds its singularity already).
+    bool turned = false;
+    int sum = 0;
+    for (const Sector& sector : sectors) {
+      const bool narrow = narrow_faces.count(sector.faces.front()) > 0;
+      turned = turned || (!narrow && claimed[sector.faces.front()]);
+      sum += narrow ? 1 : static_cast<int>(std::lround(sector.theta / step));
+    }
+    if (turned) continue;
+    int difference = n - (N - sum);  // +: fewer steps wanted, −: more
+    while (difference != 0) {
+      const int change = difference > 0 ? -1 : 1;
+      const Sector* best = nullptr;
+      int best_steps = 0;
+      double best_misfit = 0;
+      bool best_flat = true;
+      for (const Sector& sector : sectors) {
+        if (!sector_is_plain(sector, beside, claimed)) continue;
+        const int steps = static_cast<int>(std::lround(sector.theta / step)) + change;
+        const int m = static_cast<int>(sector.faces.size());
+        const double misfit = std::abs(sector.theta - steps * step);
+        if (steps < 1 || !(misfit / (m + 1) < 0.9 * kPi / N)) continue;
+        const bool flat = sector.theta > 1.5 * steps * step;
+        if (!best || (flat != best_flat ? !flat : misfit < best_misfit))
+          best = &sector, best_steps = steps, best_misfit = misfit, best_flat = flat;
+      }
+      if (!best) break;
+      turn_through(t, g, w, *best, best_steps, N, alignment.fixed, claimed);
+      alignment.given_sectors.push_back({w, w, 0.0, best->faces});
+      difference += change;
     }
   }
 }

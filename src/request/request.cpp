@@ -178,6 +178,24 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
   }
   out.sharp_edges = out.constraints.sharp_edges;
   if (designer.fixed_faces() != out.constraints.fixed_faces) designer.set_fixed_faces(out.constraints.fixed_faces);
+  // The sectors turned anew (by moves onto the feature lines or for singularities given) are fixed faces, unless
+  // a direction given by hand holds the face.
+  auto take_sectors = [&](const std::vector<FeatureSnap>& turned) {
+    for (const FeatureSnap& k : turned)
+      for (int f : k.faces)
+        if (!request.prescription.fixed.count(f)) out.constraints.fixed[f] = out.constraints.features.fixed.at(f);
+    out.constraints.fixed_faces.clear();
+    for (auto [f, angle] : out.constraints.fixed) out.constraints.fixed_faces.push_back(f);
+    p.fixed = out.constraints.fixed;
+    designer.set_fixed_faces(out.constraints.fixed_faces);
+  };
+  // Singularities given on feature vertices get the sectors that make their index (turn_sectors_for_singularities):
+  // a placement of `quad --auto` given back with -s makes the same kind of field. Not where they move (relax) or
+  // the mesh is refined (split_large_turns: its constraints are made again on each refined mesh).
+  if (!request.auto_place && !request.relax && !request.split_large_turns && !out.constraints.sharp_edges.empty()) {
+    turn_sectors_for_singularities(designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N, p.vertex, out.constraints.features);
+    if (!out.constraints.features.given_sectors.empty()) take_sectors(out.constraints.features.given_sectors);
+  }
   if (request.auto_place) {
     const bool onto = request.auto_options.onto_features > 0 && !request.split_large_turns && !out.constraints.sharp_edges.empty();
     AutoOptions o = request_auto_options(designer, request, out.constraints);
@@ -196,15 +214,7 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
         move_singularities_onto_features(designer.V(), designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N,
                                          request.auto_options.onto_features, request.auto_options.onto_flat_sectors, p.vertex, a,
                                          request.auto_options.onto_separation);
-        if (a.snapped.size() == before) return;
-        // The sectors turned anew, unless a direction given by hand holds the face.
-        for (const FeatureSnap& k : a.snapped)
-          for (int f : k.faces)
-            if (!request.prescription.fixed.count(f)) out.constraints.fixed[f] = a.fixed.at(f);
-        out.constraints.fixed_faces.clear();
-        for (auto [f, angle] : out.constraints.fixed) out.constraints.fixed_faces.push_back(f);
-        p.fixed = out.constraints.fixed;
-        designer.set_fixed_faces(out.constraints.fixed_faces);
+        if (a.snapped.size() != before) take_sectors(a.snapped);
       };
       move_onto();
       o.split_above = request.auto_options.split_above;
