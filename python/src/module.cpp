@@ -274,6 +274,14 @@ py::object json_to_python(const nlohmann::ordered_json& j) { return py::module_:
 
 py::tuple mesh_tuple(const Mesh& mesh) { return py::make_tuple(double_matrix3(mesh.V), int64_matrix(mesh.F)); }
 
+// Whether two ParamOptions ask for the same map (scale, sizing, the same aligned edges in any order).
+bool same_map_options(const ParamOptions& a, const ParamOptions& b) {
+  std::vector<int> x = a.aligned_edges, y = b.aligned_edges;
+  std::sort(x.begin(), x.end()), std::sort(y.begin(), y.end());
+  x.erase(std::unique(x.begin(), x.end()), x.end()), y.erase(std::unique(y.begin(), y.end()), y.end());
+  return a.edge_length == b.edge_length && a.target_faces == b.target_faces && a.sizing == b.sizing && x == y;
+}
+
 // A quad mesh as QuadMesh's arguments: (V, Q, face of each vertex, input vertex under each vertex or -1, quality
 // dict (quad's report), warning).
 py::tuple quads_tuple(const QuadMesh& q) {
@@ -475,6 +483,11 @@ struct DesignResult {
   IndexPrescription prescription;
   Design design;
   bool verified = false;
+  // With solve(..., map_target_faces / map_edge_length): the map map_request kept for this field (with its quad
+  // mesh) and the options it was made with; parametrize with the same options gives it back (the program's map,
+  // not made again). Not pickled.
+  std::shared_ptr<const ScaledMap> map;
+  ParamOptions map_options;
 
   // Interior edges sorted by (i, j) with their x: the rows of `trivcon solve --connection-out`.
   py::tuple connection() const {
@@ -1045,10 +1058,21 @@ PYBIND11_MODULE(_core, m) {
               std::lock_guard<std::mutex> lock(s->mutex);
               check_cancelled();  // abandoned while it waited for the designer
               FieldRequest request = q;
-              // With a map's scale: the field of map_request (the program's: placed again when its map folds).
-              FieldOutcome r = request.auto_place && (map_edge_length > 0 || map_target_faces > 0)
-                                   ? map_request(*s->designer, s->F, request, map_edge_length, map_target_faces, true).field
-                                   : solve_request(*s->designer, s->F, request);
+              // With a map's scale: the field of map_request (the program's: placed again when its map folds), and
+              // its map.
+              std::shared_ptr<const ScaledMap> map;
+              ParamOptions map_options;
+              FieldOutcome r;
+              if (request.auto_place && (map_edge_length > 0 || map_target_faces > 0)) {
+                MapOutcome m = map_request(*s->designer, s->F, request, map_edge_length, map_target_faces, true);
+                r = std::move(m.field);
+                if (r.verified) {
+                  map_options = request_param_options(*s->designer, request, r, map_edge_length, map_target_faces);
+                  map = std::make_shared<const ScaledMap>(ScaledMap{std::move(m.param), std::move(m.quads), m.scale});
+                }
+              } else {
+                r = solve_request(*s->designer, s->F, request);
+              }
               s->fixed_faces = s->designer->fixed_faces();
               o.designer = s;
               if (r.refined) {
@@ -1070,6 +1094,7 @@ PYBIND11_MODULE(_core, m) {
               d->prescription = std::move(r.prescription);
               d->design = std::move(r.design);
               d->verified = r.verified;
+              d->map = std::move(map), d->map_options = std::move(map_options);
               o.result = d;
               o.parent = std::move(r.parent_face);
               o.rounds = std::move(r.rounds);
@@ -1278,8 +1303,15 @@ PYBIND11_MODULE(_core, m) {
               if (e < 0) throw Error("aligned edge (" + std::to_string(a) + ", " + std::to_string(b) + ") is not an edge of the mesh");
               o.aligned_edges.push_back(e);
             }
-            // As every front end keeps it (map_field: at other scales when the one asked for keeps problems).
-            ScaledMap map = interruptible(r->state->threads, [r, o, quads] { return map_field(*r->state->designer, r->design, o, quads); });
+            // The map solve(..., map_target_faces) kept when asked for with its options, else as every front end
+            // keeps it (map_field: at other scales when the one asked for keeps problems).
+            ScaledMap map;
+            if (r->map && same_map_options(o, r->map_options)) {
+              map = *r->map;
+              if (!quads) map.quads.reset();
+            } else {
+              map = interruptible(r->state->threads, [r, o, quads] { return map_field(*r->state->designer, r->design, o, quads); });
+            }
             auto p = std::make_shared<Parametrization>(std::move(map.param));
             const Eigen::MatrixXd corners = input_corner_uv(*p, t, r->state->F);
             DoubleArray uv({static_cast<py::ssize_t>(corners.rows()), static_cast<py::ssize_t>(3), static_cast<py::ssize_t>(2)});

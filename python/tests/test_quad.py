@@ -245,6 +245,10 @@ def test_a_map_folding_at_the_target_is_made_at_another_scale_as_the_program_mak
     assert p.edge_length == pytest.approx(j["param"]["edge_length"], rel=1e-9)
     q = p.quads()
     assert q.ok and q.quality["quads"] == j["quad"]["quads"] and q.quality["irregular_vertices"] == j["quad"]["irregular_vertices"]
+    assert q.quality["vertices"] == j["quad"]["vertices"] and q.quality["min_scaled_jacobian"] == pytest.approx(j["quad"]["min_scaled_jacobian"])
+    # At the scale it was solved for, the map the search kept is given back, not made again: the program's.
+    again = r.quad(target_faces=700)
+    assert again.quality["quads"] == j["quad"]["quads"] and np.array_equal(again.V, q.V)
     chi, boundary, over, valence = census(*q)
     assert (chi, boundary, over) == (-52, 0, 0)
     # A map clean at the target keeps its scale.

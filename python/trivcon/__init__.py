@@ -884,7 +884,8 @@ class FieldDesigner(_Cached):
           or its quad mesh fails a check (the scale too coarse for them), or it stretches (mean singular-value
           ratio above 1.5), placed again: relaxed, with pairs cancelled within 2, then 4 units, and those relaxed, the
           cleanest map's kept (this makes the map once or more). Then Result.parametrize/quad at the same scale
-          give what the program gives. Where that map folds beside edges whose two ends lie on aligned lines (a flat
+          (and the same aligned edges and sizing) give back the map the search kept, as `trivcon quad` gives it
+          (not after pickling: then it is made again). Where that map folds beside edges whose two ends lie on aligned lines (a flat
           CAD face triangulated from its rim alone), those edges are split at their midpoints and the search runs
           again on the refined mesh (as quad does): the Result then belongs to the refined mesh, as with
           split_large_turns (Result.designer, Result.parent_face).
