@@ -388,6 +388,19 @@ int grid_vertex(const Mesh& m, int n, int x, int y) {
   return -1;
 }
 
+// The edges of an n × n grid (make_holed_grid) on the line y = 1/2, without the two at the grid's sides: a straight
+// feature line across it whose ends are inside.
+std::vector<int> middle_line(const Mesh& m, const Topology& t, int n) {
+  std::vector<int> edges;
+  for (int e = 0; e < t.num_edges; ++e) {
+    const Eigen::Vector3d a = m.V.row(t.edge_vertices(e, 0)), b = m.V.row(t.edge_vertices(e, 1));
+    if (std::abs(a.y() - 0.5) < 1e-12 && std::abs(b.y() - 0.5) < 1e-12 && std::min(a.x(), b.x()) > 0.5 / n &&
+        std::max(a.x(), b.x()) < 1 - 0.5 / n)
+      edges.push_back(e);
+  }
+  return edges;
+}
+
 TEST(FeatureAlignment, SingularityBesideAJunctionMovesOntoIt) {
   // A flat 12×12 grid with a feature line across it at y = 1/2 and another from its middle up to y = 11/12:
   // a T-junction of three sharp edges at (1/2, 1/2). A +1/4 one edge below the junction is moved onto it
@@ -464,13 +477,7 @@ TEST(FeatureAlignment, SingularityGivenOnALineGetsItsSector) {
   FieldDesigner designer(m.V, m.F);
   const Topology& t = designer.topology();
   auto at = [&](int x, int y) { return grid_vertex(m, n, x, y); };
-  std::vector<int> edges;
-  for (int e = 0; e < t.num_edges; ++e) {
-    const Eigen::Vector3d a = m.V.row(t.edge_vertices(e, 0)), b = m.V.row(t.edge_vertices(e, 1));
-    if (std::abs(a.y() - 0.5) < 1e-12 && std::abs(b.y() - 0.5) < 1e-12 && std::min(a.x(), b.x()) > 0.5 / n &&
-        std::max(a.x(), b.x()) < 1 - 0.5 / n)
-      edges.push_back(e);
-  }
+  const std::vector<int> edges = middle_line(m, t, n);
   const int w = at(n / 2, n / 2), below = at(n / 2, n / 2 - 1);
   Solved plain;
   plain.edges = edges;
@@ -530,13 +537,7 @@ TEST(FeatureAlignment, SingularitiesMovedOntoALineKeepTheirSeparation) {
   FieldDesigner designer(m.V, m.F);
   const Topology& t = designer.topology();
   auto at = [&](int x, int y) { return grid_vertex(m, n, x, y); };
-  std::vector<int> edges;
-  for (int e = 0; e < t.num_edges; ++e) {
-    const Eigen::Vector3d a = m.V.row(t.edge_vertices(e, 0)), b = m.V.row(t.edge_vertices(e, 1));
-    if (std::abs(a.y() - 0.5) < 1e-12 && std::abs(b.y() - 0.5) < 1e-12 && std::min(a.x(), b.x()) > 0.5 / n &&
-        std::max(a.x(), b.x()) < 1 - 0.5 / n)
-      edges.push_back(e);
-  }
+  const std::vector<int> edges = middle_line(m, t, n);
   ASSERT_EQ(edges.size(), static_cast<size_t>(n - 2));
   const int a = at(3, n / 2 - 1), b = at(6, n / 2 - 1);
   const std::map<int, int> given{{a, -1}, {b, -1}};

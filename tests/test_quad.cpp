@@ -362,13 +362,17 @@ TEST(Quad, SingularitiesNearASharpEdgeMoveOntoIt) {
   }
 }
 
-TEST(Quad, CubeSphereWithAutomaticCones) {
-  const Mesh m = make_cube_sphere(12, true);
+// The round cube sphere (12 × 12 per side) with --auto's 8 cones of +1/4, mapped at 6 × 36 squares.
+Pipeline cube_sphere_auto() {
   FieldRequest req;
   req.auto_place = true;
   ParamOptions o;
   o.target_faces = 6 * 36;
-  const Pipeline r = run(m, req, o);
+  return run(make_cube_sphere(12, true), req, o);
+}
+
+TEST(Quad, CubeSphereWithAutomaticCones) {
+  const Pipeline r = cube_sphere_auto();
   ASSERT_EQ(r.param.cones.size(), 8u);
   for (int n : r.param.cone_index) EXPECT_EQ(n, 1);
   ASSERT_EQ(r.param.quality.flipped_faces, 0) << param_warning(r.param);
@@ -1023,12 +1027,7 @@ TEST(Quad, RelaxationUndoesAnInvertedQuad) {
 // the quads between them turn over or get reflex corners. The relaxation untwists them on the surface; the cone's
 // vertex, which it never moves, stays where it was.
 TEST(Quad, RelaxationUntwistsQuadsAtACone) {
-  const Mesh m = make_cube_sphere(12, true);
-  FieldRequest req;
-  req.auto_place = true;
-  ParamOptions o;
-  o.target_faces = 6 * 36;
-  Pipeline r = run(m, req, o);
+  Pipeline r = cube_sphere_auto();
   ASSERT_TRUE(r.quads.quality.problems.empty()) << quad_warning(r.quads);
   QuadMesh& q = r.quads;
   int cone = -1;
