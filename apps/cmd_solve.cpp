@@ -247,12 +247,6 @@ void run_solve(const SolveOptions& o) {
   }
 
   const FieldOutcome out = solve_request(designer, mesh.F, request);
-  if (const size_t turned = out.constraints.features.given_sectors.size(); turned > 0) {
-    extra["features"]["sectors_turned_for_singularities"] = turned;
-    if (!o.quiet)
-      std::cout << "features: " << turned << " sectors at singularities on feature lines turned through by a step more or fewer, so that "
-                << "the field makes their index without a large turn (report: features.sectors_turned_for_singularities)\n";
-  }
   if (out.auto_result) {
     const AutoResult& r = *out.auto_result;
     const AutoTimings& s = r.seconds;

@@ -641,32 +641,16 @@ TEST(Quad, SingularitiesOnOneFeatureLineCloserThanAUnitKeepOne) {
     for (int x = 0; x <= n; ++x)
       points.emplace_back(double(x) / n, double(std::min(y, crease)) / n, double(std::max(y - crease, 0)) / n);
   const Mesh m = grid_of(n, points);
+  FieldRequest req;
+  req.align_boundary = true;
+  req.feature_degrees = 30;
   const std::array<int, 2> cones{crease * stride + 14, crease * stride + 16};
-  FieldRequest request;
-  request.align_boundary = true;
-  request.feature_degrees = 30;
-  request.prescription.N = 4;
-  request.prescription.vertex[cones[0]] = 1;
-  request.prescription.vertex[cones[1]] = -1;
-  // The faces beside the crease and the boundary follow them, also at the two singularities: solve_request would
-  // turn a sector at each for its index (turn_sectors_for_singularities), which gives this map without opening
-  // anything (below); a field designed with these fixed directions alone need not.
-  Pipeline r;
-  r.designer = std::make_unique<FieldDesigner>(m.V, m.F);
-  const Topology& t = r.designer->topology();
-  const RequestConstraints c = request_constraints(*r.designer, request);
-  IndexPrescription req = request.prescription;
-  req.fixed = c.fixed;
-  r.designer->set_fixed_faces(c.fixed_faces);
-  const Design design = r.designer->design(req);
-  ASSERT_TRUE(design_verified(design));
+  req.prescription.vertex[cones[0]] = 1;
+  req.prescription.vertex[cones[1]] = -1;
   ParamOptions o;
   o.edge_length = 1.0 / 6;
-  o.aligned_edges = c.sharp_edges;
-  for (int e = 0; e < t.num_edges; ++e)
-    if (t.is_boundary_edge(e)) o.aligned_edges.push_back(e);
-  r.param = parametrize(*r.designer, design, o);
-  r.quads = extract_quads(*r.designer, r.param);
+  const Pipeline r = run(m, req, o, true);
+  ASSERT_TRUE(r.outcome.verified);
   const ParamQuality& p = r.param.quality;
   ASSERT_EQ(p.flipped_faces + p.degenerate_faces + p.winding_errors, 0) << param_warning(r.param);
   EXPECT_EQ(p.unaligned_edges, 0);
@@ -676,12 +660,13 @@ TEST(Quad, SingularitiesOnOneFeatureLineCloserThanAUnitKeepOne) {
   // Each singularity its own quad vertex (not one point for both).
   std::map<int, int> at_cone;
   for (int v = 0; v < static_cast<int>(r.quads.vertex_cone.size()); ++v)
-    if (req.vertex.count(r.quads.vertex_cone[v])) ++at_cone[r.quads.vertex_cone[v]];
+    if (req.prescription.vertex.count(r.quads.vertex_cone[v])) ++at_cone[r.quads.vertex_cone[v]];
   EXPECT_EQ(at_cone, (std::map<int, int>{{cones[0], 1}, {cones[1], 1}}));
-  // Through the request (the sectors turned): clean too, each singularity its own quad vertex.
-  ParamOptions scale;
-  scale.edge_length = o.edge_length;
-  const Pipeline q = run(m, request, scale, true);
+  // With the sectors turned for them, as `param` and `quad` make the field (FieldRequest::sectors_for_singularities,
+  // turn_sectors_for_singularities): clean without opening anything.
+  FieldRequest request = req;
+  request.sectors_for_singularities = true;
+  const Pipeline q = run(m, request, o, true);
   ASSERT_TRUE(q.outcome.verified);
   EXPECT_EQ(q.outcome.constraints.features.given_sectors.size(), 2u);
   EXPECT_EQ(q.param.quality.flipped_faces + q.param.quality.degenerate_faces + q.param.quality.winding_errors, 0) << param_warning(q.param);

@@ -51,6 +51,12 @@ struct FieldRequest {
   bool split_large_turns = false;        // refine where the connection turns by π/N or more (split_large_turns.h)
   int max_split_rounds = 8;
   Sizing sizing = Sizing::map;           // for a map (request_param_options): ParamOptions::sizing
+  // For a map (map_request sets it): singularities given (not auto_place) on feature vertices get the sectors
+  // that make their index (turn_sectors_for_singularities), as the moves onto feature lines of `quad --auto` do,
+  // so that its --sing-out given back makes the same field; a map's quad corners then follow the index. Not for
+  // `solve`: there the field with the faces along the lines alone is the smoothest (often with the quarter turn
+  // spread over a sector's free faces), and -s gives back --auto's field.
+  bool sectors_for_singularities = false;
   bool features_given() const { return feature_degrees.has_value() || !feature_edges.empty(); }
 };
 

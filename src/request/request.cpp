@@ -189,10 +189,12 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
     p.fixed = out.constraints.fixed;
     designer.set_fixed_faces(out.constraints.fixed_faces);
   };
-  // Singularities given on feature vertices get the sectors that make their index (turn_sectors_for_singularities):
-  // a placement of `quad --auto` given back with -s makes the same kind of field. Not where they move (relax) or
-  // the mesh is refined (split_large_turns: its constraints are made again on each refined mesh).
-  if (!request.auto_place && !request.relax && !request.split_large_turns && !out.constraints.sharp_edges.empty()) {
+  // For a map, singularities given on feature vertices get the sectors that make their index
+  // (FieldRequest::sectors_for_singularities): a placement of `quad --auto` given back with -s makes the same
+  // field. Not where they move (relax) or the mesh is refined (split_large_turns: its constraints are made again on
+  // each refined mesh).
+  if (request.sectors_for_singularities && !request.auto_place && !request.relax && !request.split_large_turns &&
+      !out.constraints.sharp_edges.empty()) {
     turn_sectors_for_singularities(designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N, p.vertex, out.constraints.features);
     if (!out.constraints.features.given_sectors.empty()) take_sectors(out.constraints.features.given_sectors);
   }
@@ -613,6 +615,7 @@ ScaledMap map_field(const FieldDesigner& designer, const Design& design, const P
 MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
                        bool quads) {
   if (request.feature_degrees && !request.feature_min_length) request.feature_min_length = map_unit(designer, edge_length, target_faces);
+  request.sectors_for_singularities = true;
   const FieldRequest asked = request;
   MapOutcome m = map_search(designer, F, request, edge_length, target_faces, quads);
   // Where the kept map folds beside an edge whose two ends lie on aligned lines (a flat CAD face triangulated from
