@@ -1058,12 +1058,12 @@ PYBIND11_MODULE(_core, m) {
               std::lock_guard<std::mutex> lock(s->mutex);
               check_cancelled();  // abandoned while it waited for the designer
               FieldRequest request = q;
-              // With a map's scale: the field of map_request (the program's: placed again when its map folds), and
-              // its map.
+              // With a map's scale: the field of map_request, as `param`/`quad` make it (placed again when its map
+              // folds; given singularities on feature lines with their sectors turned), and its map.
               std::shared_ptr<const ScaledMap> map;
               ParamOptions map_options;
               FieldOutcome r;
-              if (request.auto_place && (map_edge_length > 0 || map_target_faces > 0)) {
+              if (map_edge_length > 0 || map_target_faces > 0) {
                 MapOutcome m = map_request(*s->designer, s->F, request, map_edge_length, map_target_faces, true);
                 r = std::move(m.field);
                 if (r.verified) {

@@ -3,6 +3,7 @@
 `trivcon quad`."""
 
 import json
+from fractions import Fraction
 import pickle
 from collections import Counter
 
@@ -98,8 +99,6 @@ def test_auto_for_a_map_is_the_programs(cli, tmp_path):
     # Without it, the smoothest field's singularities as `solve --auto` finds them (no cancelling for a map).
     plain = d.solve(4, "auto", align_features=30)
     assert sum(plain.singularities.values()) == sum(r.singularities.values())
-    with pytest.raises(trivcon.Error, match="map_target_faces needs singularities='auto'"):
-        d.solve(4, {}, map_target_faces=300)
     with pytest.raises(trivcon.Error, match="give at most one of map_target_faces and map_edge_length"):
         d.solve(4, "auto", map_target_faces=300, map_edge_length=0.1)
     with pytest.raises(trivcon.Error, match="map_edge_length must be a positive number"):
@@ -253,3 +252,27 @@ def test_a_map_folding_at_the_target_is_made_at_another_scale_as_the_program_mak
     assert (chi, boundary, over) == (-52, 0, 0)
     # A map clean at the target keeps its scale.
     assert trivcon.FieldDesigner(*trivcon.make_torus(48, 16)).solve(4, {}).parametrize(target_faces=500).scale == 1
+
+
+def test_given_singularities_for_a_map_are_the_programs(cli, tmp_path):
+    # solve(..., singularities, map_target_faces=K) makes the field as `trivcon quad -s S --target-faces K` does:
+    # the singularities quad --auto moved onto the plate's rims get the sectors that make their index, so the
+    # field is --auto's and the quads the program's. Without map_target_faces the faces follow the lines alone.
+    V, F = perforated_plate(3, 1, 8, 4, 0.3, 0.3)
+    mesh = tmp_path / "plate3.obj"
+    trivcon.write_mesh(str(mesh), V, F)
+    report, again, out, sing = tmp_path / "r.json", tmp_path / "r2.json", tmp_path / "q.obj", tmp_path / "s.txt"
+    cli("quad", mesh, "--auto", "--align-features", 30, "--target-faces", 100, "-o", out, "--report", report, "--sing-out", sing)
+    cli("quad", mesh, "-s", sing, "--align-features", 30, "--target-faces", 100, "-o", out, "--report", again)
+    j, k = json.loads(report.read_text()), json.loads(again.read_text())
+    assert j["features"]["singularities_moved_onto_them"] > 0
+    assert k["features"]["sectors_turned_for_singularities"] == j["features"]["singularities_moved_onto_them"]
+    assert k["field"]["energy"] == pytest.approx(j["field"]["energy"], rel=1e-9)
+    given = {int(v): Fraction(n) for v, n in (line.split() for line in sing.read_text().splitlines() if not line.startswith("#"))}
+    d = trivcon.FieldDesigner(V, F)
+    r = d.solve(4, given, align_features=30, map_target_faces=100)
+    assert r.energy == pytest.approx(k["field"]["energy"], rel=1e-9) and r.field_exact
+    q = r.quad(target_faces=100)
+    assert q.ok and q.quality["quads"] == k["quad"]["quads"] and q.quality["vertices"] == k["quad"]["vertices"]
+    plain = d.solve(4, given, align_features=30)
+    assert plain.energy != pytest.approx(r.energy, rel=1e-6)

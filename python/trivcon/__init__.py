@@ -876,7 +876,7 @@ class FieldDesigner(_Cached):
           direction to their children. Not with generators or boundary indices (the refined mesh has cycles
           of its own), nor with roots or feature_edges.
 
-        map_target_faces or map_edge_length (N = 4, singularities="auto"): choose the singularities for a map at
+        map_target_faces or map_edge_length (N = 4): with singularities="auto", choose the singularities for a map at
           that scale, as `trivcon param`/`quad --auto` do (docs/param.md): +- pairs closer than one unit
           cancelled (unless auto_cancel is given), those at the ends of sharp edges kept, a +-1/4 within 1.5 units
           of a sharp edge moved onto it, then close same-sign ones gathered or spread (and those spread moved onto
@@ -888,7 +888,11 @@ class FieldDesigner(_Cached):
           (not after pickling: then it is made again). Where that map folds beside edges whose two ends lie on aligned lines (a flat
           CAD face triangulated from its rim alone), those edges are split at their midpoints and the search runs
           again on the refined mesh (as quad does): the Result then belongs to the refined mesh, as with
-          split_large_turns (Result.designer, Result.parent_face).
+          split_large_turns (Result.designer, Result.parent_face). With singularities given (N = 4), the field as
+          `trivcon param -s` / `quad -s` make it and its map kept the same way: a singularity on a feature line whose
+          sectors do not make its index gets a sector turned through for it (docs/howto/features.md), so that
+          `quad --auto --sing-out`'s singularities make the same field, and parametrize/quad at that scale give
+          back the map kept (the other scales when the first keeps problems).
 
         The request means the same as the CLI's and the editor's (the library's trivcon/request.h does it).
         Errors in the prescription raise trivcon.Error with the library's message. The result is
@@ -962,8 +966,6 @@ class FieldDesigner(_Cached):
                 continue
             if isinstance(value, bool) or not isinstance(value, _numbers.Real) or not _math.isfinite(value) or value <= 0:
                 raise Error(f"{name} must be a positive number, not {value!r}")
-            if vertex is not None:
-                raise Error(f"{name} needs singularities='auto' (it chooses them for a map)")
             map_scale[k] = float(value)
         if map_scale[0] and map_scale[1]:
             raise Error("give at most one of map_target_faces and map_edge_length")
