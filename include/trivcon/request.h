@@ -229,6 +229,8 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // within the goal; past it every attempt is made; the kept map is the one with the fewest problems, then the least
 // stretch beyond the goal (the earliest of equals). `request` is left as the kept one
 // was made.
+// Still with problems, the kept field's map at other edge lengths (map_at_other_scales), then the screened
+// runners-up's in rank, until a map has none; the better one is kept.
 // Last, when the kept map has problems and folds beside an edge that is not aligned but whose two ends lie on
 // aligned edges, every such edge is split at its midpoint (split_edges_at_midpoints) and the whole search runs
 // again on the refined mesh (the request moved onto it: fixed directions and roots to every child, listed feature

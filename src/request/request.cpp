@@ -525,20 +525,34 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
       if (map_problems(best) == 0) break;
       retry(m, r);
       ++retried;
-      if (better(m, best)) {
+      if (better(m, best)) {  // the one it replaces takes its place among the runners-up
         m.first_problems = best.first_problems, m.first_distortion = best.first_distortion;
-        best = std::move(m);
-        kept = r;
+        std::swap(best, m);
+        std::swap(kept, r);
       }
     }
   }
-  // Problems left after every placement and the retries: the kept field's map at other edge lengths (map_field).
+  // Problems left after every placement and the retries: the kept field's map at other edge lengths
+  // (map_at_other_scales), then the runners-up's in rank until a map has none (another scale can mend the
+  // placement ranked second where it does not mend the first).
+  auto rescale = [&](MapOutcome& m, const FieldRequest& r) {
+    if (designer.fixed_faces() != m.field.constraints.fixed_faces) designer.set_fixed_faces(m.field.constraints.fixed_faces);
+    ScaledMap scaled{std::move(m.param), std::move(m.quads), 1.0};
+    map_at_other_scales(m.field.designer(designer), m.field.design, request_param_options(designer, r, m.field, edge_length, target_faces),
+                        scaled);
+    m.param = std::move(scaled.param), m.quads = std::move(scaled.quads), m.scale = scaled.scale;
+  };
   if (best.field.verified && map_problems(best) > 0) {
-    if (designer.fixed_faces() != best.field.constraints.fixed_faces) designer.set_fixed_faces(best.field.constraints.fixed_faces);
-    ScaledMap scaled{std::move(best.param), std::move(best.quads), 1.0};
-    map_at_other_scales(best.field.designer(designer), best.field.design,
-                        request_param_options(designer, kept, best.field, edge_length, target_faces), scaled);
-    best.param = std::move(scaled.param), best.quads = std::move(scaled.quads), best.scale = scaled.scale;
+    rescale(best, kept);
+    for (auto& [m, r] : runners) {
+      if (map_problems(best) == 0) break;
+      rescale(m, r);
+      if (better(m, best)) {
+        m.first_problems = best.first_problems, m.first_distortion = best.first_distortion;
+        std::swap(best, m);
+        std::swap(kept, r);
+      }
+    }
   }
   // The designer holds the last set-up (an attempt's or a retry's: fixed faces turned for singularities moved onto
   // features): it takes the kept field's fixed faces back, so that the designer is the kept field's (its design is
