@@ -1307,8 +1307,8 @@ PYBIND11_MODULE(_core, m) {
             // keeps it (map_field: at other scales when the one asked for keeps problems).
             ScaledMap map;
             if (r->map && same_map_options(o, r->map_options)) {
-              map = *r->map;
-              if (!quads) map.quads.reset();
+              map.param = r->map->param, map.scale = r->map->scale;
+              if (quads) map.quads = r->map->quads;
             } else {
               map = interruptible(r->state->threads, [r, o, quads] { return map_field(*r->state->designer, r->design, o, quads); });
             }

@@ -188,8 +188,7 @@ int relax_quads(const FieldDesigner& designer, const Parametrization& param, Qua
       const double best_before = best.penalty;
       Eigen::Vector3d best_point = p, best_bary = quads.vertex_barycentric.row(v).transpose();
       int best_face = quads.vertex_face[v];
-      for (size_t c = 0; c < targets.size(); ++c) {
-        const Eigen::Vector3d& target = targets[c];
+      for (const Eigen::Vector3d& target : targets)
         for (double step : {1.0, 0.5, 0.25}) {
           Eigen::Vector3d bary;
           const Eigen::Vector3d aim = p + step * (target - p);
@@ -197,7 +196,6 @@ int relax_quads(const FieldDesigner& designer, const Parametrization& param, Qua
           if (face < 0) continue;
           if (const Score s = score_around(v, q, face); s.better_than(best)) best = s, best_point = q, best_face = face, best_bary = bary;
         }
-      }
       if (best.penalty < best_before) {
         quads.V.row(v) = best_point.transpose();
         quads.vertex_face[v] = best_face;

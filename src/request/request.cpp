@@ -366,6 +366,13 @@ double map_stretch(const Parametrization& param) {
   return std::max(param.quality.mean_distortion, kMapDistortionGoal) - kMapDistortionGoal;
 }
 
+// Whether map a (with its quads) is better than map b: fewer problems, or as few and less stretch.
+bool better_map(const Parametrization& a, const std::optional<QuadMesh>& a_quads, const Parametrization& b,
+                const std::optional<QuadMesh>& b_quads) {
+  const int pa = map_problems(a, a_quads), pb = map_problems(b, b_quads);
+  return pa != pb ? pa < pb : map_stretch(a) < map_stretch(b);
+}
+
 // map_request's search on one mesh (map_request adds the refinement).
 MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
                       bool quads) {
@@ -375,9 +382,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   cancel_for_map(request, designer, edge_length, target_faces);
   const double unit = request.auto_place ? map_unit(designer, edge_length, target_faces) : 0.0;
   auto stretch = [&](const MapOutcome& m) { return map_stretch(m.param); };
-  auto better = [&](const MapOutcome& a, const MapOutcome& b) {
-    return map_problems(a) != map_problems(b) ? map_problems(a) < map_problems(b) : stretch(a) < stretch(b);
-  };
+  auto better = [&](const MapOutcome& a, const MapOutcome& b) { return better_map(a.param, a.quads, b.param, b.quads); };
   // The attempts: the placement found; the same relaxed (trivcon/relax.h: the field's energy is lower where
   // the singularities sit as the surface's curvature and the aligned lines ask, and a map of a field with less
   // rotation stretches less); the same relaxed with the periods of the conformal scale around the aligned lines
@@ -613,8 +618,7 @@ void map_at_other_scales(const FieldDesigner& designer, const Design& design, co
     if (scale != std::end(kMapScales)[-1]) o.untangle_share = kUntangleShareFollowed;  // the next scale is the cheaper remedy
     ScaledMap m{parametrize(designer, design, o), std::nullopt, scale};
     if (map.quads) m.quads = extract_quads(designer, m.param);
-    const int problems = map_problems(m.param, m.quads), kept = map_problems(map.param, map.quads);
-    if (problems < kept || (problems == kept && map_stretch(m.param) < map_stretch(map.param))) map = std::move(m);
+    if (better_map(m.param, m.quads, map.param, map.quads)) map = std::move(m);
     if (map_problems(map.param, map.quads) == 0) break;
   }
 }
