@@ -66,6 +66,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   run.retried_maps = made.retried_maps;
   run.onto_units = made.onto_units;
   run.onto_flat = made.onto_flat;
+  run.onto_boundary = made.onto_boundary;
   run.scale = made.scale;
   run.quads = std::move(made.quads);
   run.refined_edges = made.refined_edges;
@@ -127,6 +128,7 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                            {"periods", run.relaxed_periods},
                            {"onto_features_units", run.onto_units},
                            {"onto_flat_sectors", run.onto_flat},
+                           {"onto_boundary", run.onto_boundary},
                            {"first_problems", run.first_problems},
                            {"first_distortion", run.first_distortion},
                            {"retried_maps", run.retried_maps}};
@@ -145,6 +147,7 @@ std::string placement_line(const MapRun& run) {
        << " and a mean distortion of " << std::setprecision(3) << run.first_distortion << " (goal " << kMapDistortionGoal << "); placed again "
        << run.placements - 1 << " time(s), relaxed, moved onto feature lines from further or with opposite pairs cancelled further apart; kept: ";
   if (run.cancel_units > 1) line << (run.relaxed ? "relaxed, " : "") << "pairs cancelled within " << static_cast<int>(run.cancel_units) << " units";
+  else if (run.onto_boundary) line << "the singularities found, those beside the boundary moved onto it as corners" << (run.relaxed ? ", relaxed" : "");
   else if (run.onto_flat) line << "the singularities found, moved onto the feature lines from " << run.onto_units << " units where a quad gets a flat corner";
   else if (run.onto_units > kMapOntoFeatures) line << "the singularities found, moved onto the feature lines from " << run.onto_units << " units";
   else line << (run.relaxed ? (run.relaxed_periods ? "the singularities found, relaxed with the periods" : "the singularities found, relaxed") : "the first");

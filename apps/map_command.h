@@ -50,6 +50,7 @@ struct MapRun {
   bool relaxed_periods = false;  // relaxed with the periods (MapOutcome::periods)
   double onto_units = 0;         // MapOutcome::onto_units
   bool onto_flat = false;        // MapOutcome::onto_flat
+  bool onto_boundary = false;    // MapOutcome::onto_boundary
   double scale = 1;              // MapOutcome::scale
   bool boundary_aligned_unasked = false;  // quad --auto aligned the boundary without --align-boundary
   std::optional<QuadMesh> quads;  // run_map(…, true): the kept map's quad mesh

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -288,6 +289,81 @@ Mesh perforated_plate(int nx, int ny, int m, int layers, double r) {
   for (size_t i = 0; i < points.size(); ++i) out.V.row(static_cast<int>(i)) = points[i].transpose();
   out.F.resize(static_cast<int>(faces.size()), 3);
   for (size_t i = 0; i < faces.size(); ++i) out.F.row(static_cast<int>(i)) = faces[i].transpose();
+  return out;
+}
+
+Mesh lattice_plate(int nx, int ny, double r, double h) {
+  const double width = nx, height = ny;
+  const int rows = std::max(2, static_cast<int>(std::lround(height / (h * std::sqrt(3.0) / 2))));
+  const int n = std::max(1, static_cast<int>(std::lround(width / h)));
+  std::vector<Eigen::Vector2d> p;
+  std::vector<std::vector<int>> row(rows + 1);
+  for (int j = 0; j <= rows; ++j) {
+    const double y = height * j / rows;
+    std::vector<double> xs;
+    if (j % 2 == 0)
+      for (int i = 0; i <= n; ++i) xs.push_back(width * i / n);
+    else {
+      xs.push_back(0);
+      for (int i = 0; i < n; ++i) xs.push_back(width * (i + 0.5) / n);
+      xs.push_back(width);
+    }
+    for (double x : xs) row[j].push_back(static_cast<int>(p.size())), p.emplace_back(x, y);
+  }
+  std::vector<std::array<int, 3>> faces;
+  for (int j = 0; j < rows; ++j) {  // the strip between two rows, advancing along the one whose next point comes first
+    const std::vector<int>&a = row[j], &b = row[j + 1];
+    size_t i = 0, k = 0;
+    while (i + 1 < a.size() || k + 1 < b.size()) {
+      if (k + 1 == b.size() || (i + 1 < a.size() && p[a[i + 1]].x() <= p[b[k + 1]].x())) faces.push_back({a[i], a[i + 1], b[k]}), ++i;
+      else faces.push_back({a[i], b[k + 1], b[k]}), ++k;
+    }
+  }
+  std::vector<Eigen::Vector2d> centres;
+  for (int cx = 0; cx < nx; ++cx)
+    for (int cy = 0; cy < ny; ++cy) centres.emplace_back(cx + 0.5, cy + 0.5);
+  std::vector<double> d(p.size(), std::numeric_limits<double>::infinity());
+  std::vector<int> nearest(p.size(), 0);
+  for (size_t v = 0; v < p.size(); ++v)
+    for (size_t c = 0; c < centres.size(); ++c)
+      if ((p[v] - centres[c]).norm() < d[v]) d[v] = (p[v] - centres[c]).norm(), nearest[v] = static_cast<int>(c);
+  std::vector<std::array<int, 3>> kept;
+  for (const auto& f : faces)
+    if (d[f[0]] >= r + 0.3 * h && d[f[1]] >= r + 0.3 * h && d[f[2]] >= r + 0.3 * h) kept.push_back(f);
+  std::map<std::pair<int, int>, int> uses;
+  std::vector<std::set<int>> neighbours(p.size());
+  for (const auto& f : kept)
+    for (int k = 0; k < 3; ++k) {
+      const int a = f[k], b = f[(k + 1) % 3];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+      neighbours[a].insert(b), neighbours[b].insert(a);
+    }
+  std::vector<char> rim(p.size(), 0);
+  for (const auto& [e, count] : uses)
+    if (count == 1) rim[e.first] = rim[e.second] = 1;
+  for (size_t v = 0; v < p.size(); ++v)
+    if (rim[v] && d[v] < r + 2 * h) {
+      const Eigen::Vector2d& c = centres[nearest[v]];
+      p[v] = c + r * (p[v] - c).normalized();
+    }
+  for (int round = 0; round < 15; ++round)
+    for (size_t v = 0; v < p.size(); ++v) {
+      if (rim[v] || neighbours[v].empty() || d[v] >= r + 3 * h) continue;
+      Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+      for (int w : neighbours[v]) sum += p[w];
+      p[v] = sum / static_cast<double>(neighbours[v].size());
+    }
+  std::vector<int> id(p.size(), -1);
+  Mesh out;
+  int used = 0;
+  for (const auto& f : kept)
+    for (int v : f)
+      if (id[v] < 0) id[v] = used++;
+  out.V.resize(used, 3);
+  for (size_t v = 0; v < p.size(); ++v)
+    if (id[v] >= 0) out.V.row(id[v]) << p[v].x(), p[v].y(), 0;
+  out.F.resize(static_cast<int>(kept.size()), 3);
+  for (size_t i = 0; i < kept.size(); ++i) out.F.row(static_cast<int>(i)) << id[kept[i][0]], id[kept[i][1]], id[kept[i][2]];
   return out;
 }
 

@@ -68,6 +68,11 @@ Mesh sheared_box(int n);
 // quads (each cut into two triangles) from the hole's circle, sampled at the angles of 4m points evenly spaced
 // along the cell's square, out to that square; the cells share their squares' points.
 Mesh perforated_plate(int nx, int ny, int m, int layers, double r);
+// The same plate meshed as a general-purpose mesher would: a triangle lattice of spacing about h (rows of
+// equilateral triangles, so no edge follows the holes' rings), the triangles with a corner closer than r + 0.3 h to a
+// hole's centre removed, the hole's rim vertices then put on its circle and the vertices within 3 h of the rim
+// smoothed (15 rounds of neighbour means, in vertex order).
+Mesh lattice_plate(int nx, int ny, double r, double h);
 // A flat mesh in the plane z = 0 (faces counter-clockwise seen from +z) made a closed solid of thickness `height`:
 // its faces, their copy at z = −height turned over, and two triangles per boundary edge for the wall between.
 Mesh extruded(const Mesh& flat, double height);

@@ -48,6 +48,7 @@ QuadFile read_quads(const std::string& path) {
 struct Census {
   int euler = 0, boundary_edges = 0, over_shared_edges = 0;
   std::map<int, int> interior_valence;  // vertex -> valence, for vertices on no boundary edge
+  std::map<int, int> boundary_valence;  // vertex -> valence, for vertices on a boundary edge
 };
 
 // χ = V − E + F, edges in more than two quads, valences of interior vertices: from the quads alone.
@@ -65,8 +66,7 @@ Census census(const QuadFile& q) {
     if (uses > 2) ++c.over_shared_edges;
   }
   c.euler = static_cast<int>(used.size()) - static_cast<int>(edge_uses.size()) + static_cast<int>(q.quads.size());
-  for (auto [v, n] : valence)
-    if (!on_boundary.count(v)) c.interior_valence[v] = n;
+  for (auto [v, n] : valence) (on_boundary.count(v) ? c.boundary_valence : c.interior_valence)[v] = n;
   return c;
 }
 
@@ -261,6 +261,39 @@ TEST(CliQuad, PlateWith27HolesIsCleanAtTheFirstPlacement) {
   for (auto [v, n] : c.interior_valence) irregular += n != 4;
   EXPECT_EQ(irregular, 108);  // 4 × −1/4 per hole, valence 5
   EXPECT_EQ(r.out.find("placement:"), std::string::npos) << r.out;
+}
+
+// A plate with 8 round holes (radius 0.2 in unit cells) meshed on a triangle lattice, at 80 quads (about 4 quad
+// edges around a hole): the −1/4 the smoothest field puts beside each rim sit a fraction of a unit from it, where
+// the map has no integer point off the rim's iso-line, and the placements without corners keep folds or quads
+// with reflex corners. Moved onto the rims as corners of the boundary (AutoOptions::onto_boundary), the map is
+// clean and the quads convex, one irregular interior vertex left (a −2/4 in the middle, valence 6).
+TEST(CliQuad, SingularitiesBesideRoundHolesBecomeCornersOfTheirRims) {
+  const std::string mesh = mesh_file(test::lattice_plate(4, 2, 0.2, 0.05), "lattice.obj"), out = temp_file("q.obj"), report = temp_file("r.json");
+  const auto r = run_cli("quad " + mesh + " --auto --target-faces 80 -o " + out + " --report " + report);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("those beside the boundary moved onto it as corners"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(slurp(report));
+  EXPECT_EQ(j["boundary_loops"], 9);
+  EXPECT_TRUE(j["placement"]["onto_boundary"].get<bool>());
+  EXPECT_GT(j["placement"]["first_problems"].get<int>(), 0);
+  EXPECT_EQ(j["param"]["flipped_faces"], 0);
+  EXPECT_EQ(j["param"]["degenerate_faces"], 0);
+  EXPECT_LE(j["param"]["mean_distortion"].get<double>(), 1.5);
+  EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
+  EXPECT_EQ(j["quad"]["inverted_quads"], 0);
+  EXPECT_EQ(j["quad"]["nonconvex_quads"], 0);
+  EXPECT_GT(j["quad"]["min_scaled_jacobian"].get<double>(), 0.3);
+  EXPECT_NEAR(j["quad"]["quads"].get<double>(), 80, 24);
+  const QuadFile q = read_quads(out);
+  const Census c = census(q);
+  EXPECT_EQ(c.euler, -7);
+  EXPECT_EQ(c.over_shared_edges, 0);
+  // The rims' corners: boundary vertices with four edges (three quads: a concave corner of the plate), about four
+  // per hole.
+  int concave = 0;
+  for (auto [v, edges] : c.boundary_valence) concave += edges == 4;
+  EXPECT_GE(concave, 8 * 3);
 }
 
 // The placement is made again only with --auto and no --auto-cancel, and says so in the report (bones at 1,000

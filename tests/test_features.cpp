@@ -8,7 +8,10 @@
 #include <set>
 
 #include "support.h"
+#include "trivcon/angles.h"
 #include "trivcon/auto.h"
+#include "trivcon/constraints.h"
+#include "trivcon/error.h"
 #include "trivcon/features.h"
 #include "trivcon/field_io.h"
 #include "trivcon/generate.h"
@@ -525,6 +528,71 @@ TEST(FeatureAlignment, SingularityGivenOnALineGetsItsSector) {
   // And a singularity a move turned a sector for already is not turned again.
   turn_sectors_for_singularities(t, designer.geometry(), edges, 4, moved.singularities, moved.alignment);
   EXPECT_TRUE(moved.alignment.given_sectors.empty());
+}
+
+TEST(FeatureAlignment, SingularitiesBesideTheAlignedBoundaryBecomeCornersOfIt) {
+  // A unit square with a round hole of radius 1/4, meshed on a triangle lattice, its boundary aligned: the smoothest
+  // field puts four −1/4 beside the hole's rim. With the boundary as a line, each within 3 lattice spacings moves onto
+  // a rim vertex w whose fan (from one boundary edge to the other, the two end faces following them exactly) turns
+  // through with one step more, so the field turns a quarter less than the rim there, and no vertex carries the
+  // −1/4 (boundary vertices have no index): the interior singularities sum to what the turned boundary needs and
+  // the field is exact, every boundary face along its edge. A fan of three faces cannot take the turn in steps
+  // read unambiguously (two of π/4): the next rim vertex is tried.
+  const double h = 0.08;
+  const Mesh m = test::lattice_plate(1, 1, 0.25, h);
+  FieldDesigner designer(m.V, m.F);
+  const Topology& t = designer.topology();
+  const Geometry& g = designer.geometry();
+  Solved s;
+  s.alignment.fixed = boundary_alignment(m.V, t, g);
+  AutoOptions ao;
+  ao.N = 4;
+  ao.fixed = s.alignment.fixed;
+  s.singularities = auto_singularities(designer, ao).vertex;
+  const std::map<int, double> plain = s.alignment.fixed;
+  const std::map<int, int> found = s.singularities;
+
+  // Not without the boundary as a line (there are no sharp edges).
+  Solved kept = s;
+  move_singularities_onto_features(m.V, t, g, {}, 4, 3 * h, false, kept.singularities, kept.alignment, 0, false);
+  EXPECT_EQ(kept.singularities, found);
+
+  move_singularities_onto_features(m.V, t, g, {}, 4, 3 * h, false, s.singularities, s.alignment, 0, true);
+  ASSERT_FALSE(s.alignment.snapped.empty());
+  EXPECT_EQ(s.alignment.snapped.size(), 4u);
+  EXPECT_TRUE(s.singularities.empty());
+  for (const FeatureSnap& snap : s.alignment.snapped) {
+    EXPECT_EQ(found.at(snap.from), -1);
+    EXPECT_FALSE(s.singularities.count(snap.from));
+    EXPECT_TRUE(t.is_boundary_vertex(snap.to));
+    std::vector<int> fan;
+    vertex_fan(t, snap.to, fan);
+    EXPECT_EQ(snap.faces, fan);
+    EXPECT_GE(fan.size(), 4u);
+    // The fan's end faces still follow their boundary edges; the ones between turn.
+    EXPECT_NEAR(reduce_angle(s.alignment.fixed.at(fan.front()) - plain.at(fan.front()), 4), 0, 1e-12);
+    EXPECT_NEAR(reduce_angle(s.alignment.fixed.at(fan.back()) - plain.at(fan.back()), 4), 0, 1e-12);
+  }
+  design_aligned(designer, s);
+  const Design& d = s.design;
+  EXPECT_TRUE(design_verified(d));
+  EXPECT_TRUE(d.field_exact);
+  EXPECT_EQ(d.large_turn_edges, 0);
+  EXPECT_LE(d.max_fixed_error, 1e-9);
+  std::map<int, int> read;
+  for (int v = 0; v < t.num_vertices; ++v)
+    if (d.indices.vertex[v] != 0) read[v] = d.indices.vertex[v];
+  EXPECT_EQ(read, s.singularities);
+  for (int e = 0; e < t.num_edges; ++e) {
+    if (!t.is_boundary_edge(e)) continue;
+    const int f = t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1);
+    EXPECT_LE(off_edge(m.V, t, f, e, g.direction_in_face(f, d.field.angle(f))), 1e-9) << "face " << f;
+  }
+  // Without the fans turned, the −1/4 left out are missing from the sum the boundary needs.
+  Solved bare;
+  bare.alignment.fixed = plain;
+  bare.singularities = s.singularities;
+  EXPECT_THROW(design_aligned(designer, bare), Error);
 }
 
 TEST(FeatureAlignment, SingularitiesMovedOntoALineKeepTheirSeparation) {

@@ -66,6 +66,7 @@ struct AutoOptions {
   double onto_features = 0;
   double onto_separation = 0;      // not onto a vertex closer than this to another singularity (mesh units; 0: anywhere)
   bool onto_flat_sectors = false;  // and onto sectors whose quad corners would be flat (move_singularities_onto_features)
+  bool onto_boundary = false;      // and, with the boundary aligned, onto it as a corner (move_singularities_onto_features)
   bool align_curvature = false;  // follow the principal curvature directions (see above); N even
   double curvature_t = 0;        // its strength t < 1: 0 as geometry-central, → 1 smoother, < 0 closer to the curvature
 };

@@ -126,11 +126,17 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& topology,
 // already, or moved before it): two singularities less than a unit apart on one line can be rounded onto one
 // integer point, folding the map between them (a row of round holes' rims); the next nearest line vertex is
 // tried instead, else the singularity stays.
+// With `boundary`, the boundary is such a line too (faces beside its edges fixed to them, as align_boundary
+// does): a singularity moved onto a boundary vertex w turns w's fan (its faces from one boundary edge to the
+// other, the faces beside those two following them exactly) and leaves no singularity: w becomes a corner of
+// the boundary (a −1/N beside a round hole: a concave corner of the quads there, where a cone a fraction of a unit
+// inside would be rounded onto the rim's iso-line or a unit from it). A fan of three faces cannot take the turn in
+// steps the field reads unambiguously (two of π/4): on the boundary the next nearest vertices are tried too.
 // Updates `vertex` and `alignment.fixed` (new faces among them: the sector's middle ones), lists the moves in
 // `alignment.snapped`; the sectors of moves listed there already (an earlier call's) are not turned again.
 void move_singularities_onto_features(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
                                       int N, double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment,
-                                      double separation = 0);
+                                      double separation = 0, bool boundary = false);
 
 // For singularities given (vertex → n, index n/N; N even, N ≥ 4) on feature vertices (two or more sharp edges,
 // interior): a sector at w whose faces follow its two edges turns through by the nearest whole number of steps

@@ -158,6 +158,7 @@ struct MapOutcome {
   bool periods = false;    // and with the periods in the objective (kMapPeriodWeight)
   double onto_units = 0;   // with automatic placement and sharp edges: the distance singularities were moved onto them from, in units
   bool onto_flat = false;  // and onto sectors where a quad gets a flat corner (AutoOptions::onto_flat_sectors)
+  bool onto_boundary = false;  // and onto the aligned boundary as corners (AutoOptions::onto_boundary)
   double scale = 1;        // the kept map's edge length over the one asked for (kMapScales; 1: the one asked for)
   std::optional<QuadMesh> quads;  // with quads = true: the kept map's quad mesh (extract_quads)
   // Edges split at their midpoints (map_request): then field.refined, V, F and parent_face hold the refined mesh.
@@ -230,7 +231,10 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // stretch beyond the goal (the earliest of equals). `request` is left as the kept one
 // was made.
 // Still with problems, the kept field's map at other edge lengths (map_at_other_scales), then the screened
-// runners-up's in rank, until a map has none; the better one is kept.
+// runners-up's in rank, until a map has none; the better one is kept. Still with problems and the boundary
+// aligned, the placements with the singularities beside the boundary moved onto it as corners
+// (AutoOptions::onto_boundary), unrelaxed and relaxed, with their retries and scales the same way; the better
+// map is kept.
 // Last, when the kept map has problems and folds beside an edge that is not aligned but whose two ends lie on
 // aligned edges, every such edge is split at its midpoint (split_edges_at_midpoints) and the whole search runs
 // again on the refined mesh (the request moved onto it: fixed directions and roots to every child, listed feature

@@ -23,18 +23,43 @@ int corner_of_edge(const Topology& t, int f, int e) {
   return -1;
 }
 
-// The sectors around interior vertex v between consecutive sharp edges, counter-clockwise (none when fewer
-// than two sharp edges meet there). A face at v holds its corner k at v; its outgoing half-edge there is
-// face_edges(f, k) (k → k+1), its incoming one face_edges(f, k+2); the next face counter-clockwise is across
-// the incoming one.
+// The sectors around vertex v between consecutive sharp edges, counter-clockwise: around an interior vertex none
+// when fewer than two sharp edges meet there; with `boundary`, around a boundary vertex from its fan's first
+// boundary edge to its last, cut at the sharp edges between (none without `boundary`). A face at v holds its
+// corner k at v; its outgoing half-edge there is face_edges(f, k) (k → k+1), its incoming one face_edges(f, k+2);
+// the next face counter-clockwise is across the incoming one.
 struct Sector {
-  int first = -1, second = -1;  // the sharp edges: the first face's outgoing, the last face's incoming half-edge
+  int first = -1, second = -1;  // the sharp (or boundary) edges: the first face's outgoing, the last face's incoming half-edge
   std::vector<int> faces;
   double theta = 0;  // the corners' angles at v
 };
 
-std::vector<Sector> sectors_at(const Topology& t, const Geometry& g, int v, const std::vector<char>& sharp) {
+std::vector<Sector> sectors_at(const Topology& t, const Geometry& g, int v, const std::vector<char>& sharp, bool boundary = false) {
   std::vector<Sector> out;
+  Sector s;
+  auto add = [&](int f, bool& closes) {
+    const int k = t.corner_of(f, v);
+    if (s.faces.empty()) s.first = t.face_edges(f, k);
+    s.faces.push_back(f);
+    s.theta += g.corner_angles(f, k);
+    const int incoming = t.face_edges(f, (k + 2) % 3);
+    closes = sharp[incoming] || t.is_boundary_edge(incoming);
+    if (closes) {
+      s.second = incoming;
+      out.push_back(std::move(s));
+      s = Sector();
+    }
+    return incoming;
+  };
+  bool closes = false;
+  if (t.is_boundary_vertex(v)) {
+    if (!boundary) return out;
+    std::vector<int> fan;
+    vertex_fan(t, v, fan);
+    for (int f : fan) add(f, closes);
+    if (!closes) out.clear();  // a fan that does not end on the boundary (not a manifold boundary vertex)
+    return out;
+  }
   if (!t.is_interior_vertex(v)) return out;
   int start = -1, count = 0;
   for (int j = t.vertex_face_offsets[v]; j < t.vertex_face_offsets[v + 1]; ++j) {
@@ -42,22 +67,18 @@ std::vector<Sector> sectors_at(const Topology& t, const Geometry& g, int v, cons
     if (sharp[t.face_edges(f, t.corner_of(f, v))]) ++count, start = start < 0 ? f : start;
   }
   if (count < 2) return out;
-  Sector s;
   int f = start;
   for (int step = t.vertex_face_offsets[v + 1] - t.vertex_face_offsets[v]; step > 0; --step) {
-    const int k = t.corner_of(f, v);
-    if (s.faces.empty()) s.first = t.face_edges(f, k);
-    s.faces.push_back(f);
-    s.theta += g.corner_angles(f, k);
-    const int incoming = t.face_edges(f, (k + 2) % 3);
-    if (sharp[incoming]) {
-      s.second = incoming;
-      out.push_back(std::move(s));
-      s = Sector();
-    }
+    const int incoming = add(f, closes);
     f = t.edge_faces(incoming, 0) == f ? t.edge_faces(incoming, 1) : t.edge_faces(incoming, 0);
   }
   return out;
+}
+
+// The steps the field takes through a sector: one into each face and one out of the last, except at a boundary
+// edge, whose face follows it exactly (no face lies across it).
+int sector_steps(const Topology& t, const Sector& s) {
+  return static_cast<int>(s.faces.size()) + 1 - t.is_boundary_edge(s.first) - t.is_boundary_edge(s.second);
 }
 
 // Whether a face of the sector lies beside a sharp edge other than the sector's two, or is taken already.
@@ -72,17 +93,17 @@ bool sector_is_plain(const Sector& s, const std::map<int, std::vector<int>>& sha
   return true;
 }
 
-// Fixes the sector's faces W_1..W_m to the first edge's direction turned by i·δ, δ = (θ − steps·2π/N)/(m + 1):
-// with the faces across the two edges (which follow them), the field turns by δ at each of the m + 1 steps
-// and through the sector by θ − steps·2π/N, so a map gives the sector steps·2π/N.
+// Fixes the sector's faces W_1..W_m to the first edge's direction turned by δ = (θ − steps·2π/N)/(sector_steps)
+// at each step: with the faces across the two edges (which follow them), or the edges themselves where they are
+// boundary edges, the field turns through the sector by θ − steps·2π/N, so a map gives the sector steps·2π/N.
 void turn_through(const Topology& t, const Geometry& g, int v, const Sector& s, int steps, int N, std::map<int, double>& fixed,
                   std::vector<char>& claimed) {
-  const int m = static_cast<int>(s.faces.size());
-  const double delta = (s.theta - steps * 2 * kPi / N) / (m + 1);
+  const int m = static_cast<int>(s.faces.size()), before = t.is_boundary_edge(s.first) ? 0 : 1;
+  const double delta = (s.theta - steps * 2 * kPi / N) / sector_steps(t, s);
   double gamma = 0;  // the angle at v from the first edge to W_i's outgoing half-edge
   for (int i = 0; i < m; ++i) {
     const int w = s.faces[i], c = t.corner_of(w, v);
-    fixed[w] = wrap_angle(g.half_edge_angle(w, c) - gamma + (i + 1) * delta);
+    fixed[w] = wrap_angle(g.half_edge_angle(w, c) - gamma + (i + before) * delta);
     claimed[w] = 1;
     gamma += g.corner_angles(w, c);
   }
@@ -295,12 +316,19 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& t, const 
 
 void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, const Geometry& g, const std::vector<int>& edges, int N,
                                       double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment,
-                                      double separation) {
-  if (N < 4 || N % 2 != 0 || edges.empty() || !(distance > 0)) return;
+                                      double separation, bool boundary) {
+  if (N < 4 || N % 2 != 0 || (edges.empty() && !boundary) || !(distance > 0)) return;
   const std::vector<char> sharp = sharp_flags(t, edges);
-  const std::map<int, std::vector<int>> beside = sharp_faces(t, edges);
+  std::map<int, std::vector<int>> beside = sharp_faces(t, edges);
   std::vector<int> degree(t.num_vertices, 0);
   for (int e : edges) ++degree[t.edge_vertices(e, 0)], ++degree[t.edge_vertices(e, 1)];
+  if (boundary)
+    for (int e = 0; e < t.num_edges; ++e)
+      if (t.is_boundary_edge(e)) {
+        ++degree[t.edge_vertices(e, 0)], ++degree[t.edge_vertices(e, 1)];
+        beside[t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1)].push_back(e);
+      }
+  std::vector<int> corners;  // boundary vertices given a corner by a move: no singularity there, but taken
   std::vector<char> claimed(t.num_faces, 0);
   for (const NarrowCorner& k : alignment.narrow)
     for (int f : k.faces) claimed[f] = 1;
@@ -312,7 +340,7 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
     bool found = false;
     if (separation > 0)
       field::edge_dijkstra(V, t, w, separation, false, dist, [&](int v, double) {
-        found = found || (v != s && vertex.count(v));
+        found = found || (v != s && (vertex.count(v) || std::count(corners.begin(), corners.end(), v)));
         return !found;
       });
     return found;
@@ -332,7 +360,7 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
     std::sort(candidates.begin(), candidates.end());
     for (auto [d, w] : candidates) {
       // A line vertex (two sharp edges) or a junction (more): either way its sector facing s lies between two.
-      if (degree[w] < 2 || vertex.count(w) || crowded(w, s)) continue;
+      if (degree[w] < 2 || vertex.count(w) || std::count(corners.begin(), corners.end(), w) || crowded(w, s)) continue;
       // The sector of w facing s: the one holding the reached neighbour of w nearest s.
       int x = -1;
       double best = std::numeric_limits<double>::infinity();
@@ -343,7 +371,8 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
         if (!sharp[e] && it != reached.end() && degree[y] == 0 && it->second < best) best = it->second, x = y;
       }
       if (x < 0) continue;
-      const std::vector<Sector> sectors = sectors_at(t, g, w, sharp);
+      const std::vector<Sector> sectors = sectors_at(t, g, w, sharp, boundary);
+      bool moved = false;
       for (const Sector& sector : sectors) {
         bool holds = false;
         for (int f : sector.faces)
@@ -351,20 +380,24 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
         if (!holds) continue;
         const double step = 2 * kPi / N;
         const int steps = static_cast<int>(std::lround(sector.theta / step)) - n;  // one more for −1/N, one fewer for +1/N
-        const int m = static_cast<int>(sector.faces.size());
+        const int gaps = sector_steps(t, sector);
         // The quad mesh gives the sector `steps` corners at w: wider than 1.5 steps each (a +1/N on a straight
         // line or on a T-junction's straight side: one corner of about π), they would be flat or reflex.
         const bool flat = sector.theta > 1.5 * steps * step;
-        if (steps < 1 || !(std::abs(sector.theta - steps * step) / (m + 1) < 0.9 * kPi / N) || (flat && !flat_sectors) ||
+        if (steps < 1 || gaps < 1 || !(std::abs(sector.theta - steps * step) / gaps < 0.9 * kPi / N) || (flat && !flat_sectors) ||
             !sector_is_plain(sector, beside, claimed))
           break;
         turn_through(t, g, w, sector, steps, N, alignment.fixed, claimed);
         vertex.erase(s);
-        vertex[w] = n;
+        if (t.is_boundary_vertex(w)) corners.push_back(w);  // a corner of the boundary, which carries no index
+        else vertex[w] = n;
         alignment.snapped.push_back({s, w, d, sector.faces});
+        moved = true;
         break;
       }
-      break;  // the nearest eligible candidate only, moved or not
+      // The nearest eligible candidate only, moved or not; on the boundary the next ones too: a fan of three
+      // faces cannot turn a quarter in steps the field reads unambiguously (two of π/4), a wider one beside it can.
+      if (moved || !t.is_boundary_vertex(w)) break;
     }
   }
 }
@@ -406,9 +439,8 @@ void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const 
       for (const Sector& sector : sectors) {
         if (!sector_is_plain(sector, beside, claimed)) continue;
         const int steps = static_cast<int>(std::lround(sector.theta / step)) + change;
-        const int m = static_cast<int>(sector.faces.size());
         const double misfit = std::abs(sector.theta - steps * step);
-        if (steps < 1 || !(misfit / (m + 1) < 0.9 * kPi / N)) continue;
+        if (steps < 1 || !(misfit / sector_steps(t, sector) < 0.9 * kPi / N)) continue;
         const bool flat = sector.theta > 1.5 * steps * step;
         if (!best || (flat != best_flat ? !flat : misfit < best_misfit))
           best = &sector, best_steps = steps, best_misfit = misfit, best_flat = flat;

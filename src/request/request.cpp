@@ -199,7 +199,8 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
     if (!out.constraints.features.given_sectors.empty()) take_sectors(out.constraints.features.given_sectors);
   }
   if (request.auto_place) {
-    const bool onto = request.auto_options.onto_features > 0 && !request.split_large_turns && !out.constraints.sharp_edges.empty();
+    const bool boundary = request.align_boundary && request.auto_options.onto_boundary;
+    const bool onto = request.auto_options.onto_features > 0 && !request.split_large_turns && (!out.constraints.sharp_edges.empty() || boundary);
     AutoOptions o = request_auto_options(designer, request, out.constraints);
     // With moves onto the feature lines, they come before the split (AutoOptions::split_above) and again after
     // it: a −1/N beside a line moves onto it (a corner of the line's quads) instead of first gathering with a
@@ -215,7 +216,7 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
         const size_t before = a.snapped.size();
         move_singularities_onto_features(designer.V(), designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N,
                                          request.auto_options.onto_features, request.auto_options.onto_flat_sectors, p.vertex, a,
-                                         request.auto_options.onto_separation);
+                                         request.auto_options.onto_separation, boundary);
         if (a.snapped.size() != before) take_sectors(a.snapped);
       };
       move_onto();
@@ -395,6 +396,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     bool periods;
     double onto = kMapOntoFeatures;  // singularities moved onto feature lines from this many units
     bool flat = false;               // and onto sectors whose quad corners would be flat (AutoOptions::onto_flat_sectors)
+    bool boundary = false;           // and onto the aligned boundary as corners (AutoOptions::onto_boundary)
   };
   const std::vector<int> sharp = request_sharp_edges(designer, request);
   // The edges on iso-lines (the relaxation keeps singularities away from them; the periods are theirs).
@@ -416,6 +418,15 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     if (onto_attempts)
       for (double onto : {kMapOntoFeatures, kMapOntoFeaturesFar}) attempts.push_back({1.0, request.relax, false, onto, true});
   }
+  // When those keep problems after their retries: the singularities beside the aligned boundary moved onto it as
+  // corners, and those relaxed (at a coarse scale a −1/4 beside a round hole has no integer point a unit from the
+  // rim's iso-line and off it). Only then: ranked before the retries, a clean map with corners would take the
+  // place of a placement the retries mend, with quads of better shape (a plate meshed in rings around its holes).
+  std::vector<Attempt> corner_attempts;
+  if (escalate && own_onto && !request.split_large_turns && request.align_boundary) {
+    corner_attempts.push_back({1.0, request.relax, false, kMapOntoFeatures, false, true});
+    if (!request.relax) corner_attempts.push_back({1.0, true, false, kMapOntoFeatures, false, true});
+  }
   MapOutcome best;
   FieldRequest kept = request;
   // The screened maps next in rank after the kept one (better first, at most kMapRetryCandidates − 1), with
@@ -431,15 +442,20 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   std::vector<std::map<int, int>> placed;  // each map's singularities
   // The placements before relaxation, by the attempt's units, distance onto the lines and flat sectors (each
   // relaxed attempt follows the same one unrelaxed), and the ones relaxed, with the periods or without.
-  using PlacementKey = std::tuple<double, double, bool>;
+  using PlacementKey = std::tuple<double, double, bool, bool>;
   std::map<PlacementKey, std::map<int, int>> unrelaxed;
   std::set<std::pair<std::map<int, int>, bool>> relaxed_from;
   // The maps are made without ParamOptions::retries and with a share of the untangling while other attempts may
   // follow (a retry costs up to a few maps, another placement often mends more); the kept map's retries (with the
   // whole untangling) follow if it still has problems.
-  const bool screen = attempts.size() > 1;
-  for (const Attempt& attempt : attempts) {
-    const PlacementKey key{attempt.units, attempt.onto, attempt.flat};
+  const bool screen = attempts.size() + corner_attempts.size() > 1;
+  bool have_best = false;  // in this round of attempts
+  MapOutcome unverified;   // the first attempt's field, when it failed verification (unverified_first)
+  bool unverified_first = false;
+  // One attempt's placement and map, ranked against the best so far; false when the search ends (a map without
+  // problems within the goal, or the first field failed verification: `unverified`).
+  auto attempt_map = [&](const Attempt& attempt) -> bool {
+    const PlacementKey key{attempt.units, attempt.onto, attempt.flat, attempt.boundary};
     const bool own_relax = attempt.relax && !request.relax;
     // Each accepted move ranks every singularity's candidates again: past kMapRelaxMaxSingularities (cheese,
     // genus 133: 1,412 −1/4) a relaxation takes minutes, so those placements are not relaxed here. Nor are
@@ -448,11 +464,13 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     if (own_relax && (first_singularities > kMapRelaxMaxSingularities || (attempt.periods && !periods_usable(designer)) ||
                       (start != unrelaxed.end() && relaxed_from.count({start->second, attempt.periods})))) {
       ++tried;
-      continue;
+      return true;
     }
     FieldRequest r = request;
     if (escalate) r.auto_options.cancel_distance = attempt.units * unit;
-    if (own_onto) r.auto_options.onto_features = attempt.onto * unit, r.auto_options.onto_flat_sectors = attempt.flat;
+    if (own_onto)
+      r.auto_options.onto_features = attempt.onto * unit, r.auto_options.onto_flat_sectors = attempt.flat,
+      r.auto_options.onto_boundary = attempt.boundary;
     r.relax = attempt.relax;
     if (attempt.relax) {
       // The relaxation keeps singularities a unit away from the aligned lines: the energy draws a −1/4 toward a
@@ -477,15 +495,17 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     if (!m.field.verified) {
       if (tried == 1) {
         request = r;
-        return m;  // no map of an unverified field (the caller says why)
+        unverified = std::move(m);  // no map of an unverified field (the caller says why)
+        unverified_first = true;
+        return false;
       }
-      continue;
+      return true;
     }
     if (tried == 1) first_singularities = m.field.prescription.vertex.size();
     if (!attempt.relax) unrelaxed.emplace(key, m.field.prescription.vertex);
     if (own_relax && start != unrelaxed.end()) relaxed_from.insert({start->second, attempt.periods});
     // The same singularities as an earlier attempt (nothing closer than the new distance to cancel): the same map.
-    if (std::find(placed.begin(), placed.end(), m.field.prescription.vertex) != placed.end()) continue;
+    if (std::find(placed.begin(), placed.end(), m.field.prescription.vertex) != placed.end()) return true;
     placed.push_back(m.field.prescription.vertex);
     ++maps;
     ParamOptions options = request_param_options(designer, r, m.field, edge_length, target_faces);
@@ -497,10 +517,12 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     m.periods = attempt.periods;
     m.onto_units = own_onto ? attempt.onto : 0.0;
     m.onto_flat = own_onto && attempt.flat;
-    if (tried == 1 || better(m, best)) {
+    m.onto_boundary = own_onto && attempt.boundary;
+    if (!have_best || better(m, best)) {
       const int first = tried == 1 ? map_problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
-      if (tried > 1 && screen) rank_runner(std::move(best), kept);
+      if (have_best && screen) rank_runner(std::move(best), kept);
+      have_best = true;
       best = std::move(m);
       best.first_problems = first, best.first_distortion = first_distortion;
       kept = r;
@@ -509,8 +531,11 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     }
     // A map without problems within the goal ends the search; past it every attempt is made, the least stretch
     // kept.
-    if (map_problems(best) == 0 && stretch(best) == 0) break;
-  }
+    return !(map_problems(best) == 0 && stretch(best) == 0);
+  };
+  for (const Attempt& attempt : attempts)
+    if (!attempt_map(attempt)) break;
+  if (unverified_first) return unverified;
   // A screened map's retries, resumed from its first maps (at the edge length and at the field's unit size); the
   // designer holds that field's fixed faces.
   auto retry = [&](MapOutcome& m, const FieldRequest& r) {
@@ -521,7 +546,8 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     m.param = std::move(param);
   };
   int retried = 0;
-  if (screen && best.field.verified && map_problems(best) > 0) {
+  auto retry_kept = [&]() {
+    if (!(screen && best.field.verified && map_problems(best) > 0)) return;
     retry(best, kept);
     ++retried;
     // Ranked without their retries, a runner-up may still be the one they mend: theirs follow, in rank, until a
@@ -536,7 +562,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
         std::swap(kept, r);
       }
     }
-  }
+  };
   // Problems left after every placement and the retries: the kept field's map at other edge lengths
   // (map_at_other_scales), then the runners-up's in rank until a map has none (another scale can mend the
   // placement ranked second where it does not mend the first).
@@ -547,7 +573,8 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
                         scaled);
     m.param = std::move(scaled.param), m.quads = std::move(scaled.quads), m.scale = scaled.scale;
   };
-  if (best.field.verified && map_problems(best) > 0) {
+  auto rescale_kept = [&]() {
+    if (!(best.field.verified && map_problems(best) > 0)) return;
     rescale(best, kept);
     for (auto& [m, r] : runners) {
       if (map_problems(best) == 0) break;
@@ -558,6 +585,22 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
         std::swap(kept, r);
       }
     }
+  };
+  retry_kept();
+  rescale_kept();
+  // Problems left after all that: the placements with corners on the boundary, their retries and scales the same
+  // way, kept if better.
+  if (best.field.verified && map_problems(best) > 0 && !corner_attempts.empty()) {
+    MapOutcome before = std::move(best);
+    FieldRequest before_kept = kept;
+    best = MapOutcome(), kept = request, runners.clear(), have_best = false;
+    for (const Attempt& attempt : corner_attempts)
+      if (!attempt_map(attempt)) break;
+    if (have_best) retry_kept(), rescale_kept();
+    if (have_best && better(best, before))
+      best.first_problems = before.first_problems, best.first_distortion = before.first_distortion;
+    else
+      best = std::move(before), kept = std::move(before_kept);
   }
   // The designer holds the last set-up (an attempt's or a retry's: fixed faces turned for singularities moved onto
   // features): it takes the kept field's fixed faces back, so that the designer is the kept field's (its design is
