@@ -70,6 +70,18 @@ Census census(const QuadFile& q) {
   return c;
 }
 
+// A report's map without folds within the distortion goal, and its quads at the singularities, none inverted and
+// every corner convex with a sine above 0.3.
+void expect_clean_and_convex(const nlohmann::json& j) {
+  EXPECT_EQ(j["param"]["flipped_faces"], 0);
+  EXPECT_EQ(j["param"]["degenerate_faces"], 0);
+  EXPECT_LE(j["param"]["mean_distortion"].get<double>(), 1.5);
+  EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
+  EXPECT_EQ(j["quad"]["inverted_quads"], 0);
+  EXPECT_EQ(j["quad"]["nonconvex_quads"], 0);
+  EXPECT_GT(j["quad"]["min_scaled_jacobian"].get<double>(), 0.3);
+}
+
 // A cube: 8 singularities of +1/4 at the corners, the only irregular vertices, of valence 3, each at the
 // position of its corner; the report agrees with the file; the map and the singularities are written.
 TEST(CliQuad, CubeGivesEightValenceThreeCornersAndNothingElseIrregular) {
@@ -246,13 +258,7 @@ TEST(CliQuad, PlateWith27HolesIsCleanAtTheFirstPlacement) {
   EXPECT_EQ(j["placement"]["placements"], 1);
   EXPECT_EQ(j["placement"]["retried_maps"], 0);  // clean without the near-miss retries
   EXPECT_EQ(j["placement"]["relaxed"], false);
-  EXPECT_EQ(j["param"]["flipped_faces"], 0);
-  EXPECT_EQ(j["param"]["degenerate_faces"], 0);
-  EXPECT_LE(j["param"]["mean_distortion"].get<double>(), 1.5);
-  EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
-  EXPECT_EQ(j["quad"]["inverted_quads"], 0);
-  EXPECT_EQ(j["quad"]["nonconvex_quads"], 0);
-  EXPECT_GT(j["quad"]["min_scaled_jacobian"].get<double>(), 0.3);
+  expect_clean_and_convex(j);
   const QuadFile q = read_quads(out);
   const Census c = census(q);
   EXPECT_EQ(c.euler, -26);
@@ -277,13 +283,7 @@ TEST(CliQuad, SingularitiesBesideRoundHolesBecomeCornersOfTheirRims) {
   EXPECT_EQ(j["boundary_loops"], 9);
   EXPECT_TRUE(j["placement"]["onto_boundary"].get<bool>());
   EXPECT_GT(j["placement"]["first_problems"].get<int>(), 0);
-  EXPECT_EQ(j["param"]["flipped_faces"], 0);
-  EXPECT_EQ(j["param"]["degenerate_faces"], 0);
-  EXPECT_LE(j["param"]["mean_distortion"].get<double>(), 1.5);
-  EXPECT_EQ(j["quad"]["singular_mismatches"], 0);
-  EXPECT_EQ(j["quad"]["inverted_quads"], 0);
-  EXPECT_EQ(j["quad"]["nonconvex_quads"], 0);
-  EXPECT_GT(j["quad"]["min_scaled_jacobian"].get<double>(), 0.3);
+  expect_clean_and_convex(j);
   EXPECT_NEAR(j["quad"]["quads"].get<double>(), 80, 24);
   const QuadFile q = read_quads(out);
   const Census c = census(q);

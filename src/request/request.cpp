@@ -418,10 +418,11 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     if (onto_attempts)
       for (double onto : {kMapOntoFeatures, kMapOntoFeaturesFar}) attempts.push_back({1.0, request.relax, false, onto, true});
   }
-  // When those keep problems after their retries: the singularities beside the aligned boundary moved onto it as
-  // corners, and those relaxed (at a coarse scale a −1/4 beside a round hole has no integer point a unit from the
-  // rim's iso-line and off it). Only then: ranked before the retries, a clean map with corners would take the
-  // place of a placement the retries mend, with quads of better shape (a plate meshed in rings around its holes).
+  // When those keep problems after their retries and other scales: the singularities beside the aligned boundary
+  // moved onto it as corners, and those relaxed (at a coarse scale a −1/4 beside a round hole has no integer point
+  // a unit from the rim's iso-line and off it). Only then: ranked with the others, a clean map with corners would
+  // take the place of a placement that the retries or another scale mend with quads of better shape (a plate
+  // meshed in rings around its holes).
   std::vector<Attempt> corner_attempts;
   if (escalate && own_onto && !request.split_large_turns && request.align_boundary) {
     corner_attempts.push_back({1.0, request.relax, false, kMapOntoFeatures, false, true});
