@@ -451,8 +451,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   // whole untangling) follow if it still has problems.
   const bool screen = attempts.size() + corner_attempts.size() > 1;
   bool have_best = false;  // in this round of attempts
-  MapOutcome unverified;   // the first attempt's field, when it failed verification (unverified_first)
-  bool unverified_first = false;
+  std::optional<MapOutcome> unverified;  // the first attempt's field, when it failed verification
   // One attempt's placement and map, ranked against the best so far; false when the search ends (a map without
   // problems within the goal, or the first field failed verification: `unverified`).
   auto attempt_map = [&](const Attempt& attempt) -> bool {
@@ -497,7 +496,6 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
       if (tried == 1) {
         request = r;
         unverified = std::move(m);  // no map of an unverified field (the caller says why)
-        unverified_first = true;
         return false;
       }
       return true;
@@ -536,7 +534,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   };
   for (const Attempt& attempt : attempts)
     if (!attempt_map(attempt)) break;
-  if (unverified_first) return unverified;
+  if (unverified) return std::move(*unverified);
   // A screened map's retries, resumed from its first maps (at the edge length and at the field's unit size); the
   // designer holds that field's fixed faces.
   auto retry = [&](MapOutcome& m, const FieldRequest& r) {
@@ -547,22 +545,25 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     m.param = std::move(param);
   };
   int retried = 0;
-  auto retry_kept = [&]() {
-    if (!(screen && best.field.verified && map_problems(best) > 0)) return;
-    retry(best, kept);
-    ++retried;
-    // Ranked without their retries, a runner-up may still be the one they mend: theirs follow, in rank, until a
-    // map has no problems.
+  // `mend` on the kept map, then on the screened runners-up in rank until a map has no problems: ranked before it,
+  // a runner-up may still be the one it mends; one made better takes the kept map's place, which becomes a runner-up.
+  auto mend_kept = [&](const auto& mend) {
+    mend(best, kept);
     for (auto& [m, r] : runners) {
       if (map_problems(best) == 0) break;
-      retry(m, r);
-      ++retried;
-      if (better(m, best)) {  // the one it replaces takes its place among the runners-up
+      mend(m, r);
+      if (better(m, best)) {
         m.first_problems = best.first_problems, m.first_distortion = best.first_distortion;
         std::swap(best, m);
         std::swap(kept, r);
       }
     }
+  };
+  auto retry_kept = [&]() {
+    if (screen && best.field.verified && map_problems(best) > 0) mend_kept([&](MapOutcome& m, const FieldRequest& r) {
+      retry(m, r);
+      ++retried;
+    });
   };
   // Problems left after every placement and the retries: the kept field's map at other edge lengths
   // (map_at_other_scales), then the runners-up's in rank until a map has none (another scale can mend the
@@ -575,17 +576,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     m.param = std::move(scaled.param), m.quads = std::move(scaled.quads), m.scale = scaled.scale;
   };
   auto rescale_kept = [&]() {
-    if (!(best.field.verified && map_problems(best) > 0)) return;
-    rescale(best, kept);
-    for (auto& [m, r] : runners) {
-      if (map_problems(best) == 0) break;
-      rescale(m, r);
-      if (better(m, best)) {
-        m.first_problems = best.first_problems, m.first_distortion = best.first_distortion;
-        std::swap(best, m);
-        std::swap(kept, r);
-      }
-    }
+    if (best.field.verified && map_problems(best) > 0) mend_kept(rescale);
   };
   retry_kept();
   rescale_kept();
