@@ -101,7 +101,7 @@ void report_features(const SolveOptions& o, const FieldDesigner& designer, const
 // `loaded`: the input and its repair, when the design is on that repair (not on a refined mesh).
 bool solve_one(const SolveOptions& o, const MeshData& mesh, const FieldDesigner& designer, const IndexPrescription& prescription,
                const Design& d, const std::string& name, double read_seconds, const nlohmann::ordered_json& extra,
-               const std::vector<int>& sharp, const LoadedMesh* loaded = nullptr) {
+               const std::vector<int>& sharp, const LoadedMesh* loaded = nullptr, const std::map<int, int>& corners = {}) {
   const RepairedMesh* repair = loaded ? loaded->repaired() : nullptr;
   const Connection& c = d.connection;
 
@@ -112,7 +112,7 @@ bool solve_one(const SolveOptions& o, const MeshData& mesh, const FieldDesigner&
 
   auto t1 = Clock::now();
   StagedOutputs staged;
-  stage_design_outputs(staged, o.out, name, mesh, designer, prescription, d, sharp, repair, repair ? &loaded->input : nullptr);
+  stage_design_outputs(staged, o.out, name, mesh, designer, prescription, d, sharp, repair, repair ? &loaded->input : nullptr, corners);
   const ReportRun run{o.mesh, name, o.field.weights, o.field.solver, o.field.align_boundary, read_seconds, seconds_since(t1), ok};
   if (!o.out.report.empty()) {
     nlohmann::ordered_json report = solve_report(run, mesh, designer, prescription, d);
@@ -267,6 +267,12 @@ void run_solve(const SolveOptions& o) {
       std::cout << "auto: smoothest field found " << r.found.size() << " singularities, " << r.coincident_removed
                 << " removed by summing over coincident vertices, cancelled " << r.pairs.size() << " pairs, using " << r.vertex.size() << "\n";
   }
+  if (const std::map<int, int>& corners = out.constraints.features.corners; !corners.empty()) {
+    extra["corners"] = nlohmann::ordered_json::array();
+    for (auto [v, n] : input_singularities(corners, loaded.repaired())) extra["corners"].push_back({{"vertex", v}, {"index", format_index(n, out.prescription.N)}});
+    if (!o.quiet)
+      std::cout << "boundary: " << corners.size() << " boundary vertices given an index are corners of the aligned boundary (their fans turned)\n";
+  }
   if (out.relax_result) {
     extra["relax"] = relax_summary_json(*out.relax_result);
     if (!o.quiet) std::cout << relax_summary_line(*out.relax_result) << "\n";
@@ -300,7 +306,7 @@ void run_solve(const SolveOptions& o) {
     }
   }
   if (!solve_one(o, out.refined ? refined_mesh : mesh, out.designer(designer), out.prescription, out.design, "", read_seconds, extra,
-                 out.sharp_edges, out.refined ? nullptr : &loaded))
+                 out.sharp_edges, out.refined ? nullptr : &loaded, out.constraints.features.corners))
     exit_code = kVerificationFailed;
 }
 

@@ -87,7 +87,10 @@ void write_map_obj(const std::string& path, const MapRun& run) {
 }
 
 void write_map_singularities(const std::string& path, const MapRun& run) {
-  write_singularities(path, run.out.refined ? run.out.prescription.vertex : input_singularities(run.out.prescription.vertex, run.repaired()), 4);
+  // With the corners of the boundary: -s reads a boundary vertex as one (with the boundary aligned).
+  std::map<int, int> vertex = run.out.prescription.vertex;
+  for (auto [v, n] : run.out.constraints.features.corners) vertex[v] = n;
+  write_singularities(path, run.out.refined ? vertex : input_singularities(vertex, run.repaired()), 4);
 }
 
 nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
@@ -133,6 +136,11 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                            {"first_distortion", run.first_distortion},
                            {"retried_maps", run.retried_maps}};
   report["map_scale"] = run.scale;
+  // Boundary vertices made corners of the aligned boundary (by the placement, or given): no singularity there.
+  report["corners"] = nlohmann::ordered_json::array();
+  const std::map<int, int>& corners = run.out.constraints.features.corners;
+  for (auto [v, n] : run.out.refined ? corners : input_singularities(corners, run.repaired()))
+    report["corners"].push_back({{"vertex", v}, {"index", std::to_string(n) + "/4"}});
   for (size_t i = 0; i < param.cones.size(); ++i)
     report["singularities"].push_back({{"vertex", param.cones[i]}, {"index", std::to_string(param.cone_index[i]) + "/4"}});
   return report;

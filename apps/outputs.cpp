@@ -57,7 +57,8 @@ StagedOutputs::~StagedOutputs() {
 
 void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const std::string& name, const MeshData& mesh,
                           const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d,
-                          const std::vector<int>& sharp, const RepairedMesh* repair, const MeshData* input) {
+                          const std::vector<int>& sharp, const RepairedMesh* repair, const MeshData* input,
+                          const std::map<int, int>& corners) {
   const Geometry& g = designer.geometry();
   if (!paths.field.empty())
     staged.write(output_path(paths.field, name), [&](const std::string& path) {
@@ -86,7 +87,11 @@ void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const
     staged.write(output_path(paths.lines, name), [&](const std::string& path) { write_field_lines(path, mesh.V, mesh.F, g, d.field); });
   if (!paths.singularities.empty())
     staged.write(output_path(paths.singularities, name),
-                 [&](const std::string& path) { write_singularities(path, input_singularities(prescription.vertex, repair), prescription.N); });
+                 [&](const std::string& path) {
+                   std::map<int, int> vertex = prescription.vertex;
+                   vertex.insert(corners.begin(), corners.end());
+                   write_singularities(path, input_singularities(vertex, repair), prescription.N);
+                 });
   if (!paths.sharp.empty())
     staged.write(output_path(paths.sharp, name), [&](const std::string& path) {
       std::vector<char> convex;

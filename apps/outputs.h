@@ -45,9 +45,11 @@ class StagedOutputs {
 // With `repair` (the design is on that repair of `input`), per-face and per-vertex outputs are the input's: a field
 // row per input face (a duplicate's that of the face it duplicates), singularities and .sharp faces by input ids;
 // --mesh-out writes the repaired mesh, and the connection and matching (edges by vertex pairs) are that mesh's.
+// `corners` (FeatureAlignment::corners) are written with the singularities: -s reads a boundary vertex as a corner.
 void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const std::string& name, const MeshData& mesh,
                           const FieldDesigner& designer, const IndexPrescription& prescription, const Design& d,
-                          const std::vector<int>& sharp = {}, const RepairedMesh* repair = nullptr, const MeshData* input = nullptr);
+                          const std::vector<int>& sharp = {}, const RepairedMesh* repair = nullptr, const MeshData* input = nullptr,
+                          const std::map<int, int>& corners = {});
 
 // A prescription's singular vertices by the input's ids (copies made by repair named by the vertex they copy).
 std::map<int, int> input_singularities(const std::map<int, int>& vertex, const RepairedMesh* repair);

@@ -784,7 +784,7 @@ TEST(CliSolve, ErrorsWithExactMessagesAndNoOutputs) {
   expect_solve_error(dir, q(extra) + " --sing 0:1 --sing 86:1", "singular vertex 86 is not used by any face");
   expect_solve_error(dir, q(disk) + " --sing 36:1",
                      "singular vertex 36 is on boundary loop 0: a boundary vertex has no dual cycle (set the loop's index with "
-                     "--boundary instead)");
+                     "--boundary instead, or align the boundary, --align-boundary, to make the vertex a corner of it)");
   expect_solve_error(dir, S + " -N 4 --sing 0:1/3 --sing 85:5/3",
                      "--sing 0:1/3: index 1/3 is not a multiple of 1/4 (use -N to change the symmetry)");
   expect_solve_error(dir, S + " --sing 0:1/2 --sing 85:3/2",

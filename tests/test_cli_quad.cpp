@@ -7,6 +7,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 
 #include "support.h"
 #include "trivcon/generate.h"
@@ -273,10 +274,13 @@ TEST(CliQuad, PlateWith27HolesIsCleanAtTheFirstPlacement) {
 // edges around a hole): the −1/4 the smoothest field puts beside each rim sit a fraction of a unit from it, where
 // the map has no integer point off the rim's iso-line, and the placements without corners keep folds or quads
 // with reflex corners. Moved onto the rims as corners of the boundary (AutoOptions::onto_boundary), the map is
-// clean and the quads convex, one irregular interior vertex left (a −2/4 in the middle, valence 6).
+// clean and the quads convex, one irregular interior vertex left (a −2/4 in the middle, valence 6). --sing-out
+// lists the corners as boundary vertices with their index; given back with -s and the boundary aligned, they make
+// the same field and map; without the boundary aligned they are refused, naming the vertex.
 TEST(CliQuad, SingularitiesBesideRoundHolesBecomeCornersOfTheirRims) {
   const std::string mesh = mesh_file(test::lattice_plate(4, 2, 0.2, 0.05), "lattice.obj"), out = temp_file("q.obj"), report = temp_file("r.json");
-  const auto r = run_cli("quad " + mesh + " --auto --target-faces 80 -o " + out + " --report " + report);
+  const std::string sing = temp_file("s.txt");
+  const auto r = run_cli("quad " + mesh + " --auto --target-faces 80 -o " + out + " --report " + report + " --sing-out " + sing);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("those beside the boundary moved onto it as corners"), std::string::npos) << r.out;
   const nlohmann::json j = nlohmann::json::parse(slurp(report));
@@ -294,6 +298,49 @@ TEST(CliQuad, SingularitiesBesideRoundHolesBecomeCornersOfTheirRims) {
   int concave = 0;
   for (auto [v, edges] : c.boundary_valence) concave += edges == 4;
   EXPECT_GE(concave, 8 * 3);
+
+  // The file: the interior singularities and the corners, each corner a boundary vertex.
+  const MeshData plate = read_mesh(mesh);
+  const Topology t = build_topology(plate.F, static_cast<int>(plate.V.rows()));
+  IndexPrescription written;
+  written.N = 4;
+  read_singularities(sing, written);
+  std::set<std::pair<int, std::string>> cones;
+  for (const auto& k : j["singularities"]) cones.insert({k["vertex"].get<int>(), k["index"].get<std::string>()});
+  int corners = 0;
+  for (auto [v, n] : written.vertex) {
+    if (t.is_boundary_vertex(v)) ++corners;
+    else EXPECT_TRUE(cones.count({v, std::to_string(n) + "/4"})) << v;
+  }
+  EXPECT_GE(corners, 8 * 3);
+  EXPECT_EQ(static_cast<int>(written.vertex.size()) - corners, static_cast<int>(cones.size()));
+  ASSERT_EQ(static_cast<int>(j["corners"].size()), corners);
+  for (const auto& k : j["corners"]) EXPECT_EQ(written.vertex.at(k["vertex"].get<int>()), -1);
+  // `solve` takes the file with the boundary aligned and writes it back the same.
+  const std::string sing2 = temp_file("s2.txt");
+  const auto solved = run_cli("solve " + mesh + " -N 4 -s " + sing + " --align-boundary --sing-out " + sing2);
+  ASSERT_EQ(solved.status, 0) << solved.err;
+  EXPECT_NE(solved.out.find("boundary: " + std::to_string(corners) + " boundary vertices given an index are corners of the aligned boundary"),
+            std::string::npos)
+      << solved.out;
+  EXPECT_EQ(slurp(sing2), slurp(sing));
+  // Given back at the kept map's edge length: the same map.
+  const std::string out2 = temp_file("q2.obj"), report2 = temp_file("r2.json");
+  std::ostringstream length;
+  length.precision(17);
+  length << j["param"]["edge_length"].get<double>();
+  const auto back = run_cli("quad " + mesh + " -s " + sing + " --align-boundary --edge-length " + length.str() + " -o " + out2 + " --report " + report2);
+  ASSERT_EQ(back.status, 0) << back.err;
+  const nlohmann::json k = nlohmann::json::parse(slurp(report2));
+  expect_clean_and_convex(k);
+  EXPECT_EQ(k["quad"]["quads"], j["quad"]["quads"]);
+  EXPECT_EQ(k["singularities"], j["singularities"]);
+  EXPECT_EQ(slurp(out2), slurp(out));
+  // Without the boundary aligned a boundary vertex carries no index.
+  const auto refused = run_cli("quad " + mesh + " -s " + sing + " --edge-length 1 -o " + out2);
+  EXPECT_EQ(refused.status, 1) << refused.err;
+  EXPECT_NE(refused.err.find("is on boundary loop"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("or align the boundary, --align-boundary, to make the vertex a corner of it)"), std::string::npos) << refused.err;
 }
 
 // The placement is made again only with --auto and no --auto-cancel, and says so in the report (bones at 1,000

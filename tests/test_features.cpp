@@ -593,6 +593,36 @@ TEST(FeatureAlignment, SingularitiesBesideTheAlignedBoundaryBecomeCornersOfIt) {
   bare.alignment.fixed = plain;
   bare.singularities = s.singularities;
   EXPECT_THROW(design_aligned(designer, bare), Error);
+
+  // The corners are listed with their index; given as boundary vertices to turn_sectors_for_singularities with
+  // the boundary as a line, they turn the same fans the same way (a singularity file given back), and a corner
+  // there already is not turned again.
+  ASSERT_EQ(s.alignment.corners.size(), 4u);
+  for (const FeatureSnap& snap : s.alignment.snapped) EXPECT_EQ(s.alignment.corners.at(snap.to), -1);
+  FeatureAlignment given;
+  given.fixed = plain;
+  turn_sectors_for_singularities(t, g, {}, 4, s.alignment.corners, given, false);
+  EXPECT_EQ(given.fixed, plain);  // boundary vertices alone without `boundary`
+  EXPECT_TRUE(given.corners.empty());
+  turn_sectors_for_singularities(t, g, {}, 4, s.alignment.corners, given, true);
+  EXPECT_EQ(given.corners, s.alignment.corners);
+  EXPECT_EQ(given.given_sectors.size(), 4u);
+  ASSERT_EQ(given.fixed.size(), s.alignment.fixed.size());
+  for (auto [f, angle] : s.alignment.fixed) EXPECT_NEAR(given.fixed.at(f), angle, 1e-12) << "face " << f;
+  turn_sectors_for_singularities(t, g, {}, 4, s.alignment.corners, given, true);
+  EXPECT_EQ(given.given_sectors.size(), 4u);
+  // A fan of three faces (a lattice vertex on the square's straight side) cannot take a quarter turn.
+  int straight = -1;
+  for (int v = 0; v < t.num_vertices && straight < 0; ++v) {
+    std::vector<int> fan;
+    if (t.is_boundary_vertex(v) && (vertex_fan(t, v, fan), fan.size() == 3u)) straight = v;
+  }
+  ASSERT_GE(straight, 0);
+  FeatureAlignment three;
+  three.fixed = plain;
+  turn_sectors_for_singularities(t, g, {}, 4, {{straight, -1}}, three, true);
+  EXPECT_TRUE(three.corners.empty());
+  EXPECT_EQ(three.fixed, plain);
 }
 
 TEST(FeatureAlignment, SingularitiesMovedOntoALineKeepTheirSeparation) {

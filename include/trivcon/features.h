@@ -107,6 +107,10 @@ struct FeatureAlignment {
   std::vector<NarrowCorner> narrow;        // by vertex
   std::vector<FeatureSnap> snapped;        // by `from`
   std::vector<FeatureSnap> given_sectors;  // turned for singularities given (turn_sectors_for_singularities), by vertex
+  // Boundary vertices made corners of the aligned boundary (vertex → n): the fan turned through with n steps fewer
+  // than the nearest to its angle, as a singularity of index n/N would make it; no singularity there (a boundary
+  // vertex carries no index). By move_singularities_onto_features or turn_sectors_for_singularities.
+  std::map<int, int> corners;
   int corner_faces = 0;                    // faces beside two or more feature edges (compatible or not)
 };
 // The fixed directions for `edges` (interior edge ids) and symmetry N ≥ 1.
@@ -133,7 +137,8 @@ FeatureAlignment feature_alignment(const MatrixX3d& V, const Topology& topology,
 // inside would be rounded onto the rim's iso-line or a unit from it). A fan of three faces cannot take the turn in
 // steps the field reads unambiguously (two of π/4): on the boundary the next nearest vertices are tried too.
 // Updates `vertex` and `alignment.fixed` (new faces among them: the sector's middle ones), lists the moves in
-// `alignment.snapped`; the sectors of moves listed there already (an earlier call's) are not turned again.
+// `alignment.snapped` and the corners made in `alignment.corners`; the sectors of moves listed there already (an
+// earlier call's) are not turned again.
 void move_singularities_onto_features(const MatrixX3d& V, const Topology& topology, const Geometry& geometry, const std::vector<int>& edges,
                                       int N, double distance, bool flat_sectors, std::map<int, int>& vertex, FeatureAlignment& alignment,
                                       double separation = 0, bool boundary = false);
@@ -148,8 +153,13 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& topolo
 // a large turn the map folds around: a placement of `quad --auto` written with --sing-out (a singularity moved
 // onto a line, whose sector that move turned) and given back with -s. Updates `alignment.fixed` (the sectors'
 // faces) and lists the sectors in `alignment.given_sectors` (from = to = the vertex, distance 0).
+// With `boundary` (the boundary aligned), a boundary vertex w given index n/N is a corner of the boundary, as
+// move_singularities_onto_features makes one: the plain sectors of its fan (from boundary edge to boundary edge,
+// cut at sharp edges) are turned through with n steps fewer in all, and w is listed in `alignment.corners` when
+// all n could be taken (not when a sector is turned already: a corner there, or a fan of three faces asked for a
+// quarter turn). Boundary vertices are left alone without it.
 void turn_sectors_for_singularities(const Topology& topology, const Geometry& geometry, const std::vector<int>& edges, int N,
-                                    const std::map<int, int>& vertex, FeatureAlignment& alignment);
+                                    const std::map<int, int>& vertex, FeatureAlignment& alignment, bool boundary = false);
 
 // One line of a .sharp file.
 struct SharpFaceEdge {

@@ -481,6 +481,7 @@ void check_face(const Topology& t, int f, const std::string& what) {
 struct DesignResult {
   DesignerPtr state;
   IndexPrescription prescription;
+  std::map<int, int> corners;  // boundary vertices made corners of the aligned boundary (FeatureAlignment::corners)
   Design design;
   bool verified = false;
   // With solve(..., map_target_faces / map_edge_length): the map map_request kept for this field (with its quad
@@ -547,6 +548,7 @@ py::dict design_state(const DesignResult& r) {
   py::dict s;
   s["N"] = r.prescription.N;
   s["vertex"] = map_items(r.prescription.vertex);
+  s["corners"] = map_items(r.corners);
   s["generator"] = map_items(r.prescription.generator);
   s["loop"] = map_items(r.prescription.loop);
   s["fixed"] = map_items(r.prescription.fixed);
@@ -580,6 +582,7 @@ DesignResultPtr restore_design(const DesignerPtr& state, const py::dict& s) {
   IndexPrescription& p = r->prescription;
   p.N = s["N"].cast<int>();
   p.vertex = items_map<int, int>(s["vertex"]);
+  if (s.contains("corners")) r->corners = items_map<int, int>(s["corners"]);  // absent in states of trivcon before corners
   p.generator = items_map<int, int>(s["generator"]);
   p.loop = items_map<int, int>(s["loop"]);
   p.fixed = items_map<int, double>(s["fixed"]);
@@ -1092,6 +1095,7 @@ PYBIND11_MODULE(_core, m) {
               auto d = std::make_shared<DesignResult>();
               d->state = o.designer;
               d->prescription = std::move(r.prescription);
+              d->corners = r.constraints.features.corners;
               d->design = std::move(r.design);
               d->verified = r.verified;
               d->map = std::move(map), d->map_options = std::move(map_options);
@@ -1191,6 +1195,7 @@ PYBIND11_MODULE(_core, m) {
       .def_static("restore", &restore_design, py::arg("designer"), py::arg("state"), "A DesignResult of get_state()'s dict.")
       .def_property_readonly("N", [](const DesignResult& r) { return r.prescription.N; })
       .def_property_readonly("vertex", [](const DesignResult& r) { return r.prescription.vertex; })
+      .def_property_readonly("corners", [](const DesignResult& r) { return r.corners; })
       .def_property_readonly("fixed", [](const DesignResult& r) { return r.prescription.fixed; })
       .def_property_readonly("directions",
                              [](const DesignResult& r) { return double_matrix3(field_directions(r.state->geometry(), r.design.field)); })
@@ -1271,9 +1276,11 @@ PYBIND11_MODULE(_core, m) {
           "write_singularities",
           [](const DesignResult& r, const std::string& path) {
             py::gil_scoped_release release;
-            // The input's ids (a copy repair appended names the vertex it copies).
-            write_singularities(path, r.state->repair ? values_on_input(*r.state->repair, r.prescription.vertex) : r.prescription.vertex,
-                                r.prescription.N);
+            // The input's ids (a copy repair appended names the vertex it copies), with the corners of the boundary
+            // (a boundary vertex given back is one, with the boundary aligned).
+            std::map<int, int> vertex = r.prescription.vertex;
+            for (auto [v, n] : r.corners) vertex[v] = n;
+            write_singularities(path, r.state->repair ? values_on_input(*r.state->repair, vertex) : vertex, r.prescription.N);
           },
           py::arg("path"))
       .def(

@@ -276,3 +276,75 @@ def test_given_singularities_for_a_map_are_the_programs(cli, tmp_path):
     assert q.ok and q.quality["quads"] == k["quad"]["quads"] and q.quality["vertices"] == k["quad"]["vertices"]
     plain = d.solve(4, given, align_features=30)
     assert plain.energy != pytest.approx(r.energy, rel=1e-6)
+
+
+def lattice_plate(nx, ny, r, h):
+    """A plate of nx x ny unit cells with a round hole of radius r in each, meshed on a triangle lattice of spacing h
+    with the holes cut out and their rims put on the circles (tests/support.cpp, test::lattice_plate)."""
+    rows, n = max(2, round(ny / (h * np.sqrt(3) / 2))), max(1, round(nx / h))
+    P, row = [], []
+    for j in range(rows + 1):
+        xs = [nx * i / n for i in range(n + 1)] if j % 2 == 0 else [0] + [nx * (i + 0.5) / n for i in range(n)] + [nx]
+        row.append(list(range(len(P), len(P) + len(xs))))
+        P += [(x, ny * j / rows) for x in xs]
+    P = np.array(P)
+    faces = []
+    for j in range(rows):
+        a, b, i, k = row[j], row[j + 1], 0, 0
+        while i + 1 < len(a) or k + 1 < len(b):
+            if k + 1 == len(b) or (i + 1 < len(a) and P[a[i + 1], 0] <= P[b[k + 1], 0]):
+                faces.append((a[i], a[i + 1], b[k]))
+                i += 1
+            else:
+                faces.append((a[i], b[k + 1], b[k]))
+                k += 1
+    centres = np.array([(cx + 0.5, cy + 0.5) for cx in range(nx) for cy in range(ny)])
+    dist = np.linalg.norm(P[:, None, :] - centres[None, :, :], axis=2)
+    d, nearest = dist.min(axis=1), dist.argmin(axis=1)
+    kept = [f for f in faces if all(d[v] >= r + 0.3 * h for v in f)]
+    uses, neighbours = Counter(), [set() for _ in P]
+    for f in kept:
+        for k in range(3):
+            a, b = f[k], f[(k + 1) % 3]
+            uses[min(a, b), max(a, b)] += 1
+            neighbours[a].add(b), neighbours[b].add(a)
+    rim = np.zeros(len(P), bool)
+    for (a, b), count in uses.items():
+        if count == 1:
+            rim[a] = rim[b] = True
+    for v in np.nonzero(rim & (d < r + 2 * h))[0]:
+        c = centres[nearest[v]]
+        P[v] = c + r * (P[v] - c) / np.linalg.norm(P[v] - c)
+    for _ in range(15):
+        for v in range(len(P)):
+            if not rim[v] and neighbours[v] and d[v] < r + 3 * h:
+                P[v] = np.mean([P[w] for w in neighbours[v]], axis=0)
+    used = sorted({v for f in kept for v in f})
+    index = {v: i for i, v in enumerate(used)}
+    V = np.column_stack([P[used], np.zeros(len(used))])
+    return V, np.array([[index[v] for v in f] for f in kept], dtype=np.int64)
+
+
+def test_corners_of_the_boundary_are_listed_and_given_back(tmp_path):
+    # A plate with 8 round holes at 80 quads: the map's placement moves the −1/4 beside the rims onto them as
+    # corners of the boundary (tests/test_cli_quad.cpp has the quads). Result.corners lists them, write_singularities
+    # writes them beside the singularities, and given back with the boundary aligned they turn the same fans: the
+    # same field and, at the same edge length, the same quads. A boundary vertex's index without the boundary
+    # aligned is refused.
+    V, F = lattice_plate(4, 2, 0.2, 0.05)
+    d = trivcon.FieldDesigner(V, F)
+    r = d.solve(4, "auto", align_boundary=True, map_target_faces=80)
+    assert len(r.corners) >= 24 and set(r.corners.values()) == {Fraction(-1, 4)}
+    assert not set(r.corners) & set(r.singularities)
+    path = tmp_path / "s.txt"
+    r.write_singularities(str(path))
+    written = {int(v): Fraction(n) for v, n in (line.split() for line in path.read_text().splitlines() if not line.startswith("#"))}
+    assert written == {**r.singularities, **r.corners}
+    again = d.solve(4, written, align_boundary=True, map_target_faces=80)
+    assert again.corners == r.corners and again.singularities == r.singularities
+    assert again.energy == pytest.approx(r.energy, rel=1e-9) and again.field_exact
+    p = r.parametrize(target_faces=80)
+    q, q2 = p.quads(), again.quad(edge_length=p.edge_length)
+    assert q.ok and q2.ok and np.array_equal(q.V, q2.V) and np.array_equal(q.Q, q2.Q)
+    with pytest.raises(trivcon.Error, match="is on boundary loop .*or align the boundary, --align-boundary, to make the vertex a corner of it"):
+        d.solve(4, written)

@@ -1222,6 +1222,14 @@ class Result(_Cached):
         return dict(self._get("singularities", lambda: _fractions(self._r.vertex, self.N)))
 
     @property
+    def corners(self):
+        """{boundary vertex: Fraction}: corners of the aligned boundary, made where a map's placement moved a
+        singularity beside the boundary onto it, or given as a boundary vertex's index with align_boundary=True:
+        the vertex's fan turned as that index would turn it, no singularity there (docs/param.md). Empty
+        without."""
+        return dict(self._get("corners", lambda: _fractions(self._r.corners, self.N)))
+
+    @property
     def singularity_arrays(self):
         """(vertices, numerators): the prescribed vertex indices as two int64 arrays sorted by vertex,
         index = numerator / N (read-only); solve(singularities=...) takes them back."""

@@ -328,7 +328,9 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
         ++degree[t.edge_vertices(e, 0)], ++degree[t.edge_vertices(e, 1)];
         beside[t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1)].push_back(e);
       }
-  std::vector<int> corners;  // boundary vertices given a corner by a move: no singularity there, but taken
+  // Boundary vertices given a corner by this call's moves: no singularity there, but taken (an earlier call's are
+  // in claimed sectors).
+  std::set<int> corners;
   std::vector<char> claimed(t.num_faces, 0);
   for (const NarrowCorner& k : alignment.narrow)
     for (int f : k.faces) claimed[f] = 1;
@@ -340,7 +342,7 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
     bool found = false;
     if (separation > 0)
       field::edge_dijkstra(V, t, w, separation, false, dist, [&](int v, double) {
-        found = found || (v != s && (vertex.count(v) || std::count(corners.begin(), corners.end(), v)));
+        found = found || (v != s && (vertex.count(v) || corners.count(v)));
         return !found;
       });
     return found;
@@ -360,7 +362,7 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
     std::sort(candidates.begin(), candidates.end());
     for (auto [d, w] : candidates) {
       // A line vertex (two sharp edges) or a junction (more): either way its sector facing s lies between two.
-      if (degree[w] < 2 || vertex.count(w) || std::count(corners.begin(), corners.end(), w) || crowded(w, s)) continue;
+      if (degree[w] < 2 || vertex.count(w) || corners.count(w) || crowded(w, s)) continue;
       // The sector of w facing s: the one holding the reached neighbour of w nearest s.
       int x = -1;
       double best = std::numeric_limits<double>::infinity();
@@ -389,7 +391,7 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
           break;
         turn_through(t, g, w, sector, steps, N, alignment.fixed, claimed);
         vertex.erase(s);
-        if (t.is_boundary_vertex(w)) corners.push_back(w);  // a corner of the boundary, which carries no index
+        if (t.is_boundary_vertex(w)) corners.insert(w), alignment.corners[w] = n;  // a corner of the boundary: no index
         else vertex[w] = n;
         alignment.snapped.push_back({s, w, d, sector.faces});
         moved = true;
@@ -403,10 +405,15 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
 }
 
 void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const std::vector<int>& edges, int N, const std::map<int, int>& vertex,
-                                    FeatureAlignment& alignment) {
-  if (N < 4 || N % 2 != 0 || edges.empty()) return;
+                                    FeatureAlignment& alignment, bool boundary) {
+  if (N < 4 || N % 2 != 0 || (edges.empty() && !boundary)) return;
   const std::vector<char> sharp = sharp_flags(t, edges);
   const std::map<int, std::vector<int>> beside = sharp_faces(t, edges);
+  // At a boundary vertex the boundary edges are lines too: a sector with a face beside another one is not plain.
+  std::map<int, std::vector<int>> beside_boundary = beside;
+  if (boundary)
+    for (int e = 0; e < t.num_edges; ++e)
+      if (t.is_boundary_edge(e)) beside_boundary[t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1)].push_back(e);
   std::vector<char> claimed(t.num_faces, 0);
   std::set<int> narrow_faces;
   for (const NarrowCorner& k : alignment.narrow)
@@ -417,7 +424,9 @@ void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const 
   const double step = 2 * kPi / N;
   for (auto [w, n] : vertex) {
     if (w < 0 || w >= t.num_vertices) continue;
-    std::vector<Sector> sectors = sectors_at(t, g, w, sharp);
+    const bool corner = t.is_boundary_vertex(w);
+    if (corner && (!boundary || alignment.corners.count(w))) continue;
+    std::vector<Sector> sectors = sectors_at(t, g, w, sharp, corner);
     if (sectors.empty()) continue;
     // The sectors' whole steps as the alignment turns them now (a narrow corner's one, a sector turned by a
     // move onto the line one off its nearest: such a vertex holds its singularity already).
@@ -429,7 +438,8 @@ void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const 
       sum += narrow ? 1 : static_cast<int>(std::lround(sector.theta / step));
     }
     if (turned) continue;
-    int difference = n - (N - sum);  // +: fewer steps wanted, −: more
+    // +: fewer steps wanted, −: more. An interior vertex reads N − Σk; a boundary vertex no index, so all n.
+    int difference = corner ? n : n - (N - sum);
     while (difference != 0) {
       const int change = difference > 0 ? -1 : 1;
       const Sector* best = nullptr;
@@ -437,7 +447,7 @@ void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const 
       double best_misfit = 0;
       bool best_flat = true;
       for (const Sector& sector : sectors) {
-        if (!sector_is_plain(sector, beside, claimed)) continue;
+        if (!sector_is_plain(sector, corner ? beside_boundary : beside, claimed)) continue;
         const int steps = static_cast<int>(std::lround(sector.theta / step)) + change;
         const double misfit = std::abs(sector.theta - steps * step);
         if (steps < 1 || !(misfit / sector_steps(t, sector) < 0.9 * kPi / N)) continue;
@@ -450,6 +460,7 @@ void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const 
       alignment.given_sectors.push_back({w, w, 0.0, best->faces});
       difference += change;
     }
+    if (corner && difference == 0) alignment.corners[w] = n;
   }
 }
 

@@ -198,6 +198,37 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
     turn_sectors_for_singularities(designer.topology(), designer.geometry(), out.constraints.sharp_edges, p.N, p.vertex, out.constraints.features);
     if (!out.constraints.features.given_sectors.empty()) take_sectors(out.constraints.features.given_sectors);
   }
+  // Boundary vertices given an index are corners of the aligned boundary (turn_sectors_for_singularities with
+  // `boundary`): where `quad --auto` moved singularities onto the boundary, its --sing-out lists them so, and given
+  // back with -s they make the same fans. The corners leave the prescription (a boundary vertex carries no index).
+  if (!request.auto_place) {
+    const Topology& t = designer.topology();
+    std::map<int, int> on_boundary;
+    for (auto [v, n] : p.vertex)
+      if (v >= 0 && v < t.num_vertices && t.is_boundary_vertex(v)) on_boundary[v] = n;
+    if (!on_boundary.empty()) {
+      const int v = on_boundary.begin()->first;
+      const std::string where = "singular vertex " + std::to_string(v) + " is on boundary loop " + std::to_string(t.vertex_boundary_loop[v]);
+      if (!request.align_boundary)
+        throw Error(where + ": a boundary vertex has no dual cycle (set the loop's index with --boundary instead, or align the boundary, " +
+                    "--align-boundary, to make the vertex a corner of it)");
+      if (request.split_large_turns) throw Error(where + ": corners of the boundary are not made with splitting large turns");
+      FeatureAlignment& a = out.constraints.features;
+      turn_sectors_for_singularities(t, designer.geometry(), out.constraints.sharp_edges, p.N, on_boundary, a, true);
+      for (auto [w, n] : on_boundary) {
+        if (!a.corners.count(w)) {
+          std::vector<int> fan;
+          vertex_fan(t, w, fan);
+          throw Error("singular vertex " + std::to_string(w) + " on boundary loop " + std::to_string(t.vertex_boundary_loop[w]) +
+                      " cannot be a corner of index " + std::to_string(n) + "/" + std::to_string(p.N) + ": its fan of " +
+                      std::to_string(fan.size()) + " faces cannot turn by that much in steps the field reads unambiguously" +
+                      " (or it has a corner already, or faces beside other aligned edges)");
+        }
+        p.vertex.erase(w);
+      }
+      take_sectors(a.given_sectors);
+    }
+  }
   if (request.auto_place) {
     const bool boundary = request.align_boundary && request.auto_options.onto_boundary;
     const bool onto = request.auto_options.onto_features > 0 && !request.split_large_turns && (!out.constraints.sharp_edges.empty() || boundary);
