@@ -25,6 +25,9 @@ void MapCommand::add_to(CLI::App* cmd, const std::string& what_unit) {
                   "The unit's size per face: map (follows the real-valued map's own scale; the default), connection (the conformal factor of the field's connection first), uniform (docs/param.md, \"Sizing\")")
       ->check(CLI::IsMember({"map", "connection", "uniform"}))
       ->excludes(uniform);
+  cmd->add_option("--search-maps", search_maps,
+                  "When the first map has problems, the search for a better one (other placements, near-miss retries, other scales; each map costs about as much as the first) starts no step once this many maps are made, and keeps the best of them (default 0: no bound). Each step is printed as it ends")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("-q,--quiet", quiet, "Print nothing on success");
   add_mesh_options(cmd, mesh_options);
 }
@@ -54,7 +57,10 @@ MapRun run_map(const MapCommand& o, bool quads) {
     if (!o.quiet) std::cout << "boundary: aligned (quads end on it; --auto aligns every boundary loop for quad)\n";
   }
   const auto t1 = Clock::now();
-  MapOutcome made = map_request(*run.designer, mesh.F, run.request, o.edge_length, o.target_faces, quads);
+  MapSearch search;
+  search.max_maps = o.search_maps;
+  if (!o.quiet) search.progress = [](const std::string& line) { std::cout << line << std::endl; };
+  MapOutcome made = map_request(*run.designer, mesh.F, run.request, o.edge_length, o.target_faces, quads, search);
   run.map_seconds = seconds_since(t1);
   run.out = std::move(made.field);
   if (!run.out.verified)
@@ -68,6 +74,7 @@ MapRun run_map(const MapCommand& o, bool quads) {
   run.onto_flat = made.onto_flat;
   run.onto_boundary = made.onto_boundary;
   run.scale = made.scale;
+  run.maps = made.maps, run.search_stopped = made.stopped;
   run.quads = std::move(made.quads);
   run.refined_edges = made.refined_edges;
   return run;
@@ -136,6 +143,7 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
                            {"first_distortion", run.first_distortion},
                            {"retried_maps", run.retried_maps}};
   report["map_scale"] = run.scale;
+  report["search"] = {{"maps", run.maps}, {"max_maps", o.search_maps}, {"stopped", run.search_stopped}};
   // Boundary vertices made corners of the aligned boundary (by the placement, or given): no singularity there.
   report["corners"] = nlohmann::ordered_json::array();
   const std::map<int, int>& corners = run.out.constraints.features.corners;
@@ -153,13 +161,8 @@ std::string placement_line(const MapRun& run) {
   line << "placement: the singularities found gave " << run.first_problems
        << (run.quads ? " problems (map folds, wrong windings, failed quad checks)" : " problems (map folds, wrong windings)")
        << " and a mean distortion of " << std::setprecision(3) << run.first_distortion << " (goal " << kMapDistortionGoal << "); placed again "
-       << run.placements - 1 << " time(s), relaxed, moved onto feature lines from further or with opposite pairs cancelled further apart; kept: ";
-  if (run.cancel_units > 1) line << (run.relaxed ? "relaxed, " : "") << "pairs cancelled within " << static_cast<int>(run.cancel_units) << " units";
-  else if (run.onto_boundary) line << "the singularities found, those beside the boundary moved onto it as corners" << (run.relaxed ? ", relaxed" : "");
-  else if (run.onto_flat) line << "the singularities found, moved onto the feature lines from " << run.onto_units << " units where a quad gets a flat corner";
-  else if (run.onto_units > kMapOntoFeatures) line << "the singularities found, moved onto the feature lines from " << run.onto_units << " units";
-  else line << (run.relaxed ? (run.relaxed_periods ? "the singularities found, relaxed with the periods" : "the singularities found, relaxed") : "the first");
-  line << "\n";
+       << run.placements - 1 << " time(s), relaxed, moved onto feature lines from further or with opposite pairs cancelled further apart; kept: "
+       << describe_placement(run.cancel_units, run.relaxed, run.relaxed_periods, run.onto_units, run.onto_flat, run.onto_boundary) << "\n";
   return line.str();
 }
 

@@ -22,6 +22,7 @@ struct MapCommand {
   bool quiet = false;
   bool uniform_size = false;  // --uniform-size (as --sizing uniform)
   std::string sizing = "map";  // --sizing
+  int search_maps = 0;         // --search-maps (MapSearch::max_maps)
   MeshOptions mesh_options;  // --no-repair, --weld
   CLI::Option* target = nullptr;
   CLI::Option* length = nullptr;
@@ -52,6 +53,8 @@ struct MapRun {
   bool onto_flat = false;        // MapOutcome::onto_flat
   bool onto_boundary = false;    // MapOutcome::onto_boundary
   double scale = 1;              // MapOutcome::scale
+  int maps = 1;                  // MapOutcome::maps
+  bool search_stopped = false;   // MapOutcome::stopped
   bool boundary_aligned_unasked = false;  // quad --auto aligned the boundary without --align-boundary
   std::optional<QuadMesh> quads;  // run_map(…, true): the kept map's quad mesh
   int refined_edges = 0;          // MapOutcome::refined_edges: the map is on out's refined mesh

@@ -268,6 +268,10 @@ TEST(CliQuad, PlateWith27HolesIsCleanAtTheFirstPlacement) {
   for (auto [v, n] : c.interior_valence) irregular += n != 4;
   EXPECT_EQ(irregular, 108);  // 4 × −1/4 per hole, valence 5
   EXPECT_EQ(r.out.find("placement:"), std::string::npos) << r.out;
+  // A search that ends at its first map says nothing of it.
+  EXPECT_EQ(r.out.find("search:"), std::string::npos) << r.out;
+  EXPECT_EQ(j["search"]["maps"], 1);
+  EXPECT_EQ(j["search"]["stopped"], false);
 }
 
 // A plate with 8 round holes (radius 0.2 in unit cells) meshed on a triangle lattice, at 80 quads (about 4 quad
@@ -285,6 +289,17 @@ TEST(CliQuad, SingularitiesBesideRoundHolesBecomeCornersOfTheirRims) {
   EXPECT_NE(r.out.find("those beside the boundary moved onto it as corners"), std::string::npos) << r.out;
   const nlohmann::json j = nlohmann::json::parse(slurp(report));
   EXPECT_EQ(j["boundary_loops"], 9);
+  // The search's steps, printed as they end: the first placement's map with its problems, then the others.
+  const int maps = j["search"]["maps"].get<int>();
+  EXPECT_GT(maps, j["placement"]["placements"].get<int>());  // with retries and other scales
+  EXPECT_EQ(j["search"]["stopped"], false);
+  EXPECT_NE(r.out.find("\nsearch: map"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" (placement the first): " + std::to_string(j["placement"]["first_problems"].get<int>()) + " problems"), std::string::npos)
+      << r.out;
+  // The last step: the placement with corners, clean, which ends the search.
+  EXPECT_NE(r.out.find(std::to_string(maps) + " (placement the singularities found, those beside the boundary moved onto it as corners): 0 problems"),
+            std::string::npos)
+      << r.out;
   EXPECT_TRUE(j["placement"]["onto_boundary"].get<bool>());
   EXPECT_GT(j["placement"]["first_problems"].get<int>(), 0);
   expect_clean_and_convex(j);
@@ -336,6 +351,24 @@ TEST(CliQuad, SingularitiesBesideRoundHolesBecomeCornersOfTheirRims) {
   EXPECT_EQ(k["quad"]["quads"], j["quad"]["quads"]);
   EXPECT_EQ(k["singularities"], j["singularities"]);
   EXPECT_EQ(slurp(out2), slurp(out));
+  // With --search-maps 1 the search stops after the first placement's maps (with the other sizings' where its own
+  // has problems), problems and all, and says so.
+  const auto bounded = run_cli("quad " + mesh + " --auto --target-faces 80 --search-maps 1 -o " + out2 + " --report " + report2);
+  EXPECT_EQ(bounded.status, 3) << bounded.err;
+  const nlohmann::json b = nlohmann::json::parse(slurp(report2));
+  const int first = b["param"]["attempts"].get<int>();
+  EXPECT_EQ(b["search"]["maps"], first);
+  EXPECT_EQ(b["search"]["max_maps"], 1);
+  EXPECT_EQ(b["search"]["stopped"], true);
+  EXPECT_EQ(b["placement"]["placements"], 1);
+  EXPECT_EQ(b["param"]["flipped_faces"].get<int>() + b["param"]["degenerate_faces"].get<int>() + b["param"]["winding_errors"].get<int>() +
+                static_cast<int>(b["quad"]["problems"].size()) > 0,
+            true);
+  EXPECT_NE(bounded.out.find(" (placement the first): "), std::string::npos) << bounded.out;
+  EXPECT_NE(bounded.out.find("search: stopped after " + std::to_string(first) + (first == 1 ? " map" : " maps") +
+                             " (the bound given); the best of them kept\n"),
+            std::string::npos)
+      << bounded.out;
   // Without the boundary aligned a boundary vertex carries no index.
   const auto refused = run_cli("quad " + mesh + " -s " + sing + " --edge-length 1 -o " + out2);
   EXPECT_EQ(refused.status, 1) << refused.err;

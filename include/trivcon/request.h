@@ -14,9 +14,11 @@
 // smoothest field the singularities came from (turn_toward, trivcon/auto.h); otherwise the field starts at
 // angle 0 at the component's first face (FieldDesigner::design).
 #pragma once
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -163,7 +165,27 @@ struct MapOutcome {
   std::optional<QuadMesh> quads;  // with quads = true: the kept map's quad mesh (extract_quads)
   // Edges split at their midpoints (map_request): then field.refined, V, F and parent_face hold the refined mesh.
   int refined_edges = 0;
+  int maps = 0;            // maps the search made in all (placements, near-miss retries, other scales; MapSearch)
+  bool stopped = false;    // the search stopped at MapSearch::max_maps with steps left that could have mended the map
 };
+
+// How map_request's search is bounded and what it says while it runs. A search that keeps problems can make many
+// maps (each placement's, the near-miss retries', the other scales', the corners', again on a refined mesh), each
+// costing about as much as the first; a user who would rather have the best of fewer sooner bounds them.
+struct MapSearch {
+  // No step starts once this many maps are made (0: no bound). Counted: every map parametrize makes
+  // (ParamQuality::attempts: a placement's or another scale's with the other sizings' where its own keeps
+  // problems, the near-miss retries' up to 2 + 2 · ParamOptions::retries). A step under way
+  // finishes, so the search can end a few maps past the bound; what it keeps is what the search without a bound
+  // had kept at that point. The first step (the first placement's map) is always made.
+  int max_maps = 0;
+  // Called with one line after each step past a first map that has problems (the maps made so far, what the step
+  // tried, its problems and mean singular-value ratio, the best so far), and when the bound stops the search.
+  std::function<void(const std::string&)> progress;
+};
+// Words for a placement of the search (the line of `quad`, the search's progress): "the first", "pairs cancelled
+// within 2 units", "the singularities found, relaxed", ...
+std::string describe_placement(double cancel_units, bool relaxed, bool periods, double onto_units, bool onto_flat, bool onto_boundary);
 // The distance, in units of the map, within which cancel_for_map moves ±1/4 singularities onto a feature line, and
 // the farther one of map_request's attempt after the relaxed ones (a singularity in a strip or wedge between
 // two feature lines, where the map has one unit across it, has no integer point off both lines).
@@ -241,7 +263,8 @@ inline constexpr size_t kMapRelaxMaxSingularities = 600;
 // edges by their ends); its map is kept when it has fewer problems, with field.refined, V, F, parent_face and
 // refined_edges set. Not with generator or loop indices, nor after split_large_turns.
 // Throws what solve_request and parametrize throw.
+// `search` bounds the maps made and reports each step (MapSearch); MapOutcome::maps and stopped say how it went.
 MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
-                       bool quads = false);
+                       bool quads = false, const MapSearch& search = {});
 
 }  // namespace trivcon

@@ -489,6 +489,8 @@ struct DesignResult {
   // not made again). Not pickled.
   std::shared_ptr<const ScaledMap> map;
   ParamOptions map_options;
+  int search_maps = 0;          // MapOutcome::maps, stopped (not pickled)
+  bool search_stopped = false;
 
   // Interior edges sorted by (i, j) with their x: the rows of `trivcon solve --connection-out`.
   py::tuple connection() const {
@@ -1013,7 +1015,7 @@ PYBIND11_MODULE(_core, m) {
              std::vector<std::pair<int, int>> feature_edges, std::vector<std::pair<int, double>> roots, double auto_cancel, bool auto_cancel_absolute, int auto_iterations,
              std::optional<double> curvature_t, bool split, int max_rounds, bool relax, std::vector<int> relax_pins, int relax_cancel,
              int relax_max_moves, int relax_reach, double relax_periods, double map_edge_length, double map_target_faces,
-             std::optional<double> feature_min_length) {
+             std::optional<double> feature_min_length, int map_search_maps) {
             // The library's request layer (trivcon/request.h) does the work; here only the conversion.
             FieldRequest q;
             q.prescription.N = N;
@@ -1056,7 +1058,7 @@ PYBIND11_MODULE(_core, m) {
               std::vector<int> sharp;
               std::optional<RelaxResult> relaxed;
             };
-            Out out = interruptible(s->threads, [s, q = std::move(q), map_edge_length, map_target_faces] {
+            Out out = interruptible(s->threads, [s, q = std::move(q), map_edge_length, map_target_faces, map_search_maps] {
               Out o;
               std::lock_guard<std::mutex> lock(s->mutex);
               check_cancelled();  // abandoned while it waited for the designer
@@ -1066,8 +1068,13 @@ PYBIND11_MODULE(_core, m) {
               std::shared_ptr<const ScaledMap> map;
               ParamOptions map_options;
               FieldOutcome r;
+              int search_maps = 0;
+              bool search_stopped = false;
               if (map_edge_length > 0 || map_target_faces > 0) {
-                MapOutcome m = map_request(*s->designer, s->F, request, map_edge_length, map_target_faces, true);
+                MapSearch search;
+                search.max_maps = map_search_maps;
+                MapOutcome m = map_request(*s->designer, s->F, request, map_edge_length, map_target_faces, true, search);
+                search_maps = m.maps, search_stopped = m.stopped;
                 r = std::move(m.field);
                 if (r.verified) {
                   map_options = request_param_options(*s->designer, request, r, map_edge_length, map_target_faces);
@@ -1099,6 +1106,7 @@ PYBIND11_MODULE(_core, m) {
               d->design = std::move(r.design);
               d->verified = r.verified;
               d->map = std::move(map), d->map_options = std::move(map_options);
+              d->search_maps = search_maps, d->search_stopped = search_stopped;
               o.result = d;
               o.parent = std::move(r.parent_face);
               o.rounds = std::move(r.rounds);
@@ -1143,7 +1151,7 @@ PYBIND11_MODULE(_core, m) {
           py::arg("auto_iterations"), py::arg("curvature_t"), py::arg("split"), py::arg("max_rounds"), py::arg("relax") = false,
           py::arg("relax_pins") = std::vector<int>{}, py::arg("relax_cancel") = 0, py::arg("relax_max_moves") = 10000,
           py::arg("relax_reach") = 1, py::arg("relax_periods") = 0.0, py::arg("map_edge_length") = 0.0, py::arg("map_target_faces") = 0.0,
-          py::arg("feature_min_length") = std::nullopt,
+          py::arg("feature_min_length") = std::nullopt, py::arg("map_search_maps") = 0,
           "One field request (trivcon/request.h; vertex None: the smoothest field's singularities, chosen for a map at the given "
           "scale as the map commands do when one is > 0, cancel_for_map): (designer of the final mesh, "
           "DesignResult, AutoResult or None, parent face of each face (with split), rounds, converged, sharp edges, relaxation "
@@ -1196,6 +1204,11 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("N", [](const DesignResult& r) { return r.prescription.N; })
       .def_property_readonly("vertex", [](const DesignResult& r) { return r.prescription.vertex; })
       .def_property_readonly("corners", [](const DesignResult& r) { return r.corners; })
+      .def_property_readonly("search", [](const DesignResult& r) {
+        py::dict d;
+        d["maps"] = r.search_maps, d["stopped"] = r.search_stopped;
+        return d;
+      })
       .def_property_readonly("fixed", [](const DesignResult& r) { return r.prescription.fixed; })
       .def_property_readonly("directions",
                              [](const DesignResult& r) { return double_matrix3(field_directions(r.state->geometry(), r.design.field)); })

@@ -346,5 +346,12 @@ def test_corners_of_the_boundary_are_listed_and_given_back(tmp_path):
     p = r.parametrize(target_faces=80)
     q, q2 = p.quads(), again.quad(edge_length=p.edge_length)
     assert q.ok and q2.ok and np.array_equal(q.V, q2.V) and np.array_equal(q.Q, q2.Q)
+    # The search: past the first placement's map (it has problems here) more were made; map_search_maps=1 stops
+    # after the first placement's maps (with the other sizings').
+    assert r.search["maps"] > 1 and not r.search["stopped"]
+    bounded = d.solve(4, "auto", align_boundary=True, map_target_faces=80, map_search_maps=1)
+    assert bounded.search["stopped"] and 1 <= bounded.search["maps"] < r.search["maps"] and not bounded.corners
+    with pytest.raises(trivcon.Error, match=r"^map_search_maps must be a whole number >= 0, not -1$"):
+        d.solve(4, "auto", align_boundary=True, map_target_faces=80, map_search_maps=-1)
     with pytest.raises(trivcon.Error, match="is on boundary loop .*or align the boundary, --align-boundary, to make the vertex a corner of it"):
         d.solve(4, written)

@@ -826,7 +826,8 @@ class FieldDesigner(_Cached):
     def solve(self, N=1, singularities=None, generators=None, boundary=None, fixed=None, align_boundary=False,
               align_features=None, feature_edges=None, roots=None, auto_cancel=0.0, align_curvature=None,
               split_large_turns=False, max_rounds=8, relax=False, relax_pins=None, relax_cancel=0, relax_max_moves=10000,
-              relax_reach=1, relax_periods=0.0, map_target_faces=None, map_edge_length=None, feature_min_length=None):
+              relax_reach=1, relax_periods=0.0, map_target_faces=None, map_edge_length=None, feature_min_length=None,
+              map_search_maps=0):
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
@@ -893,6 +894,9 @@ class FieldDesigner(_Cached):
           sectors do not make its index gets a sector turned through for it (docs/howto/features.md), so that
           `quad --auto --sing-out`'s singularities make the same field, and parametrize/quad at that scale give
           back the map kept (the other scales when the first keeps problems).
+        map_search_maps: with map_target_faces / map_edge_length, the search for a better map starts no step once
+          this many maps are made (a step under way finishes) and keeps the best of them, as `quad --search-maps`
+          (0: no bound). Result.search says how many it made and whether the bound stopped it.
 
         The request means the same as the CLI's and the editor's (the library's trivcon/request.h does it).
         Errors in the prescription raise trivcon.Error with the library's message. The result is
@@ -969,11 +973,13 @@ class FieldDesigner(_Cached):
             map_scale[k] = float(value)
         if map_scale[0] and map_scale[1]:
             raise Error("give at most one of map_target_faces and map_edge_length")
+        if isinstance(map_search_maps, bool) or not isinstance(map_search_maps, _numbers.Integral) or map_search_maps < 0:
+            raise Error(f"map_search_maps must be a whole number >= 0, not {map_search_maps!r}")
         core, r, a, parent, rounds, converged, sharp, relaxed = self._d.solve_request(
             N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), explicit, bool(align_boundary),
             degrees, edge_pairs, root_list, cancel, False, 8, curvature_t, bool(split_large_turns), int(max_rounds),
             bool(relax), pins, int(relax_cancel), int(relax_max_moves), int(relax_reach), float(relax_periods), map_scale[0],
-            map_scale[1], feature_min_length)
+            map_scale[1], feature_min_length, int(map_search_maps))
         auto = AutoResult(a, self) if a is not None else None
         designer = self if core is self._d else FieldDesigner._of_core(core, self)
         result = Result(designer, r, auto)
@@ -1220,6 +1226,12 @@ class Result(_Cached):
     def singularities(self):
         """{vertex: Fraction}: the vertex indices prescribed (the ones found, with singularities="auto")."""
         return dict(self._get("singularities", lambda: _fractions(self._r.vertex, self.N)))
+
+    @property
+    def search(self):
+        """{"maps": n, "stopped": bool}: with map_target_faces / map_edge_length, the maps the search made and whether
+        map_search_maps stopped it (as `quad --report`'s "search"); 0 and False without."""
+        return dict(self._r.search)
 
     @property
     def corners(self):

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iomanip>
 #include <limits>
 #include <map>
 #include <queue>
 #include <set>
+#include <sstream>
 #include <string>
 #include <tuple>
 
@@ -405,9 +407,81 @@ bool better_map(const Parametrization& a, const std::optional<QuadMesh>& a_quads
   return pa != pb ? pa < pb : map_stretch(a) < map_stretch(b);
 }
 
+// The maps a search has made against MapSearch::max_maps, and its progress lines. The first step's line waits:
+// it is said with the second (a search that ends at its first map says nothing).
+class SearchLog {
+ public:
+  explicit SearchLog(const MapSearch& search) : search_(search) {}
+  bool room() const { return search_.max_maps <= 0 || made_ < search_.max_maps; }
+  int maps() const { return made_; }
+  bool stopped() const { return stopped_; }
+  // A step that made `count` maps (what it tried, the problems and mean ratio of its map), and the best so far.
+  void made(int count, const std::string& what, const Parametrization& param, const std::optional<QuadMesh>& quads, const Parametrization& best,
+            const std::optional<QuadMesh>& best_quads) {
+    made_ += count;
+    if (!search_.progress) return;
+    std::ostringstream line;
+    line << std::setprecision(3) << "search: ";
+    if (count == 1) line << "map " << made_;
+    else line << "maps " << made_ - count + 1 << "-" << made_;
+    line << " (" << what << "): " << map_problems(param, quads) << " problems, mean ratio " << param.quality.mean_distortion << "; best so far "
+         << map_problems(best, best_quads) << ", " << best.quality.mean_distortion;
+    say(line.str());
+  }
+  // A line of its own (the search moving to a refined mesh).
+  void note(const std::string& line) {
+    if (search_.progress) say("search: " + line);
+  }
+  // The bound stops the search before a step.
+  void stop() {
+    if (stopped_) return;
+    stopped_ = true;
+    if (search_.progress)
+      say("search: stopped after " + std::to_string(made_) + (made_ == 1 ? " map" : " maps") + " (the bound given); the best of them kept");
+  }
+
+ private:
+  void say(const std::string& line) {
+    if (steps_++ == 0) {
+      first_ = line;
+      return;
+    }
+    if (steps_ == 2) search_.progress(first_);
+    search_.progress(line);
+  }
+  const MapSearch& search_;
+  int made_ = 0, steps_ = 0;
+  bool stopped_ = false;
+  std::string first_;
+};
+
+// map_at_other_scales within a search's bound.
+void scales_within(const FieldDesigner& designer, const Design& design, const ParamOptions& options, ScaledMap& map, SearchLog& log) {
+  if (map_problems(map.param, map.quads) == 0 || folds_necessary(map.param)) return;
+  for (double scale : kMapScales) {
+    if (!log.room()) {
+      log.stop();
+      return;
+    }
+    ParamOptions o = options;
+    o.edge_length *= scale, o.target_faces /= scale * scale;
+    o.retries = 0;
+    if (scale != std::end(kMapScales)[-1]) o.untangle_share = kUntangleShareFollowed;  // the next scale is the cheaper remedy
+    ScaledMap m{parametrize(designer, design, o), std::nullopt, scale};
+    if (map.quads) m.quads = extract_quads(designer, m.param);
+    const bool better = better_map(m.param, m.quads, map.param, map.quads);
+    const int count = std::max(1, m.param.quality.attempts);  // with the other sizings' maps (parametrize)
+    std::ostringstream what;
+    what << "at " << scale << " times the edge length";
+    if (better) map = std::move(m);
+    log.made(count, what.str(), better ? map.param : m.param, better ? map.quads : m.quads, map.param, map.quads);
+    if (map_problems(map.param, map.quads) == 0) break;
+  }
+}
+
 // map_request's search on one mesh (map_request adds the refinement).
 MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
-                      bool quads) {
+                      bool quads, SearchLog& log) {
   const bool escalate = request.auto_place && request.auto_options.cancel_distance == 0;
   // The distance onto feature lines is map_request's own (per attempt) unless the request gave one.
   const bool own_onto = escalate && request.auto_options.onto_features == 0;
@@ -497,6 +571,10 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
       ++tried;
       return true;
     }
+    if (log.maps() > 0 && !log.room()) {
+      log.stop();
+      return false;
+    }
     FieldRequest r = request;
     if (escalate) r.auto_options.cancel_distance = attempt.units * unit;
     if (own_onto)
@@ -548,7 +626,10 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     m.onto_units = own_onto ? attempt.onto : 0.0;
     m.onto_flat = own_onto && attempt.flat;
     m.onto_boundary = own_onto && attempt.boundary;
-    if (!have_best || better(m, best)) {
+    const bool improves = !have_best || better(m, best);
+    log.made(std::max(1, m.param.quality.attempts), "placement " + describe_placement(m.cancel_units, m.relaxed, m.periods, m.onto_units, m.onto_flat, m.onto_boundary), m.param,
+             m.quads, improves ? m.param : best.param, improves ? m.quads : best.quads);
+    if (improves) {
       const int first = tried == 1 ? map_problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
       if (have_best && screen) rank_runner(std::move(best), kept);
@@ -569,11 +650,18 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   // A screened map's retries, resumed from its first maps (at the edge length and at the field's unit size); the
   // designer holds that field's fixed faces.
   auto retry = [&](MapOutcome& m, const FieldRequest& r) {
+    if (!log.room()) {
+      log.stop();
+      return;
+    }
     if (designer.fixed_faces() != m.field.constraints.fixed_faces) designer.set_fixed_faces(m.field.constraints.fixed_faces);
     ParamOptions options = request_param_options(designer, r, m.field, edge_length, target_faces);
+    const int before = m.param.quality.attempts;
     Parametrization param = parametrize_retries(m.field.designer(designer), m.field.design, options, m.param);
     if (quads && param.uv != m.param.uv) m.quads = extract_quads(m.field.designer(designer), param);
     m.param = std::move(param);
+    const MapOutcome& b = better(m, best) ? m : best;
+    log.made(std::max(1, m.param.quality.attempts - before), "near-miss retries of a placement's map", m.param, m.quads, b.param, b.quads);
   };
   int retried = 0;
   // `mend` on the kept map, then on the screened runners-up in rank until a map has no problems: ranked before it,
@@ -602,8 +690,8 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   auto rescale = [&](MapOutcome& m, const FieldRequest& r) {
     if (designer.fixed_faces() != m.field.constraints.fixed_faces) designer.set_fixed_faces(m.field.constraints.fixed_faces);
     ScaledMap scaled{std::move(m.param), std::move(m.quads), 1.0};
-    map_at_other_scales(m.field.designer(designer), m.field.design, request_param_options(designer, r, m.field, edge_length, target_faces),
-                        scaled);
+    scales_within(m.field.designer(designer), m.field.design, request_param_options(designer, r, m.field, edge_length, target_faces), scaled,
+                  log);
     m.param = std::move(scaled.param), m.quads = std::move(scaled.quads), m.scale = scaled.scale;
   };
   auto rescale_kept = [&]() {
@@ -631,6 +719,8 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   if (designer.fixed_faces() != best.field.constraints.fixed_faces) designer.set_fixed_faces(best.field.constraints.fixed_faces);
   best.placements = maps;
   best.retried_maps = retried;
+  best.maps = log.maps();
+  best.stopped = log.stopped();
   if (maps == 1) best.first_problems = 0, best.first_distortion = 0;
   request = kept;
   return best;
@@ -676,17 +766,9 @@ int map_problems(const Parametrization& param, const std::optional<QuadMesh>& qu
 }
 
 void map_at_other_scales(const FieldDesigner& designer, const Design& design, const ParamOptions& options, ScaledMap& map) {
-  if (map_problems(map.param, map.quads) == 0 || folds_necessary(map.param)) return;
-  for (double scale : kMapScales) {
-    ParamOptions o = options;
-    o.edge_length *= scale, o.target_faces /= scale * scale;
-    o.retries = 0;
-    if (scale != std::end(kMapScales)[-1]) o.untangle_share = kUntangleShareFollowed;  // the next scale is the cheaper remedy
-    ScaledMap m{parametrize(designer, design, o), std::nullopt, scale};
-    if (map.quads) m.quads = extract_quads(designer, m.param);
-    if (better_map(m.param, m.quads, map.param, map.quads)) map = std::move(m);
-    if (map_problems(map.param, map.quads) == 0) break;
-  }
+  const MapSearch unbounded;
+  SearchLog log(unbounded);
+  scales_within(designer, design, options, map, log);
 }
 
 ScaledMap map_field(const FieldDesigner& designer, const Design& design, const ParamOptions& options, bool quads) {
@@ -696,12 +778,23 @@ ScaledMap map_field(const FieldDesigner& designer, const Design& design, const P
   return map;
 }
 
+std::string describe_placement(double cancel_units, bool relaxed, bool periods, double onto_units, bool onto_flat, bool onto_boundary) {
+  std::ostringstream out;
+  if (cancel_units > 1) out << (relaxed ? "relaxed, " : "") << "pairs cancelled within " << static_cast<int>(cancel_units) << " units";
+  else if (onto_boundary) out << "the singularities found, those beside the boundary moved onto it as corners" << (relaxed ? ", relaxed" : "");
+  else if (onto_flat) out << "the singularities found, moved onto the feature lines from " << onto_units << " units where a quad gets a flat corner";
+  else if (onto_units > kMapOntoFeatures) out << "the singularities found, moved onto the feature lines from " << onto_units << " units";
+  else out << (relaxed ? (periods ? "the singularities found, relaxed with the periods" : "the singularities found, relaxed") : "the first");
+  return out.str();
+}
+
 MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest& request, double edge_length, double target_faces,
-                       bool quads) {
+                       bool quads, const MapSearch& search) {
+  SearchLog log(search);
   if (request.feature_degrees && !request.feature_min_length) request.feature_min_length = map_unit(designer, edge_length, target_faces);
   request.sectors_for_singularities = true;
   const FieldRequest asked = request;
-  MapOutcome m = map_search(designer, F, request, edge_length, target_faces, quads);
+  MapOutcome m = map_search(designer, F, request, edge_length, target_faces, quads, log);
   // Where the kept map folds beside an edge whose two ends lie on aligned lines (a flat CAD face triangulated from
   // its rim alone: every triangle of its fan has its corners on the rim's iso-lines, so some are flat in (u, v)
   // whatever the map), those edges are split at their midpoints and the search runs again on the refined mesh;
@@ -727,11 +820,19 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     }
   }
   if (!beside) return m;
+  if (!log.room()) {
+    log.stop();
+    m.stopped = true;
+    return m;
+  }
+  log.note("the map kept folds beside edges whose ends lie on aligned lines: " + std::to_string(chords.size()) +
+           " such edges split at their midpoints, the search again on that mesh");
   std::vector<int> parent;
   Mesh refined = split_edges_at_midpoints(Mesh{designer.V(), F}, chords, &parent);
   auto refined_designer = std::make_unique<FieldDesigner>(refined.V, refined.F, designer.solver_options());
   FieldRequest r = request_on_refined(asked, designer, *refined_designer, parent);
-  MapOutcome n = map_search(*refined_designer, refined.F, r, edge_length, target_faces, quads);
+  MapOutcome n = map_search(*refined_designer, refined.F, r, edge_length, target_faces, quads, log);
+  m.maps = n.maps = log.maps(), m.stopped = n.stopped = log.stopped();
   if (!n.field.verified || map_problems(n) >= map_problems(m)) return m;
   n.field.refined = std::move(refined_designer);
   n.field.V = std::move(refined.V), n.field.F = std::move(refined.F), n.field.parent_face = std::move(parent);
