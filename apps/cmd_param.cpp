@@ -67,7 +67,7 @@ void run_param(const ParamCommand& o) {
               << " s (cut " << fmt(q.seconds_cut) << ", setup " << fmt(q.seconds_setup) << ", rounding " << fmt(q.seconds_rounding)
               << ", untangling " << fmt(q.seconds_untangling) << ", stiffening "
               << fmt(q.seconds_stiffening) << ", check " << fmt(q.seconds_check) << "); field to map " << fmt(run.map_seconds)
-              << " s in all, with every placement, retry and scale tried\n";
+              << search_time_words(run) << "\n";
   if (const std::string w = param_warning(param); !w.empty()) std::cerr << "trivcon: warning: " << w << "\n";
   if (!q.seamless) exit_code = kVerificationFailed;
 }

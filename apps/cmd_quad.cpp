@@ -76,7 +76,7 @@ void run_quad(const QuadCommand& o) {
               << "time: read " << fmt(run.read_seconds) << " s, field " << fmt(run.out.design.solve_seconds + run.out.design.field_seconds)
               << " s, map " << fmt(p.seconds_total())
               << " s, quads " << fmt(q.seconds_extract + q.seconds_check) << " s (extract " << fmt(q.seconds_extract) << ", check "
-              << fmt(q.seconds_check) << "); field to quads " << fmt(run.map_seconds) << " s in all, with every placement, retry and scale tried\n";
+              << fmt(q.seconds_check) << "); field to quads " << fmt(run.map_seconds) << search_time_words(run) << "\n";
   }
   if (const std::string w = param_warning(param); !w.empty()) std::cerr << "trivcon: warning: " << w << "\n";
   if (empty) {

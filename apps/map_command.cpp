@@ -154,6 +154,11 @@ nlohmann::ordered_json map_report(const MapCommand& o, const MapRun& run) {
   return report;
 }
 
+std::string search_time_words(const MapRun& run) {
+  if (!run.search_stopped) return " s in all, with every placement, retry and scale tried";
+  return " s in all, the search stopped by --search-maps after " + std::to_string(run.maps) + " maps";
+}
+
 namespace {
 
 std::string placement_line(const MapRun& run) {

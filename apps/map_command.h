@@ -80,6 +80,8 @@ void write_map_singularities(const std::string& path, const MapRun& run);
 // What both reports hold: the mesh, the singularities (the map's cones), the field, the map (param_report), and
 // repair and relax when they ran; the caller adds its own entries and "seconds".
 nlohmann::ordered_json map_report(const MapCommand& command, const MapRun& run);
+// The end of the time line: what the search's time covers (every step, or those before --search-maps stopped it).
+std::string search_time_words(const MapRun& run);
 // What both print first: the mesh's line, the relaxation's when it ran, the field's.
 std::string map_summary(const MapCommand& command, const MapRun& run);
 

@@ -369,6 +369,11 @@ TEST(CliQuad, SingularitiesBesideRoundHolesBecomeCornersOfTheirRims) {
                              " (the bound given); the best of them kept\n"),
             std::string::npos)
       << bounded.out;
+  EXPECT_NE(bounded.out.find(" s in all, the search stopped by --search-maps after " + std::to_string(first) + " maps\n"), std::string::npos)
+      << bounded.out;
+  const auto quiet = run_cli("quad " + mesh + " --auto --target-faces 80 --search-maps 1 -q -o " + out2);
+  EXPECT_EQ(quiet.status, 3) << quiet.err;
+  EXPECT_EQ(quiet.out, "");  // -q: no search lines either
   // Without the boundary aligned a boundary vertex carries no index.
   const auto refused = run_cli("quad " + mesh + " -s " + sing + " --edge-length 1 -o " + out2);
   EXPECT_EQ(refused.status, 1) << refused.err;
