@@ -415,17 +415,20 @@ class SearchLog {
   bool room() const { return search_.max_maps <= 0 || made_ < search_.max_maps; }
   int maps() const { return made_; }
   bool stopped() const { return stopped_; }
-  // A step that made `count` maps (what it tried, the problems and mean ratio of its map), and the best so far.
-  void made(int count, const std::string& what, const Parametrization& param, const std::optional<QuadMesh>& quads, const Parametrization& best,
-            const std::optional<QuadMesh>& best_quads) {
+  // A step that made `count` maps: what it tried, and the map it ended with (the best of its own). The search keeps
+  // the best of all the steps' maps (better_map), so that is the best so far.
+  void made(int count, const std::string& what, const Parametrization& param, const std::optional<QuadMesh>& quads) {
     made_ += count;
+    const int problems = map_problems(param, quads);
+    if (made_ == count || problems < best_problems_ || (problems == best_problems_ && map_stretch(param) < best_stretch_))
+      best_problems_ = problems, best_stretch_ = map_stretch(param), best_ratio_ = param.quality.mean_distortion;
     if (!search_.progress) return;
     std::ostringstream line;
     line << std::setprecision(3) << "search: ";
     if (count == 1) line << "map " << made_;
     else line << "maps " << made_ - count + 1 << "-" << made_;
-    line << " (" << what << "): " << map_problems(param, quads) << " problems, mean ratio " << param.quality.mean_distortion << "; best so far "
-         << map_problems(best, best_quads) << ", " << best.quality.mean_distortion;
+    line << " (" << what << "): " << problems << " problems, mean ratio " << param.quality.mean_distortion << "; best so far " << best_problems_
+         << ", " << best_ratio_;
     say(line.str());
   }
   // A line of its own (the search moving to a refined mesh).
@@ -451,6 +454,8 @@ class SearchLog {
   }
   const MapSearch& search_;
   int made_ = 0, steps_ = 0;
+  int best_problems_ = 0;
+  double best_stretch_ = 0, best_ratio_ = 0;
   bool stopped_ = false;
   std::string first_;
 };
@@ -474,7 +479,7 @@ void scales_within(const FieldDesigner& designer, const Design& design, const Pa
     std::ostringstream what;
     what << "at " << scale << " times the edge length";
     if (better) map = std::move(m);
-    log.made(count, what.str(), better ? map.param : m.param, better ? map.quads : m.quads, map.param, map.quads);
+    log.made(count, what.str(), better ? map.param : m.param, better ? map.quads : m.quads);
     if (map_problems(map.param, map.quads) == 0) break;
   }
 }
@@ -626,10 +631,9 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     m.onto_units = own_onto ? attempt.onto : 0.0;
     m.onto_flat = own_onto && attempt.flat;
     m.onto_boundary = own_onto && attempt.boundary;
-    const bool improves = !have_best || better(m, best);
-    log.made(std::max(1, m.param.quality.attempts), "placement " + describe_placement(m.cancel_units, m.relaxed, m.periods, m.onto_units, m.onto_flat, m.onto_boundary), m.param,
-             m.quads, improves ? m.param : best.param, improves ? m.quads : best.quads);
-    if (improves) {
+    log.made(std::max(1, m.param.quality.attempts),
+             "placement " + describe_placement(m.cancel_units, m.relaxed, m.periods, m.onto_units, m.onto_flat, m.onto_boundary), m.param, m.quads);
+    if (!have_best || better(m, best)) {
       const int first = tried == 1 ? map_problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
       if (have_best && screen) rank_runner(std::move(best), kept);
@@ -660,8 +664,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     Parametrization param = parametrize_retries(m.field.designer(designer), m.field.design, options, m.param);
     if (quads && param.uv != m.param.uv) m.quads = extract_quads(m.field.designer(designer), param);
     m.param = std::move(param);
-    const MapOutcome& b = better(m, best) ? m : best;
-    log.made(std::max(1, m.param.quality.attempts - before), "near-miss retries of a placement's map", m.param, m.quads, b.param, b.quads);
+    log.made(std::max(1, m.param.quality.attempts - before), "near-miss retries of a placement's map", m.param, m.quads);
   };
   int retried = 0;
   // `mend` on the kept map, then on the screened runners-up in rank until a map has no problems: ranked before it,
