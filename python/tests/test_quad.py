@@ -340,6 +340,7 @@ def test_corners_of_the_boundary_are_listed_and_given_back(tmp_path):
     r.write_singularities(str(path))
     written = {int(v): Fraction(n) for v, n in (line.split() for line in path.read_text().splitlines() if not line.startswith("#"))}
     assert written == {**r.singularities, **r.corners}
+    assert pickle.loads(pickle.dumps(r)).corners == r.corners
     again = d.solve(4, written, align_boundary=True, map_target_faces=80)
     assert again.corners == r.corners and again.singularities == r.singularities
     assert again.energy == pytest.approx(r.energy, rel=1e-9) and again.field_exact
