@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <tuple>
+#include <vector>
 
 #include "trivcon/common.h"
 #include "trivcon/error.h"
@@ -163,6 +166,65 @@ TEST(Request, MapSearchRetriesTheRunnersUpWhenTheKeptMapKeepsProblems) {
   EXPECT_EQ(problems_100, 0);
   EXPECT_EQ(retried_100, 1);
   EXPECT_GT(cancel_100, 0);
+}
+
+// The search's steps (MapSearch::progress) and its bound (max_maps). Genus 4 at 80 squares keeps problems through
+// the whole search; bounded at 12 maps: one line per step, their map counts running from 1 to MapOutcome::maps
+// without a gap, the last step's best so far the map kept, then the stop; bounded at one map, the search stops
+// after the first placement's maps. A torus whose first map is clean says nothing.
+TEST(Request, MapSearchReportsEachStepAndStopsAtItsBound) {
+  const Mesh m = make_genus_surface(4, 3);
+  auto search = [&](const Mesh& mesh, double target, int max_maps, std::vector<std::string>& lines) {
+    FieldDesigner d(mesh.V, mesh.F);
+    FieldRequest r;
+    r.prescription.N = 4;
+    r.auto_place = true;
+    MapSearch s;
+    s.max_maps = max_maps;
+    s.progress = [&](const std::string& line) { lines.push_back(line); };
+    return map_request(d, mesh.F, r, 0, target, true, s);
+  };
+  std::vector<std::string> lines;
+  const MapOutcome o = search(m, 80, 12, lines);
+  EXPECT_TRUE(o.stopped);
+  EXPECT_GE(o.maps, 12);
+  ASSERT_GE(lines.size(), 3u);
+  EXPECT_EQ(lines.back(), "search: stopped after " + std::to_string(o.maps) + " maps (the bound given); the best of them kept");
+  lines.pop_back();
+  int next = 1;
+  for (const std::string& line : lines) {
+    ASSERT_EQ(line.rfind("search: map", 0), 0u) << line;
+    int first = 0, last = 0;
+    if (std::sscanf(line.c_str(), "search: maps %d-%d", &first, &last) != 2) {
+      ASSERT_EQ(std::sscanf(line.c_str(), "search: map %d", &first), 1) << line;
+      last = first;
+    }
+    EXPECT_EQ(first, next) << line;
+    EXPECT_GE(last, first) << line;
+    next = last + 1;
+  }
+  EXPECT_EQ(next - 1, o.maps);
+  EXPECT_NE(lines.front().find("(placement the first): "), std::string::npos) << lines.front();
+  // The last line's best so far is the map kept.
+  const int kept = map_problems(o.param, o.quads);
+  EXPECT_NE(lines.back().find("; best so far " + std::to_string(kept) + ", "), std::string::npos) << lines.back();
+
+  std::vector<std::string> bounded_lines;
+  const MapOutcome b = search(m, 80, 1, bounded_lines);
+  EXPECT_TRUE(b.stopped);
+  EXPECT_EQ(b.placements, 1);
+  EXPECT_LT(b.maps, 12);
+  ASSERT_EQ(bounded_lines.size(), 2u);
+  EXPECT_EQ(bounded_lines[0].rfind("search: map", 0), 0u);
+  EXPECT_EQ(bounded_lines[1], "search: stopped after " + std::to_string(b.maps) + (b.maps == 1 ? " map" : " maps") +
+                                  " (the bound given); the best of them kept");
+
+  std::vector<std::string> clean_lines;
+  const MapOutcome c = search(make_torus(48, 16), 500, 0, clean_lines);
+  EXPECT_EQ(map_problems(c.param, c.quads), 0);
+  EXPECT_TRUE(clean_lines.empty());
+  EXPECT_FALSE(c.stopped);
+  EXPECT_GE(c.maps, 1);
 }
 
 // With moves onto feature lines, the split's gathering comes after them. A plate 0.3 thick with 3 × 2 round holes
