@@ -227,6 +227,43 @@ TEST(Request, MapSearchReportsEachStepAndStopsAtItsBound) {
   EXPECT_GE(c.maps, 1);
 }
 
+// A boundary vertex given an index is a corner of the aligned boundary (solve_request turns its fan): refused by
+// name where its fan cannot take the turn (three faces of a straight side, a quarter turn), and without the
+// boundary aligned.
+TEST(Request, BoundaryVertexGivenAnIndexIsACornerOrRefusedByName) {
+  const Mesh m = test::lattice_plate(1, 1, 0.25, 0.08);
+  FieldDesigner d(m.V, m.F);
+  const Topology& t = d.topology();
+  int straight = -1;
+  for (int v = 0; v < t.num_vertices && straight < 0; ++v) {
+    std::vector<int> fan;
+    if (t.is_boundary_vertex(v) && (vertex_fan(t, v, fan), fan.size() == 3u)) straight = v;
+  }
+  ASSERT_GE(straight, 0);
+  FieldRequest r;
+  r.prescription.N = 4;
+  r.prescription.vertex = {{straight, -1}};
+  r.align_boundary = true;
+  const std::string loop = std::to_string(t.vertex_boundary_loop[straight]);
+  try {
+    solve_request(d, m.F, r);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "singular vertex " + std::to_string(straight) + " on boundary loop " + loop +
+                                         " cannot be a corner of index -1/4: its fan of 3 faces cannot turn by that much in steps the field "
+                                         "reads unambiguously (or it has a corner already, or faces beside other aligned edges)");
+  }
+  r.align_boundary = false;
+  try {
+    solve_request(d, m.F, r);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "singular vertex " + std::to_string(straight) + " is on boundary loop " + loop +
+                                         ": a boundary vertex has no dual cycle (set the loop's index with --boundary instead, or align the "
+                                         "boundary, --align-boundary, to make the vertex a corner of it)");
+  }
+}
+
 // With moves onto feature lines, the split's gathering comes after them. A plate 0.3 thick with 3 × 2 round holes
 // of radius 0.3 at 200 squares: each hole's eight −1/4 lie on its two rims (none gathered into a −2/4 in the strip
 // between two holes, as the gathering before the moves made it), the eight +1/4 at the plate's corners, and the

@@ -123,6 +123,14 @@ std::map<int, std::vector<int>> sharp_faces(const Topology& t, const std::vector
   return out;
 }
 
+// The boundary edges, as lines beside their faces (with `boundary`, the aligned boundary is a line too).
+std::vector<int> boundary_edges_beside(const Topology& t, std::map<int, std::vector<int>>& beside) {
+  std::vector<int> out;
+  for (int e = 0; e < t.num_edges; ++e)
+    if (t.is_boundary_edge(e)) out.push_back(e), beside[t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1)].push_back(e);
+  return out;
+}
+
 // Narrow corners (trivcon/features.h): sectors of angle θ < π/N between consecutive sharp edges. Following
 // both edges the field would turn by θ through the sector and a map aligned to both would collapse it; turned
 // through with one step (turn_through), it gets a corner of 2π/N.
@@ -323,11 +331,7 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
   std::vector<int> degree(t.num_vertices, 0);
   for (int e : edges) ++degree[t.edge_vertices(e, 0)], ++degree[t.edge_vertices(e, 1)];
   if (boundary)
-    for (int e = 0; e < t.num_edges; ++e)
-      if (t.is_boundary_edge(e)) {
-        ++degree[t.edge_vertices(e, 0)], ++degree[t.edge_vertices(e, 1)];
-        beside[t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1)].push_back(e);
-      }
+    for (int e : boundary_edges_beside(t, beside)) ++degree[t.edge_vertices(e, 0)], ++degree[t.edge_vertices(e, 1)];
   // Boundary vertices given a corner by this call's moves: no singularity there, but taken (an earlier call's are
   // in claimed sectors).
   std::set<int> corners;
@@ -411,9 +415,7 @@ void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const 
   const std::map<int, std::vector<int>> beside = sharp_faces(t, edges);
   // At a boundary vertex the boundary edges are lines too: a sector with a face beside another one is not plain.
   std::map<int, std::vector<int>> beside_boundary = beside;
-  if (boundary)
-    for (int e = 0; e < t.num_edges; ++e)
-      if (t.is_boundary_edge(e)) beside_boundary[t.edge_faces(e, 0) >= 0 ? t.edge_faces(e, 0) : t.edge_faces(e, 1)].push_back(e);
+  if (boundary) boundary_edges_beside(t, beside_boundary);
   std::vector<char> claimed(t.num_faces, 0);
   std::set<int> narrow_faces;
   for (const NarrowCorner& k : alignment.narrow)

@@ -222,7 +222,7 @@ FieldOutcome solve_request(FieldDesigner& designer, const MatrixX3i& F, const Fi
           std::vector<int> fan;
           vertex_fan(t, w, fan);
           throw Error("singular vertex " + std::to_string(w) + " on boundary loop " + std::to_string(t.vertex_boundary_loop[w]) +
-                      " cannot be a corner of index " + std::to_string(n) + "/" + std::to_string(p.N) + ": its fan of " +
+                      " cannot be a corner of index " + format_index(n, p.N) + ": its fan of " +
                       std::to_string(fan.size()) + " faces cannot turn by that much in steps the field reads unambiguously" +
                       " (or it has a corner already, or faces beside other aligned edges)");
         }
