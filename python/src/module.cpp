@@ -117,6 +117,23 @@ class CallThreads {
   std::optional<SingleThreadedBlas> blas_;
 };
 
+// Lines a task posts for the calling thread to pass to a Python callable (post_line; the map search's progress).
+struct JobLines {
+  std::mutex mutex;
+  std::vector<std::string> lines;
+};
+// The lines of the job running on this thread (null: none wanted).
+thread_local JobLines* current_job_lines = nullptr;
+
+// From a task: queues `line` for its caller's callable, which gets it the next time the caller wakes (every 20 ms
+// while it waits, and once more when the task ends). Nothing without a callable.
+void post_line(const std::string& line) {
+  if (JobLines* lines = current_job_lines) {
+    std::lock_guard<std::mutex> lock(lines->mutex);
+    lines->lines.push_back(line);
+  }
+}
+
 template <class T>
 struct Job {
   std::mutex mutex;
@@ -125,14 +142,16 @@ struct Job {
   std::shared_ptr<std::atomic<bool>> cancel = std::make_shared<std::atomic<bool>>(false);
   std::optional<T> value;
   std::exception_ptr error;
+  std::shared_ptr<JobLines> lines = std::make_shared<JobLines>();
 };
 
 // Runs task() on a new thread with `threads` threads (0: the module's default, negative: OpenMP's) and returns its value; the
 // caller must hold the GIL. KeyboardInterrupt (or whatever a Python signal handler raises) abandons the
 // task: it is cancelled and frees its results itself. The task must own what it reads (copies, shared
-// pointers) and must not touch Python objects.
+// pointers) and must not touch Python objects. With `on_line` (not None), the lines the task posts (post_line)
+// are passed to it on the calling thread, in order; what it raises abandons the task the same way.
 template <class Task>
-std::invoke_result_t<Task&> interruptible(int threads, Task task) {
+std::invoke_result_t<Task&> interruptible(int threads, Task task, py::object on_line = py::none()) {
   using T = std::invoke_result_t<Task&>;
   if (threads == 0) threads = default_threads.load();
   auto job = std::make_shared<Job<T>>();
@@ -143,10 +162,13 @@ std::invoke_result_t<Task&> interruptible(int threads, Task task) {
     bg.flags.insert(job->cancel);
   }
   try {
-    std::thread([job, threads, work = std::optional<Task>(std::move(task))]() mutable {
+    const bool wants_lines = !on_line.is_none();
+    std::thread([job, threads, wants_lines, work = std::optional<Task>(std::move(task))]() mutable {
       {
         CallThreads setting(threads);
         CancelScope scope(job->cancel);
+        const std::shared_ptr<JobLines> lines = job->lines;
+        current_job_lines = wants_lines ? lines.get() : nullptr;
         try {
           job->value.emplace((*work)());
         } catch (...) {
@@ -196,23 +218,42 @@ std::invoke_result_t<Task&> interruptible(int threads, Task task) {
       ~Release() { restore(); }
     } release;
     release.poll_thread = poll;
+    auto abandon = [&] {
+      std::lock_guard<std::mutex> guard(job->mutex);
+      if (!job->done) job->abandoned = true, *job->cancel = true;
+    };
+    // The task's lines so far to on_line, with the GIL; what it raises abandons the task.
+    auto deliver = [&] {
+      if (on_line.is_none()) return;
+      std::vector<std::string> lines;
+      {
+        std::lock_guard<std::mutex> guard(job->lines->mutex);
+        lines.swap(job->lines->lines);
+      }
+      if (lines.empty()) return;
+      py::gil_scoped_acquire acquire;
+      try {
+        for (const std::string& line : lines) on_line(line);
+      } catch (...) {
+        abandon();
+        throw;
+      }
+    };
     std::unique_lock<std::mutex> lock(job->mutex);
     while (!job->finished.wait_for(lock, std::chrono::milliseconds(20), [&] { return job->done; })) {
-      if (!poll) continue;
       lock.unlock();
-      {
+      deliver();
+      if (poll) {
         py::gil_scoped_acquire acquire;
         if (PyErr_CheckSignals() != 0) {
-          {
-            std::lock_guard<std::mutex> abandon(job->mutex);
-            if (!job->done) job->abandoned = true, *job->cancel = true;
-          }
+          abandon();
           throw py::error_already_set();
         }
       }
       lock.lock();
     }
     lock.unlock();
+    deliver();  // the lines posted before it ended
     release.restore();
   }
   if (job->error) std::rethrow_exception(job->error);
@@ -1015,7 +1056,7 @@ PYBIND11_MODULE(_core, m) {
              std::vector<std::pair<int, int>> feature_edges, std::vector<std::pair<int, double>> roots, double auto_cancel, bool auto_cancel_absolute, int auto_iterations,
              std::optional<double> curvature_t, bool split, int max_rounds, bool relax, std::vector<int> relax_pins, int relax_cancel,
              int relax_max_moves, int relax_reach, double relax_periods, double map_edge_length, double map_target_faces,
-             std::optional<double> feature_min_length, int map_search_maps) {
+             std::optional<double> feature_min_length, int map_search_maps, py::object map_progress) {
             // The library's request layer (trivcon/request.h) does the work; here only the conversion.
             FieldRequest q;
             q.prescription.N = N;
@@ -1073,6 +1114,7 @@ PYBIND11_MODULE(_core, m) {
               if (map_edge_length > 0 || map_target_faces > 0) {
                 MapSearch search;
                 search.max_maps = map_search_maps;
+                search.progress = post_line;  // to map_progress, on the calling thread (interruptible)
                 MapOutcome m = map_request(*s->designer, s->F, request, map_edge_length, map_target_faces, true, search);
                 search_maps = m.maps, search_stopped = m.stopped;
                 r = std::move(m.field);
@@ -1114,7 +1156,7 @@ PYBIND11_MODULE(_core, m) {
               o.sharp = std::move(r.sharp_edges);
               o.relaxed = std::move(r.relax_result);
               return o;
-            });
+            }, map_progress);
             py::list round_list;
             for (const RefineRound& k : out.rounds) {
               py::dict d;
@@ -1151,7 +1193,7 @@ PYBIND11_MODULE(_core, m) {
           py::arg("auto_iterations"), py::arg("curvature_t"), py::arg("split"), py::arg("max_rounds"), py::arg("relax") = false,
           py::arg("relax_pins") = std::vector<int>{}, py::arg("relax_cancel") = 0, py::arg("relax_max_moves") = 10000,
           py::arg("relax_reach") = 1, py::arg("relax_periods") = 0.0, py::arg("map_edge_length") = 0.0, py::arg("map_target_faces") = 0.0,
-          py::arg("feature_min_length") = std::nullopt, py::arg("map_search_maps") = 0,
+          py::arg("feature_min_length") = std::nullopt, py::arg("map_search_maps") = 0, py::arg("map_progress") = py::none(),
           "One field request (trivcon/request.h; vertex None: the smoothest field's singularities, chosen for a map at the given "
           "scale as the map commands do when one is > 0, cancel_for_map): (designer of the final mesh, "
           "DesignResult, AutoResult or None, parent face of each face (with split), rounds, converged, sharp edges, relaxation "

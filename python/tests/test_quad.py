@@ -350,7 +350,22 @@ def test_corners_of_the_boundary_are_listed_and_given_back(tmp_path):
     # The search: past the first placement's map (it has problems here) more were made; map_search_maps=1 stops
     # after the first placement's maps (with the other sizings').
     assert r.search["maps"] > 1 and not r.search["stopped"]
-    bounded = d.solve(4, "auto", align_boundary=True, map_target_faces=80, map_search_maps=1)
+    # map_progress gets the search's lines as quad prints them, on this thread; what it raises stops the search.
+    lines = []
+    bounded = d.solve(4, "auto", align_boundary=True, map_target_faces=80, map_search_maps=1, map_progress=lines.append)
+    assert len(lines) == 2 and lines[0].startswith("search: map") and " (placement the first): " in lines[0]
+    assert lines[1] == f"search: stopped after {bounded.search['maps']} maps (the bound given); the best of them kept"
+
+    class Enough(Exception):
+        pass
+
+    def stop(line):
+        raise Enough(line)
+
+    with pytest.raises(Enough, match="^search: map"):
+        d.solve(4, "auto", align_boundary=True, map_target_faces=80, map_progress=stop)
+    with pytest.raises(trivcon.Error, match=r"^map_progress must be callable or None, not 3$"):
+        d.solve(4, "auto", align_boundary=True, map_target_faces=80, map_progress=3)
     assert bounded.search["stopped"] and 1 <= bounded.search["maps"] < r.search["maps"] and not bounded.corners
     with pytest.raises(trivcon.Error, match=r"^map_search_maps must be a whole number >= 0, not -1$"):
         d.solve(4, "auto", align_boundary=True, map_target_faces=80, map_search_maps=-1)

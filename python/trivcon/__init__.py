@@ -827,7 +827,7 @@ class FieldDesigner(_Cached):
               align_features=None, feature_edges=None, roots=None, auto_cancel=0.0, align_curvature=None,
               split_large_turns=False, max_rounds=8, relax=False, relax_pins=None, relax_cancel=0, relax_max_moves=10000,
               relax_reach=1, relax_periods=0.0, map_target_faces=None, map_edge_length=None, feature_min_length=None,
-              map_search_maps=0):
+              map_search_maps=0, map_progress=None):
         """The smoothest N-direction field with exactly the given singularities: a Result.
 
         N: 1 vectors, 2 lines, 4 crosses, any N >= 1.
@@ -897,6 +897,9 @@ class FieldDesigner(_Cached):
         map_search_maps: with map_target_faces / map_edge_length, the search for a better map starts no step once
           this many maps are made (a step under way finishes) and keeps the best of them, as `quad --search-maps`
           (0: no bound). Result.search says how many it made and whether the bound stopped it.
+        map_progress: with map_target_faces / map_edge_length, a callable given each line of the search's steps as
+          `quad` prints them (`search: maps 4-6 (placement ...): 12 problems, ...`), on the calling thread while
+          the search runs; none when the first map ends the search. What it raises stops the search and is raised.
 
         The request means the same as the CLI's and the editor's (the library's trivcon/request.h does it).
         Errors in the prescription raise trivcon.Error with the library's message. The result is
@@ -975,11 +978,13 @@ class FieldDesigner(_Cached):
             raise Error("give at most one of map_target_faces and map_edge_length")
         if isinstance(map_search_maps, bool) or not isinstance(map_search_maps, _numbers.Integral) or map_search_maps < 0:
             raise Error(f"map_search_maps must be a whole number >= 0, not {map_search_maps!r}")
+        if map_progress is not None and not callable(map_progress):
+            raise Error(f"map_progress must be callable or None, not {map_progress!r}")
         core, r, a, parent, rounds, converged, sharp, relaxed = self._d.solve_request(
             N, vertex, _indices(generators, N, "generators"), _indices(boundary, N, "boundary"), explicit, bool(align_boundary),
             degrees, edge_pairs, root_list, cancel, False, 8, curvature_t, bool(split_large_turns), int(max_rounds),
             bool(relax), pins, int(relax_cancel), int(relax_max_moves), int(relax_reach), float(relax_periods), map_scale[0],
-            map_scale[1], feature_min_length, int(map_search_maps))
+            map_scale[1], feature_min_length, int(map_search_maps), map_progress)
         auto = AutoResult(a, self) if a is not None else None
         designer = self if core is self._d else FieldDesigner._of_core(core, self)
         result = Result(designer, r, auto)

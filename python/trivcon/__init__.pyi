@@ -4,7 +4,7 @@
 # name and every parameter here matches the module.
 import os
 from fractions import Fraction
-from typing import Any, Dict, Iterable, Iterator, List, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -160,6 +160,8 @@ class FieldDesigner:
         map_target_faces: Optional[float] = ...,
         map_edge_length: Optional[float] = ...,
         feature_min_length: Optional[float] = ...,
+        map_search_maps: int = ...,
+        map_progress: Optional[Callable[[str], Any]] = ...,
     ) -> Result: ...
     def relax(
         self,
@@ -236,6 +238,10 @@ class Result:
     def conflicts(self) -> List[Tuple[int, int, float]]: ...
     @property
     def singularities(self) -> Dict[int, Fraction]: ...
+    @property
+    def corners(self) -> Dict[int, Fraction]: ...
+    @property
+    def search(self) -> Dict[str, Any]: ...
     @property
     def singularity_arrays(self) -> _IndexArrays: ...
     @property
