@@ -94,9 +94,7 @@ void write_map_obj(const std::string& path, const MapRun& run) {
 }
 
 void write_map_singularities(const std::string& path, const MapRun& run) {
-  // With the corners of the boundary: -s reads a boundary vertex as one (with the boundary aligned).
-  std::map<int, int> vertex = run.out.prescription.vertex;
-  for (auto [v, n] : run.out.constraints.features.corners) vertex[v] = n;
+  const std::map<int, int> vertex = with_corners(run.out.prescription.vertex, run.out.constraints.features.corners);
   write_singularities(path, run.out.refined ? vertex : input_singularities(vertex, run.repaired()), 4);
 }
 

@@ -88,9 +88,7 @@ void stage_design_outputs(StagedOutputs& staged, const OutputPaths& paths, const
   if (!paths.singularities.empty())
     staged.write(output_path(paths.singularities, name),
                  [&](const std::string& path) {
-                   std::map<int, int> vertex = prescription.vertex;
-                   vertex.insert(corners.begin(), corners.end());
-                   write_singularities(path, input_singularities(vertex, repair), prescription.N);
+                   write_singularities(path, input_singularities(with_corners(prescription.vertex, corners), repair), prescription.N);
                  });
   if (!paths.sharp.empty())
     staged.write(output_path(paths.sharp, name), [&](const std::string& path) {

@@ -367,6 +367,13 @@ Mesh lattice_plate(int nx, int ny, double r, double h) {
   return out;
 }
 
+int boundary_vertex_with_fan(const Topology& topology, size_t faces) {
+  std::vector<int> fan;
+  for (int v = 0; v < topology.num_vertices; ++v)
+    if (topology.is_boundary_vertex(v) && (vertex_fan(topology, v, fan), fan.size() == faces)) return v;
+  return -1;
+}
+
 Mesh extruded(const Mesh& flat, double height) {
   const int n = static_cast<int>(flat.V.rows()), nf = static_cast<int>(flat.F.rows());
   std::set<std::pair<int, int>> directed;

@@ -73,6 +73,8 @@ Mesh perforated_plate(int nx, int ny, int m, int layers, double r);
 // hole's centre removed, the hole's rim vertices then put on its circle and the vertices within 3 h of the rim
 // smoothed (15 rounds of neighbour means, in vertex order).
 Mesh lattice_plate(int nx, int ny, double r, double h);
+// The first boundary vertex whose fan has `faces` faces (−1 if none): on a lattice plate's straight side, 3.
+int boundary_vertex_with_fan(const Topology& topology, size_t faces);
 // A flat mesh in the plane z = 0 (faces counter-clockwise seen from +z) made a closed solid of thickness `height`:
 // its faces, their copy at z = −height turned over, and two triangles per boundary edge for the wall between.
 Mesh extruded(const Mesh& flat, double height);

@@ -612,11 +612,7 @@ TEST(FeatureAlignment, SingularitiesBesideTheAlignedBoundaryBecomeCornersOfIt) {
   turn_sectors_for_singularities(t, g, {}, 4, s.alignment.corners, given, true);
   EXPECT_EQ(given.given_sectors.size(), 4u);
   // A fan of three faces (a lattice vertex on the square's straight side) cannot take a quarter turn.
-  int straight = -1;
-  for (int v = 0; v < t.num_vertices && straight < 0; ++v) {
-    std::vector<int> fan;
-    if (t.is_boundary_vertex(v) && (vertex_fan(t, v, fan), fan.size() == 3u)) straight = v;
-  }
+  const int straight = test::boundary_vertex_with_fan(t, 3);
   ASSERT_GE(straight, 0);
   FeatureAlignment three;
   three.fixed = plain;

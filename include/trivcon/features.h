@@ -160,6 +160,9 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& topolo
 // quarter turn). Boundary vertices are left alone without it.
 void turn_sectors_for_singularities(const Topology& topology, const Geometry& geometry, const std::vector<int>& edges, int N,
                                     const std::map<int, int>& vertex, FeatureAlignment& alignment, bool boundary = false);
+// The singular vertices with the corners of the boundary among them, as a singularity file lists them (the
+// boundary vertices read back as corners with the boundary aligned).
+std::map<int, int> with_corners(std::map<int, int> vertex, const std::map<int, int>& corners);
 
 // One line of a .sharp file.
 struct SharpFaceEdge {

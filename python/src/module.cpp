@@ -1333,8 +1333,7 @@ PYBIND11_MODULE(_core, m) {
             py::gil_scoped_release release;
             // The input's ids (a copy repair appended names the vertex it copies), with the corners of the boundary
             // (a boundary vertex given back is one, with the boundary aligned).
-            std::map<int, int> vertex = r.prescription.vertex;
-            for (auto [v, n] : r.corners) vertex[v] = n;
+            const std::map<int, int> vertex = with_corners(r.prescription.vertex, r.corners);
             write_singularities(path, r.state->repair ? values_on_input(*r.state->repair, vertex) : vertex, r.prescription.N);
           },
           py::arg("path"))

@@ -408,6 +408,11 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
   }
 }
 
+std::map<int, int> with_corners(std::map<int, int> vertex, const std::map<int, int>& corners) {
+  vertex.insert(corners.begin(), corners.end());
+  return vertex;
+}
+
 void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const std::vector<int>& edges, int N, const std::map<int, int>& vertex,
                                     FeatureAlignment& alignment, bool boundary) {
   if (N < 4 || N % 2 != 0 || (edges.empty() && !boundary)) return;
