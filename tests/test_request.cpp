@@ -171,7 +171,8 @@ TEST(Request, MapSearchRetriesTheRunnersUpWhenTheKeptMapKeepsProblems) {
 // The search's steps (MapSearch::progress) and its bound (max_maps). Genus 4 at 80 squares keeps problems through
 // the whole search; bounded at 12 maps: one line per step, their map counts running from 1 to MapOutcome::maps
 // without a gap, the last step's best so far the map kept, then the stop; bounded at one map, the search stops
-// after the first placement's maps. A torus whose first map is clean says nothing.
+// after the first placement's maps (with the singularities given, the first step is named for them). A torus whose
+// first map is clean says nothing.
 TEST(Request, MapSearchReportsEachStepAndStopsAtItsBound) {
   const Mesh m = make_genus_surface(4, 3);
   auto search = [&](const Mesh& mesh, double target, int max_maps, std::vector<std::string>& lines) {
@@ -219,6 +220,21 @@ TEST(Request, MapSearchReportsEachStepAndStopsAtItsBound) {
   EXPECT_EQ(bounded_lines[1], "search: stopped after " + std::to_string(b.maps) + (b.maps == 1 ? " map" : " maps") +
                                   " (the bound given); the best of them kept");
 
+  // With the singularities given, the first step is theirs.
+  {
+    FieldDesigner d(m.V, m.F);
+    FieldRequest r;
+    r.prescription.N = 4;
+    r.prescription.vertex = b.field.prescription.vertex;
+    std::vector<std::string> given_lines;
+    MapSearch s;
+    s.max_maps = 1;
+    s.progress = [&](const std::string& line) { given_lines.push_back(line); };
+    const MapOutcome g = map_request(d, m.F, r, 0, 80, true, s);
+    ASSERT_GT(map_problems(g.param, g.quads), 0);  // the first placement's, retried: still with problems
+    ASSERT_EQ(given_lines.size(), 2u);
+    EXPECT_NE(given_lines[0].find(" (the singularities given): "), std::string::npos) << given_lines[0];
+  }
   std::vector<std::string> clean_lines;
   const MapOutcome c = search(make_torus(48, 16), 500, 0, clean_lines);
   EXPECT_EQ(map_problems(c.param, c.quads), 0);

@@ -632,7 +632,9 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
     m.onto_flat = own_onto && attempt.flat;
     m.onto_boundary = own_onto && attempt.boundary;
     log.made(std::max(1, m.param.quality.attempts),
-             "placement " + describe_placement(m.cancel_units, m.relaxed, m.periods, m.onto_units, m.onto_flat, m.onto_boundary), m.param, m.quads);
+             request.auto_place ? "placement " + describe_placement(m.cancel_units, m.relaxed, m.periods, m.onto_units, m.onto_flat, m.onto_boundary)
+                                : std::string("the singularities given"),
+             m.param, m.quads);
     if (!have_best || better(m, best)) {
       const int first = tried == 1 ? map_problems(m) : best.first_problems;
       const double first_distortion = tried == 1 ? m.param.quality.mean_distortion : best.first_distortion;
