@@ -81,6 +81,13 @@ int sector_steps(const Topology& t, const Sector& s) {
   return static_cast<int>(s.faces.size()) + 1 - t.is_boundary_edge(s.first) - t.is_boundary_edge(s.second);
 }
 
+// Whether the sector can be turned through with `steps` corners (steps · 2π/N) in steps the field reads
+// unambiguously: at least one corner and one step, each step off its edges' directions by less than 0.9 π/N.
+bool takes_steps(const Topology& t, const Sector& s, int steps, int N) {
+  const int gaps = sector_steps(t, s);
+  return steps >= 1 && gaps >= 1 && std::abs(s.theta - steps * 2 * kPi / N) / gaps < 0.9 * kPi / N;
+}
+
 // Whether a face of the sector lies beside a sharp edge other than the sector's two, or is taken already.
 bool sector_is_plain(const Sector& s, const std::map<int, std::vector<int>>& sharp_beside, const std::vector<char>& claimed) {
   for (int w : s.faces) {
@@ -386,13 +393,10 @@ void move_singularities_onto_features(const MatrixX3d& V, const Topology& t, con
         if (!holds) continue;
         const double step = 2 * kPi / N;
         const int steps = static_cast<int>(std::lround(sector.theta / step)) - n;  // one more for −1/N, one fewer for +1/N
-        const int gaps = sector_steps(t, sector);
         // The quad mesh gives the sector `steps` corners at w: wider than 1.5 steps each (a +1/N on a straight
         // line or on a T-junction's straight side: one corner of about π), they would be flat or reflex.
         const bool flat = sector.theta > 1.5 * steps * step;
-        if (steps < 1 || gaps < 1 || !(std::abs(sector.theta - steps * step) / gaps < 0.9 * kPi / N) || (flat && !flat_sectors) ||
-            !sector_is_plain(sector, beside, claimed))
-          break;
+        if (!takes_steps(t, sector, steps, N) || (flat && !flat_sectors) || !sector_is_plain(sector, beside, claimed)) break;
         turn_through(t, g, w, sector, steps, N, alignment.fixed, claimed);
         vertex.erase(s);
         if (t.is_boundary_vertex(w)) corners.insert(w), alignment.corners[w] = n;  // a corner of the boundary: no index
@@ -457,7 +461,7 @@ void turn_sectors_for_singularities(const Topology& t, const Geometry& g, const 
         if (!sector_is_plain(sector, corner ? beside_boundary : beside, claimed)) continue;
         const int steps = static_cast<int>(std::lround(sector.theta / step)) + change;
         const double misfit = std::abs(sector.theta - steps * step);
-        if (steps < 1 || !(misfit / sector_steps(t, sector) < 0.9 * kPi / N)) continue;
+        if (!takes_steps(t, sector, steps, N)) continue;
         const bool flat = sector.theta > 1.5 * steps * step;
         if (!best || (flat != best_flat ? !flat : misfit < best_misfit))
           best = &sector, best_steps = steps, best_misfit = misfit, best_flat = flat;

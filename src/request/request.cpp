@@ -413,6 +413,12 @@ class SearchLog {
  public:
   explicit SearchLog(const MapSearch& search) : search_(search) {}
   bool room() const { return search_.max_maps <= 0 || made_ < search_.max_maps; }
+  // Whether a step may start; when not, the search stops (said once).
+  bool may_start() {
+    if (room()) return true;
+    stop();
+    return false;
+  }
   int maps() const { return made_; }
   bool stopped() const { return stopped_; }
   // A step that made `count` maps: what it tried, and the map it ended with (the best of its own). The search keeps
@@ -464,10 +470,7 @@ class SearchLog {
 void scales_within(const FieldDesigner& designer, const Design& design, const ParamOptions& options, ScaledMap& map, SearchLog& log) {
   if (map_problems(map.param, map.quads) == 0 || folds_necessary(map.param)) return;
   for (double scale : kMapScales) {
-    if (!log.room()) {
-      log.stop();
-      return;
-    }
+    if (!log.may_start()) return;
     ParamOptions o = options;
     o.edge_length *= scale, o.target_faces /= scale * scale;
     o.retries = 0;
@@ -576,10 +579,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
       ++tried;
       return true;
     }
-    if (log.maps() > 0 && !log.room()) {
-      log.stop();
-      return false;
-    }
+    if (log.maps() > 0 && !log.may_start()) return false;
     FieldRequest r = request;
     if (escalate) r.auto_options.cancel_distance = attempt.units * unit;
     if (own_onto)
@@ -656,10 +656,7 @@ MapOutcome map_search(FieldDesigner& designer, const MatrixX3i& F, FieldRequest&
   // A screened map's retries, resumed from its first maps (at the edge length and at the field's unit size); the
   // designer holds that field's fixed faces.
   auto retry = [&](MapOutcome& m, const FieldRequest& r) {
-    if (!log.room()) {
-      log.stop();
-      return;
-    }
+    if (!log.may_start()) return;
     if (designer.fixed_faces() != m.field.constraints.fixed_faces) designer.set_fixed_faces(m.field.constraints.fixed_faces);
     ParamOptions options = request_param_options(designer, r, m.field, edge_length, target_faces);
     const int before = m.param.quality.attempts;
@@ -825,8 +822,7 @@ MapOutcome map_request(FieldDesigner& designer, const MatrixX3i& F, FieldRequest
     }
   }
   if (!beside) return m;
-  if (!log.room()) {
-    log.stop();
+  if (!log.may_start()) {
     m.stopped = true;
     return m;
   }
