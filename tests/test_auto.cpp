@@ -283,6 +283,31 @@ TEST(Auto, InputWheelsOppositeSingularitiesMeetForAMap) {
   EXPECT_EQ(cancel_singularity_pairs(designer.V(), designer.topology(), r.vertex, o.cancel_distance, nullptr, true), r.vertex);
 }
 
+// The split spreads every positive singularity above +1 (a quad vertex of valence 2 or 1), alone too, and
+// never onto a vertex that already holds one: +2 on the unit sphere every 1.2 or so, the split's distance 1.0
+// (none gathered), whose rings overlap (two spreads onto vertex 10 made a +2 there). Every singularity left is
+// +1, on a vertex of its own, and the sum is kept.
+TEST(Auto, SplitSpreadsPositivesAboveOneOntoVerticesOfTheirOwn) {
+  const Mesh m = make_icosphere(3);
+  const FieldDesigner designer(m.V, m.F);
+  AutoOptions o;
+  o.split_above = 3;
+  o.split_distance = 1.0;
+  std::map<int, int> given;
+  for (int v = 0; v < m.V.rows(); ++v) {
+    bool far = true;
+    for (auto [w, n] : given) far = far && (m.V.row(w) - m.V.row(v)).norm() > 1.2;
+    if (far) given[v] = 2;
+  }
+  ASSERT_GE(given.size(), 5u);
+  AutoResult r;
+  const std::map<int, int> split = split_auto_singularities(m.V, designer.topology(), given, o, r);
+  EXPECT_EQ(r.split, static_cast<int>(given.size()));
+  EXPECT_EQ(index_sum(split), index_sum(given));
+  for (auto [v, n] : split) EXPECT_EQ(n, 1) << "vertex " << v;
+  EXPECT_EQ(static_cast<int>(split.size()), index_sum(given));
+}
+
 // The split on its own (split_auto_singularities, which the map requests run after the moves onto feature lines)
 // is the one auto_singularities ends with: on the genus-7 plate at 100 squares, with a few vertices held.
 TEST(Auto, TheSplitOnItsOwnIsAutosSplit) {

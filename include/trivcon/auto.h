@@ -46,10 +46,10 @@ struct AutoOptions {
   double cancel_distance = 0;    // cancel ± pairs at most this far apart; 0: none
   bool cancel_absolute = false;  // cancel_distance in mesh units instead of mean edge lengths
   // Split (after cancellation; split_above 0: never): singularities of one sign closer than split_distance (mesh
-  // units, along edges) are gathered at the member nearest their centroid; a gathered sum |n| > split_above, and
-  // any gathered positive sum, becomes |n| singularities of ±1 on interior vertices about split_distance from
-  // it, far from each other (gathered negative sums up to split_above stay: one −2 is a quad vertex of valence
-  // 6, two −1 a fraction of a unit apart fold the map). A cluster joins closest pair first while every member
+  // units, along edges) are gathered at the member nearest their centroid; a sum |n| > split_above, any gathered
+  // positive sum and any n > 1 become |n| singularities of ±1 on interior vertices about split_distance from it
+  // that hold none yet, far from each other (negative sums up to split_above stay: one −2 is a quad vertex of
+  // valence 6, two −1 a fraction of a unit apart fold the map). A cluster joins closest pair first while every member
   // stays within split_distance of every other. Then opposite singularities at most cancel_distance apart meet
   // as far as their indices allow (cancel_singularity_pairs with `partial`): a −2 beside a +1 becomes one −1, a
   // −2 between two +1 vanishes. `trivcon param` and `quad` with --auto use split_above = N − 1 = 3 and one quad

@@ -356,9 +356,12 @@ std::map<int, int> cancel_singularity_pairs(const MatrixX3d& V, const Topology& 
 
 namespace {
 
-// The split of AutoOptions::split_above: each singularity of |n| > limit becomes |n| of sign(n) · 1 on interior
-// vertices about `distance` from it along edges (Dijkstra: those first reached at or past it), chosen far from each other (farthest-point order,
-// in space, from the one nearest to `distance`); where too few such vertices exist, it stays as it is.
+// The split of AutoOptions::split_above: each singularity of |n| > limit, and each of n > 1 (a quad vertex of
+// valence N − n ≤ N − 2: for N = 4 two quads folded onto each other, or one with a vertex twice), becomes |n| of
+// sign(n) · 1 on interior vertices about `distance` from it along edges (Dijkstra: those first reached at or past
+// it) that hold no singularity yet (given, or placed by an earlier split whose ring overlaps this one's), chosen
+// far from each other (farthest-point order, in space, from the one nearest to `distance`); where too few such
+// vertices exist, it stays as it is.
 std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, const std::map<int, int>& given, int limit,
                                        double distance, int& split) {
   std::map<int, int> out;
@@ -421,14 +424,14 @@ std::map<int, int> split_singularities(const MatrixX3d& V, const Topology& t, co
     }
   }
   for (auto [source, n] : vertex) {
-    if (std::abs(n) <= limit && !spread.count(source)) {
+    if (std::abs(n) <= limit && n <= 1 && !spread.count(source)) {
       out[source] += n;
       continue;
     }
-    std::vector<std::pair<double, int>> reached;  // the first interior vertices at or past `distance`
+    std::vector<std::pair<double, int>> reached;  // the first free interior vertices at or past `distance`
     field::edge_dijkstra(V, t, source, std::numeric_limits<double>::infinity(), true, dist, [&](int v, double d) {
       if (d < distance) return true;
-      if (t.is_interior_vertex(v) && !given.count(v)) reached.emplace_back(d, v);
+      if (t.is_interior_vertex(v) && !given.count(v) && !out.count(v)) reached.emplace_back(d, v);
       return false;  // the ring: no further
     });
     std::sort(reached.begin(), reached.end());  // nearest first, then by id
