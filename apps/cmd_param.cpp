@@ -52,7 +52,7 @@ void run_param(const ParamCommand& o) {
   if (!o.map.quiet)
     std::cout << map_summary(o.map, run)
               << "map: edge length " << fmt(param.edge_length) << ", " << fmt(q.unit_squares) << " unit squares (target " << fmt(q.target_squares)
-              << "), " << q.cut_edges << " cut edges, " << q.integer_unknowns << " integers rounded in " << q.rounding_rounds << " solves\n"
+              << small_components_words(q) << "), " << q.cut_edges << " cut edges, " << q.integer_unknowns << " integers rounded in " << q.rounding_rounds << " solves\n"
               << "seamless: " << (q.seamless ? "yes" : "NO") << " (transition residual " << fmt(q.max_transition_residual) << ", cones off integer points by "
               << fmt(q.max_cone_offset) << ", cone angles off by " << fmt(q.max_cone_angle_error) << " rad"
               << (q.aligned_edges + q.unaligned_edges > 0

@@ -64,7 +64,7 @@ void run_quad(const QuadCommand& o) {
     for (auto [valence, count] : valences) irregular << (irregular.tellp() > 0 ? ", " : "") << count << " of valence " << valence;
     std::cout << map_summary(o.map, run)
               << "map: edge length " << fmt(param.edge_length) << ", seamless " << (p.seamless ? "yes" : "NO") << ", flipped faces "
-              << p.flipped_faces << ", degenerate " << p.degenerate_faces << "\n"
+              << p.flipped_faces << ", degenerate " << p.degenerate_faces << small_components_words(p) << "\n"
               << "quads: " << q.quads << " (target " << std::llround(q.target_quads) << "), " << q.vertices << " vertices, chi "
               << q.euler_characteristic << " (input " << q.input_euler_characteristic << "), " << q.boundary_loops << " boundary loop(s) (input "
               << q.input_boundary_loops << "), " << (q.manifold ? "manifold" : "NOT manifold") << ", "

@@ -157,6 +157,11 @@ std::string search_time_words(const MapRun& run) {
   return " s in all, the search stopped by --search-maps after " + std::to_string(run.maps) + " maps";
 }
 
+std::string small_components_words(const ParamQuality& quality) {
+  if (quality.small_components == 0) return "";
+  return ", " + std::to_string(quality.small_components) + " small component(s) given squares of their own size";
+}
+
 namespace {
 
 std::string placement_line(const MapRun& run) {

@@ -82,6 +82,8 @@ void write_map_singularities(const std::string& path, const MapRun& run);
 nlohmann::ordered_json map_report(const MapCommand& command, const MapRun& run);
 // The end of the time line: what the search's time covers (every step, or those before --search-maps stopped it).
 std::string search_time_words(const MapRun& run);
+// The map line's words for ParamQuality::small_components ("" when none).
+std::string small_components_words(const ParamQuality& quality);
 // What both print first: the mesh's line, the relaxation's when it ran, the field's.
 std::string map_summary(const MapCommand& command, const MapRun& run);
 

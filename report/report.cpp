@@ -128,6 +128,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"factorizations", q.factorizations},
           {"sizing", sizing_name(q.sizing)},
           {"sizing_rounds", q.sizing_rounds},
+          {"small_components", q.small_components},
           {"stiffening_rounds", q.stiffening_rounds},
           {"folds_real_valued", q.folds_real_valued},
           {"folds_rounded", q.folds_rounded},

@@ -381,14 +381,14 @@ TEST(CliQuad, SingularitiesBesideRoundHolesBecomeCornersOfTheirRims) {
   EXPECT_NE(refused.err.find("or align the boundary, --align-boundary, to make the vertex a corner of it)"), std::string::npos) << refused.err;
 }
 
-// The placement is made again only with --auto and no --auto-cancel, and says so in the report (bones at 1,000
-// quads: 26 small closed components, every map folds).
+// The placement is made again only with --auto and no --auto-cancel, and says so in the report (bones at 500
+// quads: 26 closed components, the smallest of one or two squares, every map folds).
 TEST(CliQuad, PlacedAgainOnlyWhenTheCancelDistanceIsTheProgramsOwn) {
   TRIVCON_REQUIRE_SHARED();
   const std::string out = temp_file("q.obj"), report = temp_file("r.json");
   for (const std::string extra : {"", " --auto-cancel 2"}) {
-    const auto r = run_cli("quad " + test::shared_mesh("bones.off") + " --auto --target-faces 1000 -o " + out + " --report " + report + extra);
-    ASSERT_EQ(r.status, 3) << extra << ": " << r.err;  // the map folds either way
+    const auto r = run_cli("quad " + test::shared_mesh("bones.off") + " --auto --target-faces 500 -o " + out + " --report " + report + extra);
+    ASSERT_EQ(r.status, 3) << extra << ": " << r.err;  // the map folds either way (bones of two squares)
     const nlohmann::json j = nlohmann::json::parse(slurp(report));
     const int placements = j["placement"]["placements"].get<int>();
     if (extra.empty()) {
@@ -416,6 +416,10 @@ TEST(CliQuad, FaceCamelheadAndBonesGiveValidQuads) {
   expect_quads_at_the_singularities("face.obj", "--auto --align-boundary --target-faces 10000", 1, false);
   expect_quads_at_the_singularities("camelhead.off", "--auto --align-boundary --target-faces 3000", 1, false);
   expect_quads_at_the_singularities("bones.off", "--auto --target-faces 10000", 52, true);  // 26 closed components
+  // At 2,000 quads: two spreads of +1/4 onto one vertex made +1/2 and +3/4 (quads with a vertex twice) on the
+  // small bones; at 1,000 the smallest bones, of three squares, get 16 of their own size.
+  expect_quads_at_the_singularities("bones.off", "--auto --target-faces 2000", 52, true);
+  expect_quads_at_the_singularities("bones.off", "--auto --target-faces 1000", 52, true);
 }
 
 // A round disk with its boundary aligned: the smoothest field puts one +1 at the centre, which no quad vertex

@@ -827,6 +827,31 @@ TEST(Quad, SeveralComponents) {
   EXPECT_EQ(r.quads.quality.input_components, 3);
 }
 
+// A component of a few unit squares gets 16 of its own size (docs/param.md, "Small components"): a cube sphere of
+// radius 0.1 beside one of radius 1 at 200 squares (about 2 of them on the small one) gets at least 12 quads,
+// and both are clean; the target's total is kept. With a fifth of the target too little to raise it, it is not.
+TEST(Quad, SmallComponentGetsSquaresOfItsOwnSize) {
+  std::vector<Mesh> parts{make_cube_sphere(12, true), make_cube_sphere(6, true)};
+  parts[1].V *= 0.1;
+  parts[1].V.col(0).array() += 3.0;
+  const Mesh m = concatenate(parts);
+  FieldRequest req;
+  req.auto_place = true;
+  ParamOptions o;
+  o.target_faces = 200;
+  const Pipeline r = run(m, req, o);
+  EXPECT_EQ(r.param.quality.small_components, 1);
+  ASSERT_EQ(r.param.quality.flipped_faces + r.param.quality.degenerate_faces, 0) << param_warning(r.param);
+  expect_clean(r, "two spheres");
+  int small_quads = 0;
+  for (int i = 0; i < r.quads.Q.rows(); ++i) small_quads += r.quads.V(r.quads.Q(i, 0), 0) > 2.0;
+  EXPECT_GE(small_quads, 12);
+  EXPECT_NEAR(r.param.quality.unit_squares, 200, 0.1 * 200);
+  o.target_faces = 20;  // 14 squares more than 2: more than a fifth of 20
+  const Pipeline coarse = run(m, req, o);
+  EXPECT_EQ(coarse.param.quality.small_components, 0);
+}
+
 // A map with folds: the extraction ends, and says what failed instead of hiding it.
 TEST(Quad, FoldsAreReportedNotHidden) {
   Pipeline r = torus_grid();

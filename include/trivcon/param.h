@@ -104,6 +104,7 @@ struct ParamQuality {
   int sizing_rounds = 0;      // re-solves with the target's size per face following the map (Sizing::map)
   int folds_real_valued = 0;  // folded faces of the first, real-valued map (before stiffening)
   int folds_rounded = 0;      // folded faces right after the rounding (before stiffening again)
+  int small_components = 0;  // components of too few unit squares given squares of their own size (docs/param.md)
   int cones_moved = 0;        // singularities moved to a neighbouring integer point against a fold or a shared point
   int integers_moved = 0;     // other integers (iso-lines, translations) moved by ±1 against a fold
   int integers_descended = 0; // integers moved by whole units to lower energy after the rounding (docs/param.md)

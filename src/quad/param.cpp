@@ -38,6 +38,10 @@ namespace {
 // of their region has det J > kReliefDeterminant (relative to the ideal unit square); a flat or folded face
 // counts as kReliefFlat in the region's stretch.
 constexpr double kReliefRatio = 10, kReliefDeterminant = 0.05, kReliefFlat = 1e6;
+// Components of fewer unit squares than kLeastSquares get squares of their own size, within kLeastSquaresShare of
+// the target's squares in all (parametrize_at, "Small components").
+constexpr double kLeastSquares = 16;
+constexpr double kLeastSquaresShare = 0.2;
 // The shape pass (last, ParamOptions::shape; on a map whose mean ratio is past kMapDistortionGoal): the faces whose
 // σ_max/σ_min exceeds it and the faces within kShapeRings rings of them lower their stretch with the barrier's shape
 // term alone, at most kShapeRounds rounds of kShapeSteps L-BFGS steps.
@@ -650,6 +654,29 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // u, A ∇φ_i·Y for v); then H = Σ_f weight_f H_f, r = s Σ_f weight_f size_f r_f, K = Pᵀ H P, b = Pᵀ r.
   std::vector<double> weight(nF, 1.0);
   std::vector<double> size(nF, 1.0);  // the target's size per face (the sizing below): s·size·(X Y)ᵀ
+  // Small components: one whose area is less than kLeastSquares unit squares (a bone of a skeleton, a screw of an
+  // assembly) cannot place its singularities a unit apart (a closed one needs 8 of +1/4 and 6 squares at the very
+  // least, as a cube); its target becomes that many squares, its size factor √(kLeastSquares / its squares) held
+  // under every sizing. Largest first (the fewest squares added), while the squares added stay within
+  // kLeastSquaresShare of the attempt's; the target's total is kept, so the other components' squares grow a little.
+  std::vector<double> least_size(nF, 1.0);
+  {
+    const int nC = static_cast<int>(t.components.size());
+    std::vector<double> squares(nC, 0), factor(nC, 1.0);
+    for (int f = 0; f < nF; ++f) squares[t.face_component[f]] += face_area[f] * s * s;
+    std::vector<std::pair<double, int>> small;  // (−squares, component)
+    for (int c = 0; c < nC; ++c)
+      if (squares[c] > 0 && squares[c] < kLeastSquares) small.emplace_back(-squares[c], c);
+    std::sort(small.begin(), small.end());
+    double added = 0;
+    for (auto [minus, c] : small) {
+      if (added + kLeastSquares + minus > kLeastSquaresShare * target_here) break;
+      added += kLeastSquares + minus;
+      factor[c] = std::sqrt(kLeastSquares / -minus);
+      ++q.small_components;
+    }
+    for (int f = 0; f < nF; ++f) size[f] = least_size[f] = factor[t.face_component[f]];
+  }
   Eigen::SparseMatrix<double> H(nX, nX), K;
   Eigen::VectorXd b;
   std::vector<int> H_entry(18 * static_cast<size_t>(nF)), H_column;
@@ -980,7 +1007,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
       size[f] = std::exp(std::clamp(phi[f], -1.0, 1.0));
       covered += face_area[f] * size[f] * size[f], total += face_area[f];
     }
-    for (int f = 0; f < nF; ++f) size[f] /= std::sqrt(covered / total);
+    for (int f = 0; f < nF; ++f) size[f] = size[f] / std::sqrt(covered / total) * least_size[f];
     assemble_rhs();
     y = solve_fixed();
     corner_uv();
@@ -1002,7 +1029,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
         const Eigen::Matrix2d J = jacobian(f);
         const Eigen::Vector2d X(std::cos(theta[f]), std::sin(theta[f])), Y(-X.y(), X.x());
         const double a = J.row(0).dot(X), d = J.row(1).dot(Y);
-        phi[f] = a > 0 && d > 0 ? std::log(std::sqrt(a * d) / s) : std::log(size[f]);  // a folded face keeps its size
+        phi[f] = a > 0 && d > 0 ? std::log(std::sqrt(a * d) / (s * least_size[f])) : std::log(size[f] / least_size[f]);  // a folded face keeps its size
       }
       for (int pass = 0; pass < 3; ++pass) {
         std::vector<double> next = phi;
