@@ -129,6 +129,8 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"sizing", sizing_name(q.sizing)},
           {"sizing_rounds", q.sizing_rounds},
           {"small_components", q.small_components},
+          {"tiny_components", q.tiny_components},
+          {"first_tiny_face", q.first_tiny_face},
           {"stiffening_rounds", q.stiffening_rounds},
           {"folds_real_valued", q.folds_real_valued},
           {"folds_rounded", q.folds_rounded},

@@ -852,6 +852,43 @@ TEST(Quad, SmallComponentGetsSquaresOfItsOwnSize) {
   EXPECT_EQ(coarse.param.quality.small_components, 0);
 }
 
+// Components smaller than one unit square (debris of a scan) are counted, and the warning says that no quad
+// fits in them (rather than only "a larger edge length"): a cube sphere with 30 stray triangles of 1e-6 squares.
+TEST(Quad, ComponentsSmallerThanASquareAreNamed) {
+  std::vector<Mesh> parts{make_cube_sphere(8, true)};
+  for (int i = 0; i < 30; ++i) {
+    Mesh tri;
+    tri.V = (MatrixX3d(3, 3) << 0, 0, 0, 1e-4, 0, 0, 0, 1e-4, 0).finished();
+    tri.V.col(0).array() += 3.0 + 0.1 * i;
+    tri.F = (MatrixX3i(1, 3) << 0, 1, 2).finished();
+    parts.push_back(tri);
+  }
+  const Mesh m = concatenate(parts);
+  FieldRequest req;
+  req.auto_place = true;
+  req.align_boundary = true;
+  ParamOptions o;
+  o.target_faces = 200;
+  const Pipeline r = run(m, req, o);
+  const ParamQuality& q = r.param.quality;
+  EXPECT_EQ(q.tiny_components + q.small_components, 30);  // the sphere is neither
+  ASSERT_GT(q.tiny_components, 0);
+  EXPECT_GE(q.first_tiny_face, parts[0].F.rows());
+  EXPECT_LT(q.first_tiny_squares, 1e-3);
+  EXPECT_LE(q.tiny_component_folds, q.flipped_faces + q.degenerate_faces);
+  EXPECT_NE(param_warning(r.param).find(std::to_string(q.tiny_components) + " component(s) of the mesh are smaller than one unit square (first: the one of face " +
+                                        std::to_string(q.first_tiny_face) + ", "),
+            std::string::npos)
+      << param_warning(r.param);
+  // The stray triangles get no quads: the quad mesh's components and χ are not the input's, and the warning says why.
+  EXPECT_NE(quad_warning(r.quads).find("(the input has " + std::to_string(q.tiny_components) + " component(s) smaller than one unit square"),
+            std::string::npos)
+      << quad_warning(r.quads);
+  const Pipeline sphere = run(parts[0], req, o);
+  EXPECT_EQ(sphere.param.quality.tiny_components, 0);
+  EXPECT_EQ(sphere.param.quality.small_components, 0);
+}
+
 // A map with folds: the extraction ends, and says what failed instead of hiding it.
 TEST(Quad, FoldsAreReportedNotHidden) {
   Pipeline r = torus_grid();

@@ -127,6 +127,11 @@ struct ParamQuality {
   int attempts = 1;           // maps made (ParamOptions::retries); the one kept is described here
   int first_factorizations = 0;  // the first map's factorizations (the retries' budget counts against them)
   std::vector<int> first_flipped;  // up to 10 ids of flipped or degenerate faces
+  // Components smaller than one unit square at the map's scale (their own, for small components): no quad fits
+  // there whatever the singularities (debris of a scan, a stray triangle); the first one's first face and its
+  // unit squares; and how many of the flipped or degenerate faces are theirs.
+  int tiny_components = 0, first_tiny_face = -1, tiny_component_folds = 0;
+  double first_tiny_squares = 0;
   double max_transition_residual = 0;  // over cut edges: how far φ_R − J^r φ_L is from one whole vector at both ends
   double max_cone_offset = 0;          // distance of a singular vertex's (u, v) from the nearest integer point
   double max_cone_angle_error = 0;     // |Σ (u, v) corner angles − 2π(1 − k)| at singular vertices, radians

@@ -60,6 +60,7 @@ struct QuadQuality {
   int unused_vertices = 0;         // integer points in no face (dropped from V)
   int unclosed_vertices = 0;       // input vertices whose (u, v) does not come back to itself around its fan
   int map_folds = 0;               // the map's flipped and degenerate faces (ParamQuality), for the warning
+  int map_tiny_components = 0;     // the map's components smaller than one unit square (ParamQuality), for the warning
   int relaxed_vertices = 0;        // vertices moved on the surface to undo inverted or nearly inverted quads
   int filled_faces = 0;            // of the non-quad faces: filled with quads around a new vertex (QuadOptions::fill_faces)
   std::vector<int> problem_faces;  // up to 10 input faces where points were dropped or traces failed

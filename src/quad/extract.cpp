@@ -831,6 +831,7 @@ QuadMesh Extractor::run() {
   if (options_.fill_faces && !out.other_faces.empty()) q_.filled_faces = quad::fill_faces(designer_, param_, out);
   q_.target_quads = param_.quality.target_squares;
   q_.map_folds = param_.quality.flipped_faces + param_.quality.degenerate_faces;
+  q_.map_tiny_components = param_.quality.tiny_components;
 
   std::vector<std::string>& problems = q_.problems;
   auto say = [&](const std::string& s) { problems.push_back(s); };

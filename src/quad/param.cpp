@@ -2093,6 +2093,16 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
 
   // --- What the map promises, checked on the result --------------------------------------------------------
   const auto t4 = linalg::Clock::now();
+  std::vector<char> tiny(t.components.size(), 0);  // ParamQuality::tiny_components
+  {
+    std::vector<double> squares(t.components.size(), 0);
+    for (int f = 0; f < nF; ++f) squares[t.face_component[f]] += face_area[f] * s * s * least_size[f] * least_size[f];
+    for (size_t c = 0; c < squares.size(); ++c)
+      if (squares[c] < 1) {
+        tiny[c] = 1;
+        if (q.tiny_components++ == 0) q.first_tiny_face = t.components[c].first_face, q.first_tiny_squares = squares[c];
+      }
+  }
   double mapped_area = 0;  // of the faces neither flipped nor degenerate: the mean distortion's weights
   for (int f = 0; f < nF; ++f) {
     const double a = uv_area(f);
@@ -2102,12 +2112,11 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
     }
     const double ratio = distortion(f);
     q.max_distortion = std::max(q.max_distortion, ratio);
-    if (a < -1e-12 * face_area[f] * s * s) {
-      ++q.flipped_faces;
+    const bool flipped = a < -1e-12 * face_area[f] * s * s, degenerate = !flipped && !(a > 1e-12 * face_area[f] * s * s);
+    if (flipped || degenerate) {
+      ++(flipped ? q.flipped_faces : q.degenerate_faces);
       if (q.first_flipped.size() < 10) q.first_flipped.push_back(f);
-    } else if (!(a > 1e-12 * face_area[f] * s * s)) {
-      ++q.degenerate_faces;
-      if (q.first_flipped.size() < 10) q.first_flipped.push_back(f);
+      q.tiny_component_folds += tiny[t.face_component[f]];
     } else if (std::isfinite(ratio)) {
       q.mean_distortion += g.face_area[f] * ratio;
       mapped_area += g.face_area[f];
@@ -2309,13 +2318,21 @@ std::string param_warning(const Parametrization& param) {
     for (size_t i = 0; i < q.first_flipped.size(); ++i) s << (i ? ", " : "") << q.first_flipped[i];
     s << ")";
     if (q.max_cone_angle_error > 1e-6) s << ", folding around singularities (cone angles off by up to " << q.max_cone_angle_error << " rad)";
-    s << " after " << q.stiffening_rounds << " stiffening rounds: a larger edge length, or singularities further apart, usually removes them";
+    s << " after " << q.stiffening_rounds << " stiffening rounds";
+    if (q.tiny_component_folds < bad) s << ": a larger edge length, or singularities further apart, usually removes them";
+    if (q.tiny_component_folds > 0) s << " (" << q.tiny_component_folds << " of them in components smaller than one unit square)";
     for (size_t k = 0; k < param.cones.size(); ++k)
       if (param.cone_index[k] >= 4) {
         s << "; singular vertex " << param.cones[k] << " has index " << param.cone_index[k] << "/4 >= 1: its (u, v) angle 2pi(1 - k) <= 0 "
           << "cannot be made without folding (a quad mesh needs indices below 1)";
         break;
       }
+  }
+  if (q.tiny_components > 0) {
+    if (!s.str().empty()) s << "; ";
+    s << q.tiny_components << " component(s) of the mesh are smaller than one unit square (first: the one of face " << q.first_tiny_face << ", "
+      << q.first_tiny_squares << " unit squares): no quad fits in them whatever the singularities; a smaller edge length, or the mesh "
+      << "without them";
   }
   return s.str();
 }

@@ -250,6 +250,8 @@ std::string quad_warning(const QuadMesh& quads) {
   std::ostringstream s;
   s << "the quad mesh (" << q.quads << " quads) has problems: ";
   for (size_t i = 0; i < q.problems.size(); ++i) s << (i ? "; " : "") << q.problems[i];
+  if (q.map_tiny_components > 0)
+    s << " (the input has " << q.map_tiny_components << " component(s) smaller than one unit square, where no quad fits: see param_warning)";
   if (q.map_folds > 0)
     s << " (the map has " << q.map_folds << " folded or degenerate faces, the usual cause: see param_warning)";
   else if (q.failed_traces > 0 && q.input_boundary_loops > 0)
