@@ -37,7 +37,8 @@ void MapCommand::check(const std::string& command) const {
     throw CLI::ValidationError("--target-faces / --edge-length", "give the scale of the map: one of them");
   if (field.split_large_turns)
     throw CLI::ValidationError("--split-large-turns", "not needed by " + command +
-                                                          ": the map uses the connection's own matching, so large turns are no problem");
+                                                          ": the map uses the connection's own matching, so large turns are no problem below pi "
+                                                          "(beyond, the report's param.half_turn_edges counts them)");
 }
 
 MapRun run_map(const MapCommand& o, bool quads) {
@@ -198,7 +199,11 @@ std::string map_summary(const MapCommand& o, const MapRun& run) {
                                 std::to_string(run.out.V.rows()) + " vertices, " + std::to_string(run.out.F.rows()) +
                                 " faces; the map's file holds the refined mesh, the report its faces' input faces (refine.parent_face)\n"
                           : std::string()) +
-         "field: N 4, " + std::to_string(run.param.cones.size()) + " singular vertices, verified\n";
+         (run.param.quality.half_turn_edges == 0
+              ? "field: N 4, " + std::to_string(run.param.cones.size()) + " singular vertices, verified\n"
+              : "field: N 4, " + std::to_string(run.out.prescription.vertex.size()) + " singular vertices prescribed, verified; the per-face field the map " +
+                    "follows shows " + std::to_string(run.param.cones.size()) + " (the connection turns by pi or more across " +
+                    std::to_string(run.param.quality.half_turn_edges) + " edges)\n");
 }
 
 }  // namespace trivcon::cli

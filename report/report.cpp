@@ -130,6 +130,7 @@ nlohmann::ordered_json param_report(const Parametrization& param) {
           {"sizing_rounds", q.sizing_rounds},
           {"small_components", q.small_components},
           {"tiny_components", q.tiny_components},
+          {"half_turn_edges", q.half_turn_edges},
           {"first_tiny_face", q.first_tiny_face},
           {"stiffening_rounds", q.stiffening_rounds},
           {"folds_real_valued", q.folds_real_valued},

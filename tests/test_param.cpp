@@ -498,6 +498,39 @@ TEST(Param, CheckerboardPicture) {
   EXPECT_THROW(render_design(*r.designer, r.outcome.design, ro), Error);
 }
 
+// Where the connection turns by π or more across an edge the per-face field turns by 2π less: the map, which
+// follows it, reads a +1 and a −1 at that edge's ends that were not prescribed. Counted (half_turn_edges), said
+// in the warning, and nowhere else: +3 (twelve quarters) at one vertex of a coarse icosphere, −1 at another, the
+// first vertex's five dual edges turning by about 6π/5 each; the cube sphere's eight +1/4 turn far less.
+TEST(Param, ConnectionTurningByHalfARevolutionIsReported) {
+  const Mesh m = make_icosphere(1);
+  FieldDesigner d(m.V, m.F);
+  IndexPrescription p;
+  p.N = 4;
+  int far = 0;
+  for (int v = 0; v < m.V.rows(); ++v)
+    if (m.V.row(v).dot(m.V.row(0)) < m.V.row(far).dot(m.V.row(0))) far = v;
+  p.vertex = {{0, 12}, {far, -4}};
+  const Design design = d.design(p);
+  ParamOptions o;
+  o.target_faces = 60;
+  const Parametrization param = parametrize(d, design, o);
+  int half_turns = 0;
+  for (int e = 0; e < d.topology().num_edges; ++e) half_turns += std::abs(design.connection.x[e]) >= kPi;
+  ASSERT_GT(half_turns, 0);
+  EXPECT_EQ(param.quality.half_turn_edges, half_turns);
+  EXPECT_NE(param_warning(param).find("the connection turns by pi or more across " + std::to_string(half_turns) + " edge(s)"), std::string::npos)
+      << param_warning(param);
+  std::map<int, int> cones;
+  for (size_t k = 0; k < param.cones.size(); ++k) cones[param.cones[k]] = param.cone_index[k];
+  EXPECT_NE(cones, p.vertex);  // the map's cones are the per-face field's, not the prescription
+  FieldRequest req;
+  req.auto_place = true;
+  ParamOptions unit;
+  unit.edge_length = 0.5;
+  EXPECT_EQ(run(make_cube_sphere(4, true), req, unit).param.quality.half_turn_edges, 0);
+}
+
 TEST(Param, RefusesWhatItCannotMap) {
   const Mesh m = make_torus(12, 6);
   FieldDesigner d(m.V, m.F);

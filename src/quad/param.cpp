@@ -316,6 +316,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // --- The cut and the combing ---------------------------------------------------------------------------
   const Eigen::VectorXi matching = connection_matching(t, g, field, design.connection.x);
   const FieldIndices indices = indices_with_matching(t, g, designer.cycles(), field, matching);
+  for (int e = 0; e < nE; ++e) q.half_turn_edges += !t.is_boundary_edge(e) && std::abs(design.connection.x[e]) >= kPi - 1e-9;
   std::vector<int> comb(nF, -1);          // which direction is u: k_f
   std::vector<char> tree_edge(nE, 0);
   for (int c = 0; c < static_cast<int>(t.components.size()); ++c) {
@@ -2327,6 +2328,12 @@ std::string param_warning(const Parametrization& param) {
           << "cannot be made without folding (a quad mesh needs indices below 1)";
         break;
       }
+  }
+  if (q.half_turn_edges > 0) {
+    if (!s.str().empty()) s << "; ";
+    s << "the connection turns by pi or more across " << q.half_turn_edges << " edge(s): the per-face field, which the map follows, turns by "
+      << "2pi less there and shows singularities of index +1 and -1 at their ends that were not prescribed (singularities a triangle or two "
+      << "apart: fewer of them, or a finer mesh there)";
   }
   if (q.tiny_components > 0) {
     if (!s.str().empty()) s << "; ";
