@@ -131,10 +131,11 @@ struct ParamQuality {
   // there whatever the singularities (debris of a scan, a stray triangle); the first one's first face and its
   // unit squares; and how many of the flipped or degenerate faces are theirs.
   int tiny_components = 0, first_tiny_face = -1, tiny_component_folds = 0;
-  // Interior edges across which the connection turns by π or more: the per-face field, which the map follows, turns
-  // by 2π less there, so the cones at the edge's ends read ±1 more than prescribed (docs/param.md, "The cut").
-  int half_turn_edges = 0;
   double first_tiny_squares = 0;
+  // Interior edges across which the connection turns by π or more: the per-face field, which the map follows, turns
+  // by 2π less there, so the cones at the edge's ends read ±1 more than prescribed (docs/param.md, "The cut and
+  // the combing").
+  int half_turn_edges = 0;
   double max_transition_residual = 0;  // over cut edges: how far φ_R − J^r φ_L is from one whole vector at both ends
   double max_cone_offset = 0;          // distance of a singular vertex's (u, v) from the nearest integer point
   double max_cone_angle_error = 0;     // |Σ (u, v) corner angles − 2π(1 − k)| at singular vertices, radians

@@ -661,10 +661,15 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   // under every sizing. Largest first (the fewest squares added), while the squares added stay within
   // kLeastSquaresShare of the attempt's; the target's total is kept, so the other components' squares grow a little.
   std::vector<double> least_size(nF, 1.0);
+  auto component_squares = [&]() {  // each component's target squares at the current scale, with its own size
+    std::vector<double> squares(t.components.size(), 0);
+    for (int f = 0; f < nF; ++f) squares[t.face_component[f]] += face_area[f] * s * s * least_size[f] * least_size[f];
+    return squares;
+  };
   {
     const int nC = static_cast<int>(t.components.size());
-    std::vector<double> squares(nC, 0), factor(nC, 1.0);
-    for (int f = 0; f < nF; ++f) squares[t.face_component[f]] += face_area[f] * s * s;
+    const std::vector<double> squares = component_squares();
+    std::vector<double> factor(nC, 1.0);
     std::vector<std::pair<double, int>> small;  // (−squares, component)
     for (int c = 0; c < nC; ++c)
       if (squares[c] > 0 && squares[c] < kLeastSquares) small.emplace_back(-squares[c], c);
@@ -2096,8 +2101,7 @@ Parametrization parametrize_at(const FieldDesigner& designer, const Design& desi
   const auto t4 = linalg::Clock::now();
   std::vector<char> tiny(t.components.size(), 0);  // ParamQuality::tiny_components
   {
-    std::vector<double> squares(t.components.size(), 0);
-    for (int f = 0; f < nF; ++f) squares[t.face_component[f]] += face_area[f] * s * s * least_size[f] * least_size[f];
+    const std::vector<double> squares = component_squares();
     for (size_t c = 0; c < squares.size(); ++c)
       if (squares[c] < 1) {
         tiny[c] = 1;
