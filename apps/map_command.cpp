@@ -182,6 +182,15 @@ std::string scale_line(double scale) {
   return line.str();
 }
 
+// The field's singular vertices are the map's cones, but where the connection turns by π or more across an edge
+// (ParamQuality::half_turn_edges) the per-face field the map follows shows more than were prescribed.
+std::string field_line(const MapRun& run) {
+  const std::string cones = std::to_string(run.param.cones.size());
+  if (run.param.quality.half_turn_edges == 0) return "field: N 4, " + cones + " singular vertices, verified\n";
+  return "field: N 4, " + std::to_string(run.out.prescription.vertex.size()) + " singular vertices prescribed, verified; the per-face field the map " +
+         "follows shows " + cones + " (the connection turns by pi or more across " + std::to_string(run.param.quality.half_turn_edges) + " edges)\n";
+}
+
 }  // namespace
 
 std::string map_summary(const MapCommand& o, const MapRun& run) {
@@ -199,11 +208,7 @@ std::string map_summary(const MapCommand& o, const MapRun& run) {
                                 std::to_string(run.out.V.rows()) + " vertices, " + std::to_string(run.out.F.rows()) +
                                 " faces; the map's file holds the refined mesh, the report its faces' input faces (refine.parent_face)\n"
                           : std::string()) +
-         (run.param.quality.half_turn_edges == 0
-              ? "field: N 4, " + std::to_string(run.param.cones.size()) + " singular vertices, verified\n"
-              : "field: N 4, " + std::to_string(run.out.prescription.vertex.size()) + " singular vertices prescribed, verified; the per-face field the map " +
-                    "follows shows " + std::to_string(run.param.cones.size()) + " (the connection turns by pi or more across " +
-                    std::to_string(run.param.quality.half_turn_edges) + " edges)\n");
+         field_line(run);
 }
 
 }  // namespace trivcon::cli
